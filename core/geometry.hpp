@@ -1,0 +1,48 @@
+#pragma once
+/// Basic geometric types shared by every loom module. All coordinates are in scene
+/// units (see Scene::units) and in the scene's world frame unless a name says otherwise.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <limits>
+
+namespace loom {
+
+/// A point or vector in world coordinates, scene units.
+using Vec3 = Eigen::Vector3d;
+
+/// Axis-aligned bounding box; empty() until the first point is added.
+struct AABB {
+  Vec3 min = Vec3::Constant(std::numeric_limits<double>::infinity());
+  Vec3 max = Vec3::Constant(-std::numeric_limits<double>::infinity());
+
+  /// True while no point has been added.
+  bool empty() const { return !(min.x() <= max.x()); }
+  /// Grows the box to contain p.
+  void extend(const Vec3& p) {
+    min = min.cwiseMin(p);
+    max = max.cwiseMax(p);
+  }
+  /// Grows the box to contain another box.
+  void extend(const AABB& b) {
+    if (b.empty()) return;
+    extend(b.min);
+    extend(b.max);
+  }
+  /// Edge lengths (zero vector when empty).
+  Vec3 size() const { return empty() ? Vec3::Zero() : Vec3(max - min); }
+  /// Centre point (zero when empty).
+  Vec3 center() const { return empty() ? Vec3::Zero() : Vec3(0.5 * (min + max)); }
+  /// Length of the diagonal, 0 when empty.
+  double diagonal() const { return size().norm(); }
+  /// True if p lies in the closed box.
+  bool contains(const Vec3& p) const {
+    return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
+  }
+};
+
+/// True if every component is finite (no NaN, no inf).
+inline bool is_finite(const Vec3& v) { return v.allFinite(); }
+
+}  // namespace loom

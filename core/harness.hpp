@@ -1,0 +1,95 @@
+#pragma once
+/// The harness model of the parametric-model patent (seed: cable-assembly-parametric-
+/// model-xml): four sets — physical attributes, electrical attributes, structure
+/// (ports and branch points, each branch point joined to exactly three nodes) and
+/// branch paths (ordered path points per segment). Lengths in Harness::units.
+
+#include "core/geometry.hpp"
+#include "core/units.hpp"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace loom {
+
+/// Physical attributes of one cable (patent: type id, colour, diameter, min bend radius).
+struct CablePhysical {
+  std::string type;            ///< cable type id, e.g. "AWG20"
+  std::string color;           ///< free text colour name
+  double diameter = 0.0;       ///< outer diameter (> 0), harness units
+  double min_bend_radius = 0.0;  ///< smallest allowed centerline bend radius (≥ 0; 0 = unchecked)
+};
+
+/// One cable: an electrical connection between two ports.
+struct Cable {
+  std::string id;
+  std::string ports[2];  ///< the two port ids it connects (electrical attributes)
+  CablePhysical physical;
+  int line = 0;          ///< line in the source file (0 if built in code)
+  /// Radius of the cable (diameter / 2).
+  double radius() const { return 0.5 * physical.diameter; }
+};
+
+/// A connector pin or cable end: a fixed position with the direction a cable leaves it.
+struct Port {
+  std::string id;
+  Vec3 position = Vec3::Zero();
+  Vec3 direction = Vec3::UnitX();  ///< unit exit direction
+  int line = 0;
+};
+
+/// A branch point of the harness tree; joined to exactly three nodes. The position
+/// may be absent on input, in which case the router places it.
+struct BranchPoint {
+  std::string id;
+  std::optional<Vec3> position;
+  int line = 0;
+};
+
+/// How the path points of a segment become a curve.
+enum class Interp { BSpline, Polyline };
+
+/// An exact cubic (or other degree) B-spline as stored in routed XML.
+struct BSplineData {
+  int degree = 3;
+  std::vector<double> knots;
+  std::vector<Vec3> control_points;
+};
+
+/// A branch path between two nodes (ports or branch points): ordered interior path
+/// points, how to interpolate them, and optionally the exact routed spline.
+struct Segment {
+  std::string from;   ///< start node id (a port or a branch point)
+  std::string to;     ///< end node id
+  std::vector<Vec3> path;  ///< interior path points, from → to (may be empty)
+  Interp interp = Interp::BSpline;
+  std::optional<BSplineData> bspline;  ///< exact routed curve from → to, if any
+  std::optional<double> diameter;      ///< bundle diameter given in the file, if any
+  /// Id of the branch element this segment was written under (empty: top level), kept
+  /// so that writing the file back reproduces its structure.
+  std::string parent_branch;
+  int line = 0;
+};
+
+/// The harness as read from XML: four sets plus the order elements appeared in.
+struct Harness {
+  std::string name;
+  Unit units = Unit::Millimetre;
+  std::vector<Cable> cables;
+  std::vector<Port> ports;
+  std::vector<BranchPoint> branches;
+  std::vector<Segment> segments;
+  std::string source_file;  ///< the file it was read from (for messages)
+
+  /// Index of a port by id, or -1.
+  int find_port(const std::string& id) const;
+  /// Index of a branch point by id, or -1.
+  int find_branch(const std::string& id) const;
+  /// Index of a cable by id, or -1.
+  int find_cable(const std::string& id) const;
+  /// Smallest cable diameter (0 if there are no cables).
+  double smallest_diameter() const;
+};
+
+}  // namespace loom

@@ -1,0 +1,52 @@
+#include "core/io/atomic_file.hpp"
+
+#include <atomic>
+#include <stdexcept>
+#include <system_error>
+#include <unistd.h>
+
+namespace loom {
+
+namespace {
+std::filesystem::path temp_sibling(const std::filesystem::path& p) {
+  static std::atomic<unsigned> counter{0};
+  auto name = "." + p.filename().string() + ".tmp." + std::to_string(::getpid()) + "." +
+              std::to_string(counter++);
+  return p.parent_path() / name;
+}
+}  // namespace
+
+AtomicFile::AtomicFile(std::filesystem::path path, bool binary) : path_(std::move(path)) {
+  std::error_code ec;
+  if (path_.has_parent_path()) std::filesystem::create_directories(path_.parent_path(), ec);
+  tmp_ = temp_sibling(path_);
+  out_.open(tmp_, binary ? std::ios::binary | std::ios::trunc : std::ios::trunc);
+  if (!out_) throw std::runtime_error(path_.string() + ": cannot create output file");
+}
+
+AtomicFile::~AtomicFile() {
+  if (!committed_) {
+    out_.close();
+    std::error_code ec;
+    std::filesystem::remove(tmp_, ec);
+  }
+}
+
+void AtomicFile::commit() {
+  out_.flush();
+  const bool ok = static_cast<bool>(out_);
+  out_.close();
+  if (!ok) throw std::runtime_error(path_.string() + ": write failed");
+  std::error_code ec;
+  std::filesystem::rename(tmp_, path_, ec);
+  if (ec) throw std::runtime_error(path_.string() + ": cannot rename temporary file: " + ec.message());
+  committed_ = true;
+}
+
+void write_file_atomic(const std::filesystem::path& path, const std::string& content) {
+  AtomicFile f(path, true);
+  f.stream().write(content.data(), static_cast<std::streamsize>(content.size()));
+  f.commit();
+}
+
+}  // namespace loom

@@ -1,0 +1,44 @@
+#pragma once
+/// Reading meshes and CAD files into world-frame Parts.
+/// Meshes (STL ascii/binary, OBJ, PLY, OFF, glTF/GLB, DAE) through Assimp; STEP and IGES
+/// through OpenCASCADE, tessellated with a deflection derived from the scene.
+
+#include "core/mesh.hpp"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace loom {
+
+/// A named piece of geometry read from a file (a STEP product occurrence, a solid, or the
+/// whole mesh file), in the file's own frame and units converted to the requested unit.
+struct NamedMesh {
+  std::string name;
+  Mesh mesh;
+  int brep_faces = 0;  ///< B-rep faces tessellated (CAD files only)
+};
+
+/// How CAD files are tessellated.
+struct TessellationParams {
+  double linear_deflection = 0.1;  ///< scene units
+  double angular_deflection_deg = 20.0;
+  double unit_in_mm = 1.0;         ///< target unit (STEP lengths are converted to it)
+};
+
+/// True for extensions handled by OpenCASCADE (.step .stp .iges .igs).
+bool is_cad_file(const std::filesystem::path& p);
+/// True for extensions handled by Assimp (.stl .obj .ply .off .gltf .glb .dae).
+bool is_mesh_file(const std::filesystem::path& p);
+
+/// Reads a mesh file as one mesh (all of its meshes merged, node transforms applied,
+/// identical vertices welded). Throws InputError for a missing/unreadable/empty file or
+/// non-finite coordinates.
+Mesh read_mesh_file(const std::filesystem::path& path);
+
+/// Reads a STEP/IGES file. With `split` true, one NamedMesh per leaf product occurrence
+/// (name = product name, "#k" appended to repeated names); otherwise one compound mesh.
+std::vector<NamedMesh> read_cad_file(const std::filesystem::path& path, const TessellationParams& tp,
+                                     bool split);
+
+}  // namespace loom

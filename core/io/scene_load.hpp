@@ -1,0 +1,30 @@
+#pragma once
+/// Loading a whole scene: the TOML file, every part file (meshes and CAD), the harness,
+/// and the derived settings (DESIGN §3, §7).
+
+#include "core/scene.hpp"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace loom {
+
+/// What load_scene() should do.
+struct SceneLoadOptions {
+  bool load_parts = true;    ///< false: only TOML + harness (fast, for tests of settings)
+  bool use_cache = true;     ///< cache CAD tessellations keyed by file hash and deflection
+};
+
+/// What loading took and noticed.
+struct SceneLoadReport {
+  double load_ms = 0.0;
+  std::vector<std::string> notes;  ///< e.g. "part 'skin' is open: surface checks only"
+};
+
+/// Reads and validates a scene file. Relative paths in it are relative to its directory.
+/// Throws InputError (file, line, key, reason) for every malformed input.
+Scene load_scene(const std::filesystem::path& toml, const SceneLoadOptions& opt = {},
+                 SceneLoadReport* report = nullptr);
+
+}  // namespace loom

@@ -1,0 +1,31 @@
+#pragma once
+/// A part of the scene: named, meshed geometry in world coordinates.
+
+#include "core/mesh.hpp"
+
+#include <string>
+
+namespace loom {
+
+/// What a part is for the harness.
+enum class PartRole {
+  Structure,  ///< a solid the cables must not hit (ribs, spars, boxes)
+  KeepOut,    ///< a zone the cables must not enter (e.g. a moving actuator's envelope)
+};
+
+/// "structure" | "keep_out".
+const char* role_name(PartRole r);
+
+/// One part: a mesh in world coordinates with its role and the extra clearance it asks for.
+struct Part {
+  std::string name;        ///< unique within the scene
+  Mesh mesh;               ///< exact triangles, world frame, scene units
+  PartRole role = PartRole::Structure;
+  double clearance = 0.0;  ///< extra clearance to this part, added to the routing clearance
+  bool closed = false;     ///< true if the mesh is watertight: only then does it have an inside
+  std::string source_file;  ///< file it came from
+  std::string source_name;  ///< product / solid name inside that file (STEP), if any
+  int source_faces = 0;     ///< B-rep faces it was tessellated from (STEP/IGES), else 0
+};
+
+}  // namespace loom

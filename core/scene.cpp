@@ -1,0 +1,24 @@
+#include "core/scene.hpp"
+
+namespace loom {
+
+AABB Scene::bounds() const {
+  AABB box;
+  for (const auto& p : parts) box.extend(p.mesh.bounds());
+  for (const auto& p : harness.ports) box.extend(p.position);
+  return box;
+}
+
+std::size_t Scene::triangle_count() const {
+  std::size_t n = 0;
+  for (const auto& p : parts) n += p.mesh.triangle_count();
+  return n;
+}
+
+int Scene::find_part(const std::string& name) const {
+  for (std::size_t i = 0; i < parts.size(); ++i)
+    if (parts[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+}  // namespace loom

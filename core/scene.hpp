@@ -1,0 +1,60 @@
+#pragma once
+/// A scene: parts, the harness, and the settings for routing, simplification and
+/// tessellation. Every resolution that is not given is derived from the scene and the
+/// derivation is recorded (DESIGN §7: model no more than a scene needs).
+
+#include "core/harness.hpp"
+#include "core/part.hpp"
+#include "core/units.hpp"
+
+#include <string>
+#include <vector>
+
+namespace loom {
+
+/// A numeric setting together with where its value came from.
+struct Setting {
+  double value = 0.0;
+  std::string source;  ///< "scene file" or the derivation rule, e.g. "smallest cable radius / 10"
+};
+
+/// [routing] of the scene file.
+struct RoutingSettings {
+  Setting clearance;       ///< required gap between cable surface and structure
+  std::string planner = "rrtconnect";
+  Setting time_limit;      ///< seconds per cable or bundle
+  unsigned seed = 1;
+};
+
+/// [simplify] of the scene file (α-SIM level of detail).
+struct SimplifySettings {
+  Setting dim_pre;  ///< features smaller than this vanish; default smallest cable diameter
+};
+
+/// [tessellation]: how finely STEP/IGES B-reps are meshed.
+struct TessellationSettings {
+  Setting linear_deflection;  ///< max chord deviation; default smallest cable radius / 10
+  Setting angular_deflection_deg;
+};
+
+/// Everything a command needs about the problem.
+struct Scene {
+  std::string name;
+  Unit units = Unit::Millimetre;
+  std::string source_file;  ///< the TOML file
+  std::vector<Part> parts;
+  Harness harness;
+  bool has_harness = false;
+  RoutingSettings routing;
+  SimplifySettings simplify;
+  TessellationSettings tessellation;
+
+  /// Bounding box of all parts and ports.
+  AABB bounds() const;
+  /// Total triangle count over all parts.
+  std::size_t triangle_count() const;
+  /// Index of a part by name, or -1.
+  int find_part(const std::string& name) const;
+};
+
+}  // namespace loom

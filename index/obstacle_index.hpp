@@ -1,0 +1,88 @@
+#pragma once
+/// One interface for every obstacle query loom makes (DESIGN §5–§7). Implementations:
+/// EmbreeIndex (exact triangles, float BVH, re-centred), FclIndex (exact, double, used to
+/// certify), VoxelMap (OctoMap + Euclidean distance map, approximate, for planning).
+/// All queries are const and thread-safe; batch forms run in parallel (TBB).
+/// Coordinates are world frame, scene units. Part ids index Scene::parts.
+
+#include "core/geometry.hpp"
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace loom {
+
+/// Result of a closest-point query.
+struct ClosestHit {
+  double distance = std::numeric_limits<double>::infinity();  ///< unsigned distance to the surface
+  Vec3 point = Vec3::Zero();  ///< closest point on the surface
+  int part = -1;              ///< part id, -1 if nothing within the search radius
+  std::int64_t triangle = -1; ///< triangle index within the part's mesh (-1 for voxel answers)
+  bool found() const { return part >= 0; }
+};
+
+/// Result of a ray cast.
+struct RayHit {
+  double t = std::numeric_limits<double>::infinity();  ///< distance along the unit direction
+  int part = -1;
+  std::int64_t triangle = -1;
+  Vec3 normal = Vec3::Zero();  ///< geometric normal of the hit triangle (unit)
+  bool found() const { return part >= 0; }
+};
+
+/// What an index guarantees about its distances.
+struct IndexAccuracy {
+  bool exact = false;       ///< true if distances come from exact triangle geometry
+  double abs_error = 0.0;   ///< bound on |reported - true| distance, scene units
+  std::string description;  ///< e.g. "Embree float BVH, re-centred: ≤ 2e-5 mm"
+};
+
+/// The obstacle query interface. Every method is const and safe to call concurrently.
+class ObstacleIndex {
+ public:
+  virtual ~ObstacleIndex() = default;
+
+  /// Name of the implementation ("embree", "fcl", "voxel", "brute").
+  virtual std::string name() const = 0;
+  /// Accuracy of the distances this index returns.
+  virtual IndexAccuracy accuracy() const = 0;
+  /// Number of parts indexed.
+  virtual int part_count() const = 0;
+
+  /// Closest point on any part within max_radius of p (found() == false if none).
+  /// A tight max_radius is most of the speed: pass what you know.
+  virtual ClosestHit closest(const Vec3& p,
+                             double max_radius = std::numeric_limits<double>::infinity()) const = 0;
+  /// Closest point on one given part (found() == false if farther than max_radius).
+  virtual ClosestHit closest_on_part(const Vec3& p, int part,
+                                     double max_radius = std::numeric_limits<double>::infinity()) const = 0;
+  /// True if p is strictly inside a closed part (open parts have no inside); the part id
+  /// is written to *part when given. Correct for points near edges and vertices.
+  virtual bool inside(const Vec3& p, int* part = nullptr) const = 0;
+  /// First hit along origin + t·dir, 0 ≤ t ≤ t_max (dir need not be unit).
+  virtual RayHit ray(const Vec3& origin, const Vec3& dir,
+                     double t_max = std::numeric_limits<double>::infinity()) const = 0;
+  /// True if any part surface comes within r of the point (early exit).
+  virtual bool any_within(const Vec3& p, double r) const = 0;
+  /// True if any part surface comes within r of the segment ab, i.e. the capsule of radius
+  /// r around ab touches a part (early exit). r = 0 tests the segment itself.
+  virtual bool segment_within(const Vec3& a, const Vec3& b, double r) const = 0;
+  /// Distance from segment ab to the nearest part surface, with the closest points.
+  /// `point` is on the surface; `*segment_param` (if given) is the parameter in [0,1] on ab.
+  virtual ClosestHit segment_closest(const Vec3& a, const Vec3& b,
+                                     double max_radius = std::numeric_limits<double>::infinity(),
+                                     double* segment_param = nullptr) const = 0;
+
+  /// Batch closest(): out[i] for points[i]; parallel over points (TBB), `threads` ≤ 0 = all.
+  virtual std::vector<ClosestHit> closest_batch(const std::vector<Vec3>& points, double max_radius,
+                                                int threads = 0) const;
+  /// Batch inside().
+  virtual std::vector<char> inside_batch(const std::vector<Vec3>& points, int threads = 0) const;
+  /// Batch any_within().
+  virtual std::vector<char> any_within_batch(const std::vector<Vec3>& points, double r,
+                                             int threads = 0) const;
+};
+
+}  // namespace loom
