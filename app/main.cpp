@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1, 1);
   int exit_code = 0;
   loom::app::add_info_command(app, exit_code);
+  loom::app::add_demo_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {

@@ -1,0 +1,35 @@
+// `loom demo [--out DIR]`: the main job on the bundled wing-section example.
+#include "app/commands.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#ifndef LOOM_EXAMPLES_DIR
+#define LOOM_EXAMPLES_DIR "examples"
+#endif
+
+namespace loom::app {
+
+/// The bundled example scene: $LOOM_EXAMPLES_DIR overrides the compiled-in source path.
+std::string demo_scene_path() {
+  if (const char* d = std::getenv("LOOM_EXAMPLES_DIR"); d && *d) return std::string(d) + "/wing-section/scene.toml";
+  return std::string(LOOM_EXAMPLES_DIR) + "/wing-section/scene.toml";
+}
+
+void add_demo_command(CLI::App& app, int& exit_code) {
+  auto* cmd = app.add_subcommand("demo", "Run loom on the bundled wing-section example");
+  auto out = std::make_shared<std::string>("loom-demo");
+  auto quiet = std::make_shared<bool>(false);
+  cmd->add_option("--out", *out, "Output directory")->capture_default_str();
+  cmd->add_flag("--quiet", *quiet, "Print nothing (exit status only)");
+  cmd->callback([out, quiet, &exit_code]() {
+    // Until routing lands, the demo is `loom info` on the bundled example (issue 2).
+    (void)out;
+    exit_code = run_info(demo_scene_path(), false, *quiet);
+  });
+}
+
+}  // namespace loom::app

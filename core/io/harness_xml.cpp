@@ -1,0 +1,396 @@
+#include "core/io/harness_xml.hpp"
+
+#include "core/error.hpp"
+#include "core/harness_topology.hpp"
+#include "core/io/atomic_file.hpp"
+
+#include <pugixml.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace loom {
+
+namespace {
+
+/// Maps pugixml byte offsets to 1-based line numbers.
+class LineMap {
+ public:
+  explicit LineMap(const std::string& text) {
+    for (std::size_t i = 0; i < text.size(); ++i)
+      if (text[i] == '\n') newlines_.push_back(static_cast<std::ptrdiff_t>(i));
+  }
+  int line(std::ptrdiff_t offset) const {
+    if (offset < 0) return 0;
+    return static_cast<int>(std::lower_bound(newlines_.begin(), newlines_.end(), offset) - newlines_.begin()) + 1;
+  }
+
+ private:
+  std::vector<std::ptrdiff_t> newlines_;
+};
+
+class Reader {
+ public:
+  Reader(const std::string& text, std::string file) : lines_(text), file_(std::move(file)) {}
+
+  int line(const pugi::xml_node& n) const { return lines_.line(n.offset_debug()); }
+
+  [[noreturn]] void fail(const pugi::xml_node& n, const std::string& reason) const {
+    throw InputError({file_, line(n), describe(n)}, reason);
+  }
+
+  static std::string describe(const pugi::xml_node& n) {
+    std::string s = "<" + std::string(n.name());
+    for (const char* key : {"id", "from", "to"}) {
+      auto a = n.attribute(key);
+      if (a) s += " " + std::string(key) + "=\"" + a.value() + "\"";
+    }
+    return s + ">";
+  }
+
+  std::string required(const pugi::xml_node& n, const char* attr) const {
+    auto a = n.attribute(attr);
+    if (!a) fail(n, std::string("missing attribute '") + attr + "'");
+    std::string v = a.value();
+    if (v.empty()) fail(n, std::string("attribute '") + attr + "' is empty");
+    return v;
+  }
+
+  double number(const pugi::xml_node& n, const char* attr) const {
+    const std::string v = required(n, attr);
+    return parse_number(n, attr, v);
+  }
+
+  double parse_number(const pugi::xml_node& n, const std::string& attr, const std::string& v) const {
+    char* end = nullptr;
+    const double d = std::strtod(v.c_str(), &end);
+    while (end && *end && std::isspace(static_cast<unsigned char>(*end))) ++end;
+    if (end == v.c_str() || (end && *end != '\0'))
+      fail(n, "attribute '" + attr + "' is not a number: '" + v + "'");
+    if (!std::isfinite(d)) fail(n, "attribute '" + attr + "' is not finite: '" + v + "'");
+    return d;
+  }
+
+  std::optional<double> optional_number(const pugi::xml_node& n, const char* attr) const {
+    if (!n.attribute(attr)) return std::nullopt;
+    return number(n, attr);
+  }
+
+  Vec3 point(const pugi::xml_node& n) const { return {number(n, "x"), number(n, "y"), number(n, "z")}; }
+
+  void only_attributes(const pugi::xml_node& n, std::initializer_list<const char*> allowed) const {
+    for (auto a : n.attributes()) {
+      bool ok = false;
+      for (const char* k : allowed) ok = ok || std::string(a.name()) == k;
+      if (!ok) fail(n, std::string("unknown attribute '") + a.name() + "'");
+    }
+  }
+
+  [[noreturn]] void unknown_child(const pugi::xml_node& parent, const pugi::xml_node& child) const {
+    fail(child, std::string("unexpected element <") + child.name() + "> inside <" + parent.name() + ">");
+  }
+
+  Harness read(const pugi::xml_document& doc) {
+    Harness h;
+    h.source_file = file_;
+    pugi::xml_node root = doc.document_element();
+    if (!root) throw InputError({file_, 1, ""}, "no root element");
+    h.name = root.attribute("name") ? root.attribute("name").value() : root.name();
+    if (auto u = root.attribute("units")) {
+      auto unit = parse_unit(u.value());
+      if (!unit) fail(root, std::string("unknown units '") + u.value() + "' (use mm, cm, m or in)");
+      h.units = *unit;
+    }
+    only_attributes(root, {"name", "units"});
+    bool seen_attr = false, seen_struct = false;
+    for (auto child : root.children()) {
+      if (child.type() != pugi::node_element) continue;
+      const std::string name = child.name();
+      if (name == "attributes") {
+        if (seen_attr) fail(child, "duplicate <attributes>");
+        seen_attr = true;
+        read_attributes(child, h);
+      } else if (name == "structure") {
+        if (seen_struct) fail(child, "duplicate <structure>");
+        seen_struct = true;
+        read_structure(child, h);
+      } else {
+        unknown_child(root, child);
+      }
+    }
+    if (!seen_struct && !h.cables.empty()) fail(root, "missing <structure> (ports and segments)");
+    // Canonical segment order (the order the writer uses): segments nested under branch
+    // points, branch by branch, then top-level ones; so read → write → read is the identity.
+    std::stable_partition(h.segments.begin(), h.segments.end(),
+                          [](const Segment& s) { return !s.parent_branch.empty(); });
+    return h;
+  }
+
+ private:
+  void read_attributes(const pugi::xml_node& node, Harness& h) {
+    for (auto c : node.children()) {
+      if (c.type() != pugi::node_element) continue;
+      if (std::string(c.name()) != "cable") unknown_child(node, c);
+      only_attributes(c, {"id"});
+      Cable cab;
+      cab.id = required(c, "id");
+      cab.line = line(c);
+      bool have_el = false, have_phys = false;
+      for (auto sub : c.children()) {
+        if (sub.type() != pugi::node_element) continue;
+        const std::string sn = sub.name();
+        if (sn == "electrical") {
+          if (have_el) fail(sub, "duplicate <electrical>");
+          have_el = true;
+          only_attributes(sub, {});
+          int n = 0;
+          for (auto p : sub.children()) {
+            if (p.type() != pugi::node_element) continue;
+            if (std::string(p.name()) != "port") unknown_child(sub, p);
+            only_attributes(p, {"id"});
+            if (n >= 2) fail(p, "a cable connects exactly two ports; this is a third");
+            cab.ports[n++] = required(p, "id");
+          }
+          if (n != 2) fail(sub, "a cable connects exactly two ports, found " + std::to_string(n));
+        } else if (sn == "physical") {
+          if (have_phys) fail(sub, "duplicate <physical>");
+          have_phys = true;
+          only_attributes(sub, {"type", "color", "colour", "diameter", "min_bend_radius"});
+          cab.physical.type = sub.attribute("type").value();
+          cab.physical.color = sub.attribute("color") ? sub.attribute("color").value() : sub.attribute("colour").value();
+          cab.physical.diameter = number(sub, "diameter");
+          if (!(cab.physical.diameter > 0.0))
+            fail(sub, "diameter must be positive, got " + full_precision(cab.physical.diameter));
+          cab.physical.min_bend_radius = optional_number(sub, "min_bend_radius").value_or(0.0);
+          if (cab.physical.min_bend_radius < 0.0)
+            fail(sub, "min_bend_radius must not be negative, got " + full_precision(cab.physical.min_bend_radius));
+        } else {
+          unknown_child(c, sub);
+        }
+      }
+      if (!have_el) fail(c, "missing <electrical> (the two port ids)");
+      if (!have_phys) fail(c, "missing <physical> (diameter, min_bend_radius)");
+      h.cables.push_back(std::move(cab));
+    }
+  }
+
+  void read_segment(const pugi::xml_node& s, Harness& h, const std::string& parent) {
+    Segment seg;
+    seg.line = line(s);
+    seg.parent_branch = parent;
+    if (parent.empty()) {
+      only_attributes(s, {"from", "to", "diameter"});
+      seg.from = required(s, "from");
+    } else {
+      only_attributes(s, {"to", "diameter"});
+      seg.from = parent;
+    }
+    seg.to = required(s, "to");
+    seg.diameter = optional_number(s, "diameter");
+    if (seg.diameter && !(*seg.diameter > 0.0))
+      fail(s, "diameter must be positive, got " + full_precision(*seg.diameter));
+    bool have_path = false;
+    for (auto c : s.children()) {
+      if (c.type() != pugi::node_element) continue;
+      const std::string n = c.name();
+      if (n == "path") {
+        if (have_path) fail(c, "duplicate <path>");
+        have_path = true;
+        only_attributes(c, {"interp"});
+        if (auto a = c.attribute("interp")) {
+          const std::string v = a.value();
+          if (v == "bspline") seg.interp = Interp::BSpline;
+          else if (v == "polyline") seg.interp = Interp::Polyline;
+          else fail(c, "interp must be 'bspline' or 'polyline', got '" + v + "'");
+        }
+        for (auto p : c.children()) {
+          if (p.type() != pugi::node_element) continue;
+          if (std::string(p.name()) != "pt") unknown_child(c, p);
+          only_attributes(p, {"x", "y", "z"});
+          seg.path.push_back(point(p));
+        }
+      } else if (n == "bspline") {
+        if (seg.bspline) fail(c, "duplicate <bspline>");
+        only_attributes(c, {"degree", "knots"});
+        BSplineData b;
+        const double deg = number(c, "degree");
+        if (deg < 1 || deg > 7 || deg != std::floor(deg)) fail(c, "degree must be an integer in 1..7");
+        b.degree = static_cast<int>(deg);
+        std::istringstream ks(required(c, "knots"));
+        std::string tok;
+        while (ks >> tok) b.knots.push_back(parse_number(c, "knots", tok));
+        for (std::size_t i = 1; i < b.knots.size(); ++i)
+          if (b.knots[i] < b.knots[i - 1]) fail(c, "knots must not decrease (knot " + std::to_string(i) + ")");
+        for (auto p : c.children()) {
+          if (p.type() != pugi::node_element) continue;
+          if (std::string(p.name()) != "cp") unknown_child(c, p);
+          only_attributes(p, {"x", "y", "z"});
+          b.control_points.push_back(point(p));
+        }
+        if (b.control_points.size() < static_cast<std::size_t>(b.degree) + 1)
+          fail(c, "a degree-" + std::to_string(b.degree) + " spline needs at least " +
+                      std::to_string(b.degree + 1) + " control points, found " +
+                      std::to_string(b.control_points.size()));
+        if (b.knots.size() != b.control_points.size() + b.degree + 1)
+          fail(c, "expected " + std::to_string(b.control_points.size() + b.degree + 1) +
+                      " knots (control points + degree + 1), found " + std::to_string(b.knots.size()));
+        seg.bspline = std::move(b);
+      } else {
+        unknown_child(s, c);
+      }
+    }
+    h.segments.push_back(std::move(seg));
+  }
+
+  void read_structure(const pugi::xml_node& node, Harness& h) {
+    for (auto c : node.children()) {
+      if (c.type() != pugi::node_element) continue;
+      const std::string n = c.name();
+      if (n == "port") {
+        only_attributes(c, {"id", "x", "y", "z", "dx", "dy", "dz"});
+        Port p;
+        p.id = required(c, "id");
+        p.line = line(c);
+        p.position = point(c);
+        Vec3 d{number(c, "dx"), number(c, "dy"), number(c, "dz")};
+        const double len = d.norm();
+        if (!(len > 1e-12)) fail(c, "exit direction (dx, dy, dz) has zero length");
+        p.direction = d / len;
+        h.ports.push_back(std::move(p));
+      } else if (n == "branch") {
+        only_attributes(c, {"id", "x", "y", "z"});
+        BranchPoint b;
+        b.id = required(c, "id");
+        b.line = line(c);
+        const bool any = c.attribute("x") || c.attribute("y") || c.attribute("z");
+        if (any) b.position = point(c);
+        h.branches.push_back(b);
+        for (auto s : c.children()) {
+          if (s.type() != pugi::node_element) continue;
+          if (std::string(s.name()) != "segment") unknown_child(c, s);
+          read_segment(s, h, b.id);
+        }
+      } else if (n == "segment") {
+        read_segment(c, h, "");
+      } else {
+        unknown_child(node, c);
+      }
+    }
+  }
+
+  LineMap lines_;
+  std::string file_;
+};
+
+std::string fmt(double v) { return full_precision(v); }
+
+void put_point(pugi::xml_node n, const Vec3& p) {
+  n.append_attribute("x") = fmt(p.x()).c_str();
+  n.append_attribute("y") = fmt(p.y()).c_str();
+  n.append_attribute("z") = fmt(p.z()).c_str();
+}
+
+/// A segment is written inside its branch element only if it starts there (the nested
+/// form has no `from` attribute).
+bool nested_under(const Segment& s, const std::string& branch) {
+  return s.parent_branch == branch && s.from == branch;
+}
+
+void put_segment(pugi::xml_node parent, const Segment& s, bool nested) {
+  auto e = parent.append_child("segment");
+  if (!nested) e.append_attribute("from") = s.from.c_str();
+  e.append_attribute("to") = s.to.c_str();
+  if (s.diameter) e.append_attribute("diameter") = fmt(*s.diameter).c_str();
+  if (!s.path.empty() || s.interp == Interp::Polyline) {
+    auto p = e.append_child("path");
+    p.append_attribute("interp") = s.interp == Interp::Polyline ? "polyline" : "bspline";
+    for (const auto& q : s.path) put_point(p.append_child("pt"), q);
+  }
+  if (s.bspline) {
+    auto b = e.append_child("bspline");
+    b.append_attribute("degree") = s.bspline->degree;
+    std::string knots;
+    for (std::size_t i = 0; i < s.bspline->knots.size(); ++i) knots += (i ? " " : "") + fmt(s.bspline->knots[i]);
+    b.append_attribute("knots") = knots.c_str();
+    for (const auto& q : s.bspline->control_points) put_point(b.append_child("cp"), q);
+  }
+}
+
+}  // namespace
+
+Harness parse_harness_xml(const std::string& text, const std::string& name_for_errors) {
+  pugi::xml_document doc;
+  auto res = doc.load_buffer(text.data(), text.size(), pugi::parse_default | pugi::parse_ws_pcdata_single);
+  if (!res) {
+    LineMap lm(text);
+    throw InputError({name_for_errors, lm.line(res.offset), ""}, std::string("malformed XML: ") + res.description());
+  }
+  Reader r(text, name_for_errors);
+  Harness h = r.read(doc);
+  HarnessTopology topo(h);  // validates ids, branch degree, cycles, connectivity
+  (void)topo;
+  return h;
+}
+
+Harness read_harness_xml(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw InputError({path.string(), 0, ""},
+                     std::filesystem::exists(path) ? "cannot read harness file" : "harness file not found");
+  }
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_harness_xml(ss.str(), path.string());
+}
+
+std::string harness_to_xml(const Harness& h) {
+  pugi::xml_document doc;
+  auto root = doc.append_child("harness");
+  root.append_attribute("name") = h.name.c_str();
+  root.append_attribute("units") = unit_name(h.units);
+  auto attrs = root.append_child("attributes");
+  for (const auto& c : h.cables) {
+    auto e = attrs.append_child("cable");
+    e.append_attribute("id") = c.id.c_str();
+    auto el = e.append_child("electrical");
+    el.append_child("port").append_attribute("id") = c.ports[0].c_str();
+    el.append_child("port").append_attribute("id") = c.ports[1].c_str();
+    auto ph = e.append_child("physical");
+    ph.append_attribute("type") = c.physical.type.c_str();
+    ph.append_attribute("color") = c.physical.color.c_str();
+    ph.append_attribute("diameter") = fmt(c.physical.diameter).c_str();
+    ph.append_attribute("min_bend_radius") = fmt(c.physical.min_bend_radius).c_str();
+  }
+  auto st = root.append_child("structure");
+  for (const auto& p : h.ports) {
+    auto e = st.append_child("port");
+    e.append_attribute("id") = p.id.c_str();
+    put_point(e, p.position);
+    e.append_attribute("dx") = fmt(p.direction.x()).c_str();
+    e.append_attribute("dy") = fmt(p.direction.y()).c_str();
+    e.append_attribute("dz") = fmt(p.direction.z()).c_str();
+  }
+  for (const auto& b : h.branches) {
+    auto e = st.append_child("branch");
+    e.append_attribute("id") = b.id.c_str();
+    if (b.position) put_point(e, *b.position);
+    for (const auto& s : h.segments)
+      if (nested_under(s, b.id)) put_segment(e, s, true);
+  }
+  for (const auto& s : h.segments)
+    if (s.parent_branch.empty() || h.find_branch(s.parent_branch) < 0 || !nested_under(s, s.parent_branch))
+      put_segment(st, s, false);
+  std::ostringstream os;
+  doc.save(os, "  ", pugi::format_default, pugi::encoding_utf8);
+  return os.str();
+}
+
+void write_harness_xml(const Harness& h, const std::filesystem::path& path) {
+  write_file_atomic(path, harness_to_xml(h));
+}
+
+}  // namespace loom

@@ -1,0 +1,236 @@
+#include "core/io/mesh_read.hpp"
+
+#include "core/error.hpp"
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <BRepMesh_IncrementalMesh.hxx>
+#include <BRep_Tool.hxx>
+#include <IGESCAFControl_Reader.hxx>
+#include <IFSelect_ReturnStatus.hxx>
+#include <Interface_Static.hxx>
+#include <Poly_Triangulation.hxx>
+#include <STEPCAFControl_Reader.hxx>
+#include <TDF_ChildIterator.hxx>
+#include <TDF_Label.hxx>
+#include <TDF_LabelSequence.hxx>
+#include <TDataStd_Name.hxx>
+#include <TDocStd_Document.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopLoc_Location.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Compound.hxx>
+#include <TopoDS_Face.hxx>
+#include <BRep_Builder.hxx>
+#include <XCAFApp_Application.hxx>
+#include <XCAFDoc_DocumentTool.hxx>
+#include <XCAFDoc_ShapeTool.hxx>
+
+#include <algorithm>
+#include <cctype>
+#include <map>
+
+namespace loom {
+
+namespace {
+std::string lower_ext(const std::filesystem::path& p) {
+  std::string e = p.extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
+  return e;
+}
+
+void require_readable(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw InputError({path.string(), 0, ""}, "file not found");
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError({path.string(), 0, ""}, "not a regular file");
+  std::ifstream probe(path, std::ios::binary);
+  if (!probe) throw InputError({path.string(), 0, ""}, "cannot open file for reading");
+}
+
+void finish_mesh(Mesh& m, const std::filesystem::path& path, const std::string& what) {
+  const long bad = first_non_finite_vertex(m);
+  if (bad >= 0)
+    throw InputError({path.string(), 0, what}, "vertex " + std::to_string(bad) + " has a NaN or infinite coordinate");
+  weld_identical_vertices(m);
+}
+}  // namespace
+
+bool is_cad_file(const std::filesystem::path& p) {
+  const auto e = lower_ext(p);
+  return e == ".step" || e == ".stp" || e == ".iges" || e == ".igs";
+}
+
+bool is_mesh_file(const std::filesystem::path& p) {
+  const auto e = lower_ext(p);
+  return e == ".stl" || e == ".obj" || e == ".ply" || e == ".off" || e == ".gltf" || e == ".glb" || e == ".dae";
+}
+
+Mesh read_mesh_file(const std::filesystem::path& path) {
+  require_readable(path);
+  if (!is_mesh_file(path))
+    throw InputError({path.string(), 0, ""}, "unknown mesh extension '" + path.extension().string() +
+                                                 "' (meshes: .stl .obj .ply .off .gltf .glb .dae; CAD: .step .stp .iges .igs)");
+  Assimp::Importer importer;
+  // Points and lines are dropped; node transforms are baked in so one mesh results.
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  const aiScene* sc = importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                                           aiProcess_PreTransformVertices | aiProcess_SortByPType);
+  if (!sc) throw InputError({path.string(), 0, ""}, std::string("cannot read mesh: ") + importer.GetErrorString());
+  Mesh m;
+  for (unsigned i = 0; i < sc->mNumMeshes; ++i) {
+    const aiMesh* am = sc->mMeshes[i];
+    if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
+    const auto base = static_cast<std::uint32_t>(m.vertices.size());
+    for (unsigned v = 0; v < am->mNumVertices; ++v)
+      m.vertices.emplace_back(am->mVertices[v].x, am->mVertices[v].y, am->mVertices[v].z);
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      if (face.mNumIndices != 3) continue;
+      m.triangles.push_back({base + face.mIndices[0], base + face.mIndices[1], base + face.mIndices[2]});
+    }
+  }
+  finish_mesh(m, path, "");
+  if (m.empty()) throw InputError({path.string(), 0, ""}, "the mesh has no triangles");
+  return m;
+}
+
+namespace {
+
+/// Appends the triangulation of every face of `shape` (already meshed) to `out`,
+/// honouring face orientation and locations, scaled by `scale`. Returns the face count.
+int append_triangulation(const TopoDS_Shape& shape, double scale, Mesh& out) {
+  int faces = 0;
+  for (TopExp_Explorer ex(shape, TopAbs_FACE); ex.More(); ex.Next()) {
+    const TopoDS_Face& face = TopoDS::Face(ex.Current());
+    ++faces;
+    TopLoc_Location loc;
+    Handle(Poly_Triangulation) tri = BRep_Tool::Triangulation(face, loc);
+    if (tri.IsNull()) continue;
+    const gp_Trsf tr = loc.Transformation();
+    const auto base = static_cast<std::uint32_t>(out.vertices.size());
+    for (Standard_Integer i = 1; i <= tri->NbNodes(); ++i) {
+      gp_Pnt p = tri->Node(i).Transformed(tr);
+      out.vertices.emplace_back(p.X() * scale, p.Y() * scale, p.Z() * scale);
+    }
+    const bool reversed = face.Orientation() == TopAbs_REVERSED;
+    for (Standard_Integer i = 1; i <= tri->NbTriangles(); ++i) {
+      Standard_Integer a, b, c;
+      tri->Triangle(i).Get(a, b, c);
+      if (reversed) std::swap(b, c);
+      out.triangles.push_back({base + static_cast<std::uint32_t>(a - 1), base + static_cast<std::uint32_t>(b - 1),
+                               base + static_cast<std::uint32_t>(c - 1)});
+    }
+  }
+  return faces;
+}
+
+std::string label_name(const TDF_Label& l) {
+  Handle(TDataStd_Name) n;
+  if (l.FindAttribute(TDataStd_Name::GetID(), n)) {
+    TCollection_AsciiString s(n->Get());
+    return s.ToCString();
+  }
+  return "";
+}
+
+struct Leaf {
+  std::string name;
+  TopoDS_Shape shape;  // located in the assembly frame
+};
+
+void collect_leaves(const Handle(XCAFDoc_ShapeTool)& tool, const TDF_Label& label, const TopLoc_Location& loc,
+                    std::vector<Leaf>& out) {
+  TDF_Label ref = label;
+  TopLoc_Location here = loc;
+  std::string instance_name = label_name(label);
+  if (XCAFDoc_ShapeTool::IsReference(label)) {
+    XCAFDoc_ShapeTool::GetReferredShape(label, ref);
+    here = loc * XCAFDoc_ShapeTool::GetLocation(label);
+  }
+  if (XCAFDoc_ShapeTool::IsAssembly(ref)) {
+    TDF_LabelSequence comps;
+    XCAFDoc_ShapeTool::GetComponents(ref, comps);
+    for (Standard_Integer i = 1; i <= comps.Length(); ++i) collect_leaves(tool, comps.Value(i), here, out);
+    return;
+  }
+  TopoDS_Shape s = XCAFDoc_ShapeTool::GetShape(ref);
+  if (s.IsNull()) return;
+  std::string name = label_name(ref);
+  if (name.empty()) name = instance_name;
+  out.push_back({name, s.Moved(here)});
+}
+}  // namespace
+
+std::vector<NamedMesh> read_cad_file(const std::filesystem::path& path, const TessellationParams& tp, bool split) {
+  require_readable(path);
+  if (!is_cad_file(path))
+    throw InputError({path.string(), 0, ""}, "not a STEP/IGES file: '" + path.extension().string() + "'");
+  if (!(tp.linear_deflection > 0.0))
+    throw InputError({path.string(), 0, ""}, "tessellation deflection must be positive");
+  Handle(XCAFApp_Application) app = XCAFApp_Application::GetApplication();
+  Handle(TDocStd_Document) doc;
+  app->NewDocument("MDTV-XCAF", doc);
+  const std::string ext = lower_ext(path);
+  // OpenCASCADE converts lengths to millimetres on transfer; we then scale to scene units.
+  Interface_Static::SetCVal("xstep.cascade.unit", "MM");
+  bool ok = false;
+  if (ext == ".step" || ext == ".stp") {
+    STEPCAFControl_Reader reader;
+    reader.SetNameMode(true);
+    if (reader.ReadFile(path.string().c_str()) != IFSelect_RetDone)
+      throw InputError({path.string(), 0, ""}, "cannot parse STEP file");
+    ok = reader.Transfer(doc);
+  } else {
+    IGESCAFControl_Reader reader;
+    reader.SetNameMode(true);
+    if (reader.ReadFile(path.string().c_str()) != IFSelect_RetDone)
+      throw InputError({path.string(), 0, ""}, "cannot parse IGES file");
+    ok = reader.Transfer(doc);
+  }
+  if (!ok) throw InputError({path.string(), 0, ""}, "OpenCASCADE could not transfer the file's shapes");
+  Handle(XCAFDoc_ShapeTool) tool = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
+  TDF_LabelSequence roots;
+  tool->GetFreeShapes(roots);
+  std::vector<Leaf> leaves;
+  for (Standard_Integer i = 1; i <= roots.Length(); ++i) collect_leaves(tool, roots.Value(i), TopLoc_Location(), leaves);
+  app->Close(doc);
+  if (leaves.empty()) throw InputError({path.string(), 0, ""}, "the file contains no shapes");
+
+  const double scale = 1.0 / tp.unit_in_mm;
+  // Deflection is given in scene units; OpenCASCADE meshes in the file's (mm) frame.
+  const double lin_mm = tp.linear_deflection * tp.unit_in_mm;
+  const double ang = tp.angular_deflection_deg * M_PI / 180.0;
+  std::vector<NamedMesh> out;
+  if (!split) {
+    BRep_Builder bb;
+    TopoDS_Compound comp;
+    bb.MakeCompound(comp);
+    for (const auto& l : leaves) bb.Add(comp, l.shape);
+    BRepMesh_IncrementalMesh mesher(comp, lin_mm, false, ang, true);
+    NamedMesh nm;
+    nm.name = leaves.size() == 1 ? leaves[0].name : path.stem().string();
+    nm.brep_faces = append_triangulation(comp, scale, nm.mesh);
+    finish_mesh(nm.mesh, path, nm.name);
+    if (nm.mesh.empty()) throw InputError({path.string(), 0, ""}, "tessellation produced no triangles");
+    out.push_back(std::move(nm));
+    return out;
+  }
+  std::map<std::string, int> seen;
+  for (const auto& l : leaves) {
+    BRepMesh_IncrementalMesh mesher(l.shape, lin_mm, false, ang, true);
+    NamedMesh nm;
+    std::string base = l.name.empty() ? "solid" : l.name;
+    const int k = ++seen[base];
+    nm.name = k == 1 ? base : base + "#" + std::to_string(k);
+    nm.brep_faces = append_triangulation(l.shape, scale, nm.mesh);
+    finish_mesh(nm.mesh, path, nm.name);
+    if (nm.mesh.empty()) continue;  // e.g. a wire-frame or empty product: nothing to collide with
+    out.push_back(std::move(nm));
+  }
+  if (out.empty()) throw InputError({path.string(), 0, ""}, "tessellation produced no triangles");
+  return out;
+}
+
+}  // namespace loom

@@ -1,0 +1,313 @@
+#include "core/io/scene_load.hpp"
+
+#include "core/error.hpp"
+#include "core/harness_topology.hpp"
+#include "core/io/harness_xml.hpp"
+#include "core/io/mesh_read.hpp"
+#include "core/io/tessellation_cache.hpp"
+
+#include <toml++/toml.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace loom {
+
+namespace {
+
+class TomlReader {
+ public:
+  explicit TomlReader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const toml::node* n, const std::string& key, const std::string& reason) const {
+    const int line = n ? static_cast<int>(n->source().begin.line) : 0;
+    throw InputError({file_, line, key}, reason);
+  }
+
+  void only_keys(const toml::table& t, const std::string& where, std::initializer_list<const char*> allowed) const {
+    for (const auto& [k, v] : t) {
+      bool ok = false;
+      for (const char* a : allowed) ok = ok || k.str() == a;
+      if (!ok) fail(&v, where + "." + std::string(k.str()), "unknown key (allowed: " + join(allowed) + ")");
+    }
+  }
+
+  static std::string join(std::initializer_list<const char*> l) {
+    std::string s;
+    for (const char* a : l) s += (s.empty() ? "" : ", ") + std::string(a);
+    return s;
+  }
+
+  std::optional<double> number(const toml::table& t, const std::string& where, const char* key) const {
+    const toml::node* n = t.get(key);
+    if (!n) return std::nullopt;
+    double v;
+    if (auto i = n->as_integer()) v = static_cast<double>(i->get());
+    else if (auto f = n->as_floating_point()) v = f->get();
+    else fail(n, where + "." + key, "expected a number");
+    if (!std::isfinite(v)) fail(n, where + "." + key, "must be finite, got " + full_precision(v));
+    return v;
+  }
+
+  std::optional<std::string> string(const toml::table& t, const std::string& where, const char* key) const {
+    const toml::node* n = t.get(key);
+    if (!n) return std::nullopt;
+    auto s = n->as_string();
+    if (!s) fail(n, where + "." + key, "expected a string");
+    return s->get();
+  }
+
+  Vec3 vec3(const toml::node* n, const std::string& key) const {
+    auto a = n->as_array();
+    if (!a || a->size() != 3) fail(n, key, "expected an array of 3 numbers");
+    Vec3 v;
+    for (int i = 0; i < 3; ++i) {
+      const toml::node* e = a->get(static_cast<std::size_t>(i));
+      if (auto x = e->as_integer()) v[i] = static_cast<double>(x->get());
+      else if (auto f = e->as_floating_point()) v[i] = f->get();
+      else fail(e, key, "expected numbers");
+      if (!std::isfinite(v[i])) fail(e, key, "must be finite");
+    }
+    return v;
+  }
+
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+};
+
+/// Transform of DESIGN §3: scale, then rotate about X, Y, Z (fixed axes), then translate.
+Eigen::Affine3d part_transform(const TomlReader& r, const toml::table* t, const std::string& where) {
+  Eigen::Affine3d m = Eigen::Affine3d::Identity();
+  if (!t) return m;
+  r.only_keys(*t, where, {"translate", "rotate_deg", "scale"});
+  Vec3 tr = Vec3::Zero(), rot = Vec3::Zero();
+  double scale = 1.0;
+  if (auto n = t->get("translate")) tr = r.vec3(n, where + ".translate");
+  if (auto n = t->get("rotate_deg")) rot = r.vec3(n, where + ".rotate_deg");
+  if (auto s = r.number(*t, where, "scale")) {
+    scale = *s;
+    if (!(scale > 0.0)) r.fail(t->get("scale"), where + ".scale", "must be positive");
+  }
+  const double d2r = M_PI / 180.0;
+  // Fixed-axis X then Y then Z: R = Rz · Ry · Rx.
+  const Eigen::Matrix3d R = (Eigen::AngleAxisd(rot.z() * d2r, Vec3::UnitZ()) *
+                             Eigen::AngleAxisd(rot.y() * d2r, Vec3::UnitY()) *
+                             Eigen::AngleAxisd(rot.x() * d2r, Vec3::UnitX()))
+                                .toRotationMatrix();
+  m.linear() = R * scale;
+  m.translation() = tr;
+  return m;
+}
+
+std::filesystem::path resolve(const std::filesystem::path& base, const std::string& rel) {
+  std::filesystem::path p(rel);
+  return p.is_absolute() ? p : base / p;
+}
+
+}  // namespace
+
+Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions& opt, SceneLoadReport* report) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string file = toml_path.string();
+  {
+    std::error_code ec;
+    if (!std::filesystem::exists(toml_path, ec)) throw InputError({file, 0, ""}, "scene file not found");
+    std::ifstream probe(toml_path);
+    if (!probe) throw InputError({file, 0, ""}, "cannot read scene file");
+  }
+  toml::table doc;
+  try {
+    doc = toml::parse_file(file);
+  } catch (const toml::parse_error& e) {
+    throw InputError({file, static_cast<int>(e.source().begin.line), ""},
+                     std::string("malformed TOML: ") + std::string(e.description()));
+  }
+  TomlReader r(file);
+  r.only_keys(doc, "", {"scene", "part", "harness", "routing", "simplify", "tessellation"});
+  const std::filesystem::path base = toml_path.parent_path();
+  Scene scene;
+  scene.source_file = file;
+
+  const toml::table* sc = doc["scene"].as_table();
+  if (!sc) r.fail(nullptr, "[scene]", "missing [scene] table (name, units)");
+  r.only_keys(*sc, "scene", {"name", "units"});
+  scene.name = r.string(*sc, "scene", "name").value_or(toml_path.stem().string());
+  const std::string units = r.string(*sc, "scene", "units").value_or("mm");
+  auto unit = parse_unit(units);
+  if (!unit) r.fail(sc->get("units"), "scene.units", "unknown unit '" + units + "' (use mm, cm, m or in)");
+  scene.units = *unit;
+
+  // Harness first: cable sizes drive the derived tessellation deflection.
+  if (const toml::table* ht = doc["harness"].as_table()) {
+    r.only_keys(*ht, "harness", {"file"});
+    auto hf = r.string(*ht, "harness", "file");
+    if (!hf) r.fail(ht->get("file") ? ht->get("file") : nullptr, "harness.file", "missing harness file name");
+    try {
+      scene.harness = read_harness_xml(resolve(base, *hf));
+    } catch (const InputError& e) {
+      if (e.where().file.empty() || e.where().line == 0) {
+        // Point at the scene entry as well so the user sees where the path came from.
+        throw InputError(e.where(), e.reason() + " (referenced by " + file + ":" +
+                                        std::to_string(ht->get("file")->source().begin.line) + " harness.file)");
+      }
+      throw;
+    }
+    if (scene.harness.units != scene.units)
+      r.fail(ht->get("file"), "harness.file",
+             std::string("unit mismatch: the harness is in ") + unit_name(scene.harness.units) +
+                 " but the scene is in " + unit_name(scene.units) + " (all lengths must share the scene unit)");
+    scene.has_harness = true;
+  }
+  const double dmin = scene.harness.smallest_diameter();
+  const double mm = 1.0 / unit_in_mm(scene.units);  // one millimetre in scene units
+
+  // [routing]
+  scene.routing.clearance = {dmin > 0 ? dmin : 1.0 * mm,
+                             dmin > 0 ? "default: smallest cable diameter" : "default: 1 mm (no cables)"};
+  scene.routing.time_limit = {1.0, "default: 1 s per cable or bundle"};
+  if (const toml::table* rt = doc["routing"].as_table()) {
+    r.only_keys(*rt, "routing", {"clearance", "planner", "time_limit", "seed"});
+    if (auto v = r.number(*rt, "routing", "clearance")) {
+      if (*v < 0) r.fail(rt->get("clearance"), "routing.clearance", "must not be negative");
+      scene.routing.clearance = {*v, "scene file"};
+    }
+    if (auto v = r.number(*rt, "routing", "time_limit")) {
+      if (*v < 0) r.fail(rt->get("time_limit"), "routing.time_limit", "must not be negative");
+      scene.routing.time_limit = {*v, "scene file"};
+    }
+    if (auto v = r.string(*rt, "routing", "planner")) scene.routing.planner = *v;
+    if (auto v = r.number(*rt, "routing", "seed")) {
+      if (*v < 0 || *v != std::floor(*v)) r.fail(rt->get("seed"), "routing.seed", "must be a non-negative integer");
+      scene.routing.seed = static_cast<unsigned>(*v);
+    }
+  }
+  // [simplify]
+  scene.simplify.dim_pre = {dmin > 0 ? dmin : 1.0 * mm,
+                            dmin > 0 ? "default: smallest cable diameter" : "default: 1 mm (no cables)"};
+  if (const toml::table* st = doc["simplify"].as_table()) {
+    r.only_keys(*st, "simplify", {"dim_pre"});
+    if (auto v = r.number(*st, "simplify", "dim_pre")) {
+      if (!(*v > 0)) r.fail(st->get("dim_pre"), "simplify.dim_pre", "must be positive");
+      scene.simplify.dim_pre = {*v, "scene file"};
+    }
+  }
+  // [tessellation]
+  scene.tessellation.linear_deflection = {dmin > 0 ? dmin / 20.0 : 0.1 * mm,
+                                          dmin > 0 ? "default: smallest cable radius / 10" : "default: 0.1 mm (no cables)"};
+  scene.tessellation.angular_deflection_deg = {20.0, "default: 20 degrees"};
+  if (const toml::table* tt = doc["tessellation"].as_table()) {
+    r.only_keys(*tt, "tessellation", {"linear_deflection", "angular_deflection_deg"});
+    if (auto v = r.number(*tt, "tessellation", "linear_deflection")) {
+      if (!(*v > 0)) r.fail(tt->get("linear_deflection"), "tessellation.linear_deflection", "must be positive");
+      scene.tessellation.linear_deflection = {*v, "scene file"};
+    }
+    if (auto v = r.number(*tt, "tessellation", "angular_deflection_deg")) {
+      if (!(*v > 0 && *v < 180))
+        r.fail(tt->get("angular_deflection_deg"), "tessellation.angular_deflection_deg", "must be in (0, 180)");
+      scene.tessellation.angular_deflection_deg = {*v, "scene file"};
+    }
+  }
+
+  // [[part]]
+  std::set<std::string> names;
+  if (const toml::node* pn = doc.get("part")) {
+    const toml::array* parts = pn->as_array();
+    if (!parts) r.fail(pn, "part", "expected [[part]] tables");
+    int idx = 0;
+    for (const toml::node& node : *parts) {
+      ++idx;
+      const toml::table* pt = node.as_table();
+      const std::string where = "part[" + std::to_string(idx) + "]";
+      if (!pt) r.fail(&node, where, "expected a table");
+      r.only_keys(*pt, where, {"name", "file", "transform", "role", "clearance", "compound"});
+      auto file_rel = r.string(*pt, where, "file");
+      if (!file_rel) r.fail(&node, where, "missing 'file'");
+      const std::string pname = r.string(*pt, where, "name").value_or(std::filesystem::path(*file_rel).stem().string());
+      const std::string pwhere = "part '" + pname + "'";
+      PartRole role = PartRole::Structure;
+      if (auto ro = r.string(*pt, where, "role")) {
+        if (*ro == "structure") role = PartRole::Structure;
+        else if (*ro == "keep_out") role = PartRole::KeepOut;
+        else r.fail(pt->get("role"), pwhere + ".role", "role must be 'structure' or 'keep_out', got '" + *ro + "'");
+      }
+      const double extra = r.number(*pt, where, "clearance").value_or(0.0);
+      if (extra < 0) r.fail(pt->get("clearance"), pwhere + ".clearance", "must not be negative");
+      bool compound = false;
+      if (const toml::node* cn = pt->get("compound")) {
+        auto b = cn->as_boolean();
+        if (!b) r.fail(cn, pwhere + ".compound", "expected true or false");
+        compound = b->get();
+      }
+      const Eigen::Affine3d xf = part_transform(r, pt->get("transform") ? pt->get("transform")->as_table() : nullptr,
+                                                pwhere + ".transform");
+      if (pt->get("transform") && !pt->get("transform")->as_table())
+        r.fail(pt->get("transform"), pwhere + ".transform", "expected an inline table { translate, rotate_deg, scale }");
+      const std::filesystem::path fpath = resolve(base, *file_rel);
+      if (!is_cad_file(fpath) && !is_mesh_file(fpath))
+        r.fail(pt->get("file"), pwhere + ".file",
+               "unknown file extension '" + fpath.extension().string() +
+                   "' (meshes: .stl .obj .ply .off .gltf .glb .dae; CAD: .step .stp .iges .igs)");
+      if (!opt.load_parts) {
+        std::error_code ec;
+        if (!std::filesystem::exists(fpath, ec))
+          r.fail(pt->get("file"), pwhere + ".file", "file not found: " + fpath.string());
+        Part p;
+        p.name = pname;
+        p.role = role;
+        p.clearance = extra;
+        p.source_file = fpath.string();
+        if (!names.insert(p.name).second) r.fail(&node, pwhere, "duplicate part name");
+        scene.parts.push_back(std::move(p));
+        continue;
+      }
+      std::vector<NamedMesh> pieces;
+      try {
+        if (is_cad_file(fpath)) {
+          TessellationParams tp;
+          tp.linear_deflection = scene.tessellation.linear_deflection.value;
+          tp.angular_deflection_deg = scene.tessellation.angular_deflection_deg.value;
+          tp.unit_in_mm = unit_in_mm(scene.units);
+          pieces = opt.use_cache ? read_cad_file_cached(fpath, tp, !compound) : read_cad_file(fpath, tp, !compound);
+        } else {
+          pieces.push_back({pname, read_mesh_file(fpath), 0});
+        }
+      } catch (const InputError& e) {
+        throw InputError(e.where(), e.reason() + " (" + file + ":" + std::to_string(pt->get("file")->source().begin.line) +
+                                        " " + pwhere + ")");
+      }
+      for (auto& piece : pieces) {
+        Part p;
+        p.name = pieces.size() == 1 ? pname : pname + "/" + piece.name;
+        p.mesh = std::move(piece.mesh);
+        p.mesh.transform(xf);
+        p.role = role;
+        p.clearance = extra;
+        p.source_file = fpath.string();
+        p.source_name = piece.name;
+        p.source_faces = piece.brep_faces;
+        const MeshTopology topo = analyse_topology(p.mesh);
+        p.closed = topo.closed;
+        orient_outward(p.mesh, topo);
+        if (p.mesh.empty()) r.fail(pt->get("file"), pwhere + ".file", "empty mesh");
+        if (!p.closed && report)
+          report->notes.push_back("part '" + p.name + "' is open (" + std::to_string(topo.boundary_edges) +
+                                  " boundary edges): it has no inside, surface checks only");
+        if (!names.insert(p.name).second) r.fail(&node, pwhere, "duplicate part name '" + p.name + "'");
+        scene.parts.push_back(std::move(p));
+      }
+    }
+  }
+  // Ports and branch points must be finite (checked by the XML reader) and, if the scene has
+  // parts, inside the OctoMap-addressable range; that check belongs to the voxel map.
+  if (report) {
+    report->load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
+  return scene;
+}
+
+}  // namespace loom

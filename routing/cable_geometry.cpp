@@ -1,0 +1,93 @@
+#include "routing/cable_geometry.hpp"
+
+#include <stdexcept>
+
+namespace loom {
+
+namespace {
+
+std::optional<Vec3> node_position(const Harness& h, const std::string& id) {
+  if (int p = h.find_port(id); p >= 0) return h.ports[p].position;
+  if (int b = h.find_branch(id); b >= 0) return h.branches[b].position;
+  return std::nullopt;
+}
+
+/// The curve traversed backwards: u ↦ (a + b) − u.
+Centerline reversed(const Centerline& c) {
+  const auto& k = c.knots();
+  const double a = k.front(), b = k.back();
+  std::vector<double> knots(k.size());
+  for (std::size_t i = 0; i < k.size(); ++i) knots[i] = a + b - k[k.size() - 1 - i];
+  std::vector<Vec3> cps(c.control_points().rbegin(), c.control_points().rend());
+  return Centerline(c.degree(), std::move(knots), std::move(cps));
+}
+
+/// A degree-1 curve as an exact cubic: each linear piece becomes a cubic Bézier with
+/// control points at thirds; interior knots get multiplicity 3 (the corners stay corners).
+Centerline linear_as_cubic(const Centerline& c) {
+  const auto& k = c.knots();
+  const auto& p = c.control_points();
+  std::vector<double> knots;
+  std::vector<Vec3> cps{p.front()};
+  knots.insert(knots.end(), 4, k[1]);
+  for (std::size_t i = 0; i + 1 < p.size(); ++i) {
+    const Vec3 d = p[i + 1] - p[i];
+    cps.push_back(p[i] + d / 3.0);
+    cps.push_back(p[i] + 2.0 * d / 3.0);
+    cps.push_back(p[i + 1]);
+    const double t = k[i + 2];
+    knots.insert(knots.end(), i + 2 < p.size() ? 3 : 4, t);
+  }
+  return Centerline(3, std::move(knots), std::move(cps));
+}
+
+Centerline as_cubic(const Centerline& c) {
+  if (c.degree() == 3) return c;
+  if (c.degree() == 1) return linear_as_cubic(c);
+  throw std::invalid_argument("cable_centerline: only degree 1 and 3 segment curves can be joined, got degree " +
+                              std::to_string(c.degree()));
+}
+
+/// Joins two clamped cubics end to start (C0 at the joint, knot multiplicity 3 there).
+Centerline join(const Centerline& a, const Centerline& b) {
+  const auto& ka = a.knots();
+  const auto& kb = b.knots();
+  const double shift = ka.back() - kb.front();
+  std::vector<double> knots(ka.begin(), ka.end() - 1);  // a's knots with its end knot thrice
+  for (std::size_t i = 4; i < kb.size(); ++i) knots.push_back(kb[i] + shift);
+  std::vector<Vec3> cps = a.control_points();
+  cps.insert(cps.end(), b.control_points().begin() + 1, b.control_points().end());
+  return Centerline(3, std::move(knots), std::move(cps));
+}
+
+}  // namespace
+
+std::optional<Centerline> segment_centerline(const Harness& h, int segment) {
+  const Segment& s = h.segments.at(static_cast<std::size_t>(segment));
+  if (s.bspline) return Centerline(s.bspline->degree, s.bspline->knots, s.bspline->control_points);
+  const auto a = node_position(h, s.from), b = node_position(h, s.to);
+  if (!a || !b) return std::nullopt;
+  std::vector<Vec3> pts{*a};
+  pts.insert(pts.end(), s.path.begin(), s.path.end());
+  pts.push_back(*b);
+  if (s.interp == Interp::Polyline) return Centerline::polyline(pts);
+  InterpolationOptions opt;
+  // A cable leaves a port along its exit direction and arrives against it.
+  if (int p = h.find_port(s.from); p >= 0) opt.start_tangent = h.ports[p].direction;
+  if (int p = h.find_port(s.to); p >= 0) opt.end_tangent = -h.ports[p].direction;
+  return Centerline::interpolate(pts, opt);
+}
+
+std::optional<Centerline> cable_centerline(const HarnessTopology& topo, int cable) {
+  const Harness& h = topo.harness();
+  std::optional<Centerline> out;
+  for (const SegmentUse& u : topo.cable_chain(cable)) {
+    auto c = segment_centerline(h, u.segment);
+    if (!c) return std::nullopt;
+    Centerline piece = as_cubic(u.reversed ? reversed(*c) : *c);
+    out = out ? join(*out, piece) : piece;
+  }
+  return out;
+}
+
+}  // namespace loom

@@ -1,0 +1,25 @@
+#pragma once
+/// The centerline of each cable and segment of a harness: segment curves from their
+/// <bspline> (exact) or from their path points (interp bspline|polyline), joined along
+/// each cable's chain of segments (HarnessTopology) from its first port to its second.
+
+#include "core/centerline.hpp"
+#include "core/harness_topology.hpp"
+
+#include <optional>
+#include <vector>
+
+namespace loom {
+
+/// The curve of one segment, from → to: its exact <bspline> if present; else the
+/// interpolating cubic (interp="bspline", tangent-clamped along port exit directions at
+/// port ends) or polyline through from-node, path points, to-node. nullopt if an end has
+/// no position (an unplaced branch point) — the segment is not routed yet.
+std::optional<Centerline> segment_centerline(const Harness& h, int segment);
+
+/// A cable's full centerline from its first to its second port: the segment curves of its
+/// chain joined in order (reversed where the cable runs to → from) into one curve.
+/// nullopt if any segment of the chain is not routed.
+std::optional<Centerline> cable_centerline(const HarnessTopology& topo, int cable);
+
+}  // namespace loom

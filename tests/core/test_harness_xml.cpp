@@ -1,0 +1,244 @@
+// Harness XML: lossless round trip and the bad-input catalogue (each error names the line).
+#include "core/error.hpp"
+#include "core/harness_topology.hpp"
+#include "core/io/harness_xml.hpp"
+
+#include <gtest/gtest.h>
+#include <rapidcheck/gtest.h>
+
+#include <fstream>
+
+namespace loom {
+namespace {
+
+const char* kSample = R"(<?xml version="1.0"?>
+<harness name="W1" units="mm">
+  <attributes>
+    <cable id="C1">
+      <electrical><port id="J1.1"/><port id="J3.4"/></electrical>
+      <physical type="AWG20" color="red" diameter="1.8" min_bend_radius="18"/>
+    </cable>
+    <cable id="C2">
+      <electrical><port id="J2.1"/><port id="J3.4"/></electrical>
+      <physical type="AWG22" color="blue" diameter="1.2" min_bend_radius="12"/>
+    </cable>
+    <cable id="C3">
+      <electrical><port id="J4.1"/><port id="J4.2"/></electrical>
+      <physical type="AWG22" color="white" diameter="1.2" min_bend_radius="12"/>
+    </cable>
+  </attributes>
+  <structure>
+    <segment from="J4.1" to="J4.2">
+      <path interp="polyline"><pt x="0" y="5" z="0"/><pt x="0.1" y="5" z="0.25"/></path>
+    </segment>
+    <port id="J1.1" x="0" y="0" z="0" dx="1" dy="0" dz="0"/>
+    <port id="J2.1" x="0" y="100" z="0" dx="1" dy="0" dz="0"/>
+    <port id="J3.4" x="300" y="50" z="0" dx="-1" dy="0" dz="0"/>
+    <port id="J4.1" x="0" y="0" z="50" dx="0" dy="0" dz="1"/>
+    <port id="J4.2" x="0" y="10" z="50" dx="0" dy="0" dz="1"/>
+    <branch id="B1" x="120" y="40" z="10">
+      <segment to="J1.1">
+        <path interp="bspline"><pt x="60" y="10" z="5"/></path>
+      </segment>
+      <segment to="J2.1"/>
+      <segment to="J3.4" diameter="3.5">
+        <bspline degree="3" knots="0 0 0 0 1 1 1 1">
+          <cp x="120" y="40" z="10"/><cp x="180" y="45" z="8"/><cp x="240" y="50" z="2"/><cp x="300" y="50" z="0"/>
+        </bspline>
+      </segment>
+    </branch>
+  </structure>
+</harness>
+)";
+
+void expect_same(const Harness& a, const Harness& b) {
+  EXPECT_EQ(a.name, b.name);
+  EXPECT_EQ(a.units, b.units);
+  ASSERT_EQ(a.cables.size(), b.cables.size());
+  for (std::size_t i = 0; i < a.cables.size(); ++i) {
+    EXPECT_EQ(a.cables[i].id, b.cables[i].id);
+    EXPECT_EQ(a.cables[i].ports[0], b.cables[i].ports[0]);
+    EXPECT_EQ(a.cables[i].ports[1], b.cables[i].ports[1]);
+    EXPECT_EQ(a.cables[i].physical.type, b.cables[i].physical.type);
+    EXPECT_EQ(a.cables[i].physical.color, b.cables[i].physical.color);
+    EXPECT_EQ(a.cables[i].physical.diameter, b.cables[i].physical.diameter);
+    EXPECT_EQ(a.cables[i].physical.min_bend_radius, b.cables[i].physical.min_bend_radius);
+  }
+  ASSERT_EQ(a.ports.size(), b.ports.size());
+  for (std::size_t i = 0; i < a.ports.size(); ++i) {
+    EXPECT_EQ(a.ports[i].id, b.ports[i].id);
+    EXPECT_EQ(a.ports[i].position, b.ports[i].position);
+    EXPECT_EQ(a.ports[i].direction, b.ports[i].direction);
+  }
+  ASSERT_EQ(a.branches.size(), b.branches.size());
+  for (std::size_t i = 0; i < a.branches.size(); ++i) {
+    EXPECT_EQ(a.branches[i].id, b.branches[i].id);
+    EXPECT_EQ(a.branches[i].position.has_value(), b.branches[i].position.has_value());
+    if (a.branches[i].position && b.branches[i].position) {
+      EXPECT_EQ(*a.branches[i].position, *b.branches[i].position);
+    }
+  }
+  ASSERT_EQ(a.segments.size(), b.segments.size());
+  for (std::size_t i = 0; i < a.segments.size(); ++i) {
+    const auto &x = a.segments[i], &y = b.segments[i];
+    EXPECT_EQ(x.from, y.from);
+    EXPECT_EQ(x.to, y.to);
+    EXPECT_EQ(x.path, y.path);
+    EXPECT_EQ(x.interp, y.interp);
+    EXPECT_EQ(x.diameter, y.diameter);
+    EXPECT_EQ(x.parent_branch, y.parent_branch);
+    ASSERT_EQ(x.bspline.has_value(), y.bspline.has_value());
+    if (x.bspline) {
+      EXPECT_EQ(x.bspline->degree, y.bspline->degree);
+      EXPECT_EQ(x.bspline->knots, y.bspline->knots);
+      EXPECT_EQ(x.bspline->control_points, y.bspline->control_points);
+    }
+  }
+}
+
+TEST(HarnessXml, ReadsEveryField) {
+  Harness h = parse_harness_xml(kSample, "sample.xml");
+  EXPECT_EQ(h.name, "W1");
+  ASSERT_EQ(h.cables.size(), 3u);
+  EXPECT_EQ(h.cables[0].ports[1], "J3.4");
+  EXPECT_DOUBLE_EQ(h.cables[0].physical.diameter, 1.8);
+  EXPECT_EQ(h.cables[1].physical.color, "blue");
+  ASSERT_EQ(h.ports.size(), 5u);
+  EXPECT_EQ(h.ports[2].direction, Vec3(-1, 0, 0));
+  ASSERT_EQ(h.branches.size(), 1u);
+  EXPECT_EQ(*h.branches[0].position, Vec3(120, 40, 10));
+  ASSERT_EQ(h.segments.size(), 4u);
+  // Canonical order: nested segments first, then top-level ones.
+  EXPECT_EQ(h.segments[0].from, "B1");
+  EXPECT_EQ(h.segments[0].path.size(), 1u);
+  EXPECT_EQ(h.segments[2].diameter, 3.5);
+  ASSERT_TRUE(h.segments[2].bspline.has_value());
+  EXPECT_EQ(h.segments[2].bspline->control_points.size(), 4u);
+  EXPECT_EQ(h.segments[3].interp, Interp::Polyline);
+  EXPECT_EQ(h.segments[3].from, "J4.1");
+  EXPECT_GT(h.cables[0].line, 3);
+}
+
+TEST(HarnessXml, RoundTripIsLossless) {
+  Harness a = parse_harness_xml(kSample, "sample.xml");
+  const std::string text = harness_to_xml(a);
+  Harness b = parse_harness_xml(text, "written.xml");
+  expect_same(a, b);
+  EXPECT_EQ(harness_to_xml(b), text);  // and the writer is a fixed point
+}
+
+TEST(HarnessXml, RoundTripThroughFile) {
+  Harness a = parse_harness_xml(kSample, "sample.xml");
+  const auto path = std::filesystem::temp_directory_path() / "loom_test_roundtrip.xml";
+  write_harness_xml(a, path);
+  Harness b = read_harness_xml(path);
+  expect_same(a, b);
+  std::filesystem::remove(path);
+}
+
+// Full-precision numbers survive the round trip bit for bit.
+RC_GTEST_PROP(HarnessXmlProps, CoordinatesRoundTripExactly, ()) {
+  Harness a = parse_harness_xml(kSample, "sample.xml");
+  const auto x = *rc::gen::arbitrary<double>();
+  const auto y = *rc::gen::arbitrary<double>();
+  RC_PRE(std::isfinite(x) && std::isfinite(y));
+  a.ports[0].position = Vec3(x, y, x * 0.1);
+  a.segments[0].path[0] = Vec3(y, x, 1e-300);
+  Harness b = parse_harness_xml(harness_to_xml(a), "w.xml");
+  RC_ASSERT(b.ports[0].position == a.ports[0].position);
+  RC_ASSERT(b.segments[0].path[0] == a.segments[0].path[0]);
+}
+
+/// Replaces the first occurrence of `from` in the sample and expects an InputError whose
+/// message contains every needle (including the line number where given).
+void expect_bad(const std::string& from, const std::string& to, std::vector<std::string> needles) {
+  std::string text = kSample;
+  const auto at = text.find(from);
+  ASSERT_NE(at, std::string::npos) << from;
+  text.replace(at, from.size(), to);
+  try {
+    parse_harness_xml(text, "bad.xml");
+    FAIL() << "expected an error for: " << to;
+  } catch (const InputError& e) {
+    for (const auto& n : needles) EXPECT_NE(std::string(e.what()).find(n), std::string::npos) << e.what();
+    EXPECT_EQ(e.where().file, "bad.xml");
+  }
+}
+
+TEST(HarnessXml, UnknownPortId) {
+  expect_bad(R"(<port id="J3.4"/></electrical>
+      <physical type="AWG20")", R"(<port id="J9.9"/></electrical>
+      <physical type="AWG20")", {"bad.xml:4:", "cable 'C1'", "unknown port id 'J9.9'"});
+}
+
+TEST(HarnessXml, BranchWithFourConnections) {
+  expect_bad(R"(<segment to="J2.1"/>)", R"(<segment to="J2.1"/><segment to="J4.1"/>)",
+             {"branch 'B1'", "exactly 3 nodes, this one connects 4"});
+}
+
+TEST(HarnessXml, BranchWithTwoConnections) {
+  expect_bad(R"(<segment to="J2.1"/>)", "", {"branch 'B1'", "connects 2"});
+}
+
+TEST(HarnessXml, Cycle) {
+  expect_bad(R"(<segment from="J4.1" to="J4.2">)", R"(<segment from="J4.1" to="J4.2"></segment><segment from="J4.2" to="J1.1"></segment><segment from="J4.1" to="J2.1">)",
+             {"cycle"});
+}
+
+TEST(HarnessXml, DisconnectedCable) {
+  expect_bad(R"(<port id="J4.2"/>)", R"(<port id="J1.1"/>)", {"cable 'C3'", "not connected"});
+}
+
+TEST(HarnessXml, DuplicateIds) {
+  expect_bad(R"(<cable id="C2">)", R"(<cable id="C1">)", {"duplicate cable id"});
+  expect_bad(R"(<port id="J2.1" x)", R"(<port id="J1.1" x)", {"duplicate node id"});
+}
+
+TEST(HarnessXml, NonPositiveDiameter) {
+  expect_bad(R"(diameter="1.8")", R"(diameter="0")", {"bad.xml:6:", "<physical>", "diameter must be positive"});
+  expect_bad(R"(diameter="1.8")", R"(diameter="-2")", {"diameter must be positive"});
+}
+
+TEST(HarnessXml, NanAndInfCoordinates) {
+  expect_bad(R"(x="300")", R"(x="nan")", {"<port id=\"J3.4\">", "not finite"});
+  expect_bad(R"(x="60")", R"(x="inf")", {"<pt>", "not finite"});
+  expect_bad(R"(x="300")", R"(x="3e400")", {"not finite"});
+  expect_bad(R"(x="300")", R"(x="abc")", {"not a number"});
+}
+
+TEST(HarnessXml, ZeroLengthPortDirection) {
+  expect_bad(R"(dx="-1" dy="0" dz="0")", R"(dx="0" dy="0" dz="0")", {"J3.4", "zero length"});
+}
+
+TEST(HarnessXml, MalformedXmlNamesLine) {
+  expect_bad("</attributes>", "</attribute>", {"bad.xml:", "malformed XML"});
+}
+
+TEST(HarnessXml, UnknownElementAndAttribute) {
+  expect_bad("<attributes>", "<attributes><wire/>", {"unexpected element <wire>"});
+  expect_bad(R"(color="red")", R"(colr="red")", {"unknown attribute 'colr'"});
+}
+
+TEST(HarnessXml, BadSplines) {
+  expect_bad(R"(knots="0 0 0 0 1 1 1 1")", R"(knots="0 0 0 1 1 1 1")", {"expected 8 knots"});
+  expect_bad(R"(knots="0 0 0 0 1 1 1 1")", R"(knots="0 0 0 0 1 0.5 1 1")", {"must not decrease"});
+  expect_bad(R"(interp="polyline")", R"(interp="spline")", {"interp must be"});
+}
+
+TEST(HarnessXml, CableWithThreePorts) {
+  expect_bad(R"(<port id="J3.4"/></electrical>)", R"(<port id="J3.4"/><port id="J2.1"/></electrical>)",
+             {"exactly two ports"});
+}
+
+TEST(HarnessXml, MissingFileIsNamed) {
+  try {
+    read_harness_xml("/nonexistent/harness.xml");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/harness.xml"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("not found"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace loom
