@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -26,9 +27,16 @@ void add_demo_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--out", *out, "Output directory")->capture_default_str();
   cmd->add_flag("--quiet", *quiet, "Print nothing (exit status only)");
   cmd->callback([out, quiet, &exit_code]() {
-    // Until routing lands, the demo is `loom info` on the bundled example (issue 2).
-    (void)out;
-    exit_code = run_info(demo_scene_path(), false, *quiet);
+    // The main job on the bundled wing section: what is there, then route + exact audit.
+    const std::string scene = demo_scene_path();
+    if (!*quiet) {
+      run_info(scene, false, false);
+      std::printf("\n");
+    }
+    RouteCommandOptions o;
+    o.out = *out;
+    o.quiet = *quiet;
+    exit_code = run_route(scene, o);
   });
 }
 

@@ -106,10 +106,11 @@ void print_text(const Scene& scene, const SceneLoadReport& rep) {
   std::printf("\nparts:\n");
   for (const auto& p : scene.parts) {
     const AABB b = p.mesh.bounds();
+    char extra[64] = "";
+    if (p.clearance > 0) std::snprintf(extra, sizeof extra, "  +%.4g %s clearance", p.clearance, unit_name(scene.units));
     std::printf("  %-28s %-9s %9zu tris  %-6s  bbox [%.1f %.1f %.1f]..[%.1f %.1f %.1f]%s\n", p.name.c_str(),
                 role_name(p.role), p.mesh.triangle_count(), p.closed ? "closed" : "open", b.min.x(), b.min.y(),
-                b.min.z(), b.max.x(), b.max.y(), b.max.z(),
-                p.clearance > 0 ? (" +" + std::to_string(p.clearance) + " clearance").c_str() : "");
+                b.min.z(), b.max.x(), b.max.y(), b.max.z(), extra);
   }
   const Harness& h = scene.harness;
   if (scene.has_harness) {

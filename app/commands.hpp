@@ -12,8 +12,27 @@ class App;
 namespace loom::app {
 
 void add_info_command(CLI::App& app, int& exit_code);
+/// `loom scan`: centerline, tube and deviation report of a scanned cable (DESIGN §4).
+void add_scan_command(CLI::App& app, int& exit_code);
+/// `loom audit`: clash, bend and clearance audit of a harness (DESIGN §4).
+void add_audit_command(CLI::App& app, int& exit_code);
 /// `loom info`: prints the scene summary (text or JSON); returns the exit status.
 int run_info(const std::string& scene, bool json, bool quiet);
+
+/// Flags of `loom route`.
+struct RouteCommandOptions {
+  std::string out = "loom-route";
+  std::string planner;       ///< empty: the scene's
+  double time_limit = -1.0;  ///< < 0: the scene's
+  long seed = -1;            ///< < 0: the scene's
+  int threads = 0;
+  bool no_simplify = false;
+  bool json = false;
+  bool quiet = false;
+};
+void add_route_command(CLI::App& app, int& exit_code);
+/// `loom route`: routes, audits and writes the outputs; returns the DESIGN §4 exit status.
+int run_route(const std::string& scene, const RouteCommandOptions& options);
 
 void add_demo_command(CLI::App& app, int& exit_code);
 /// Path of the bundled demo scene ($LOOM_EXAMPLES_DIR overrides the built-in path).

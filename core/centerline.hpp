@@ -5,7 +5,9 @@
 
 #include "core/geometry.hpp"
 
+#include <cstddef>
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace loom {
@@ -43,6 +45,10 @@ class Centerline {
   /// Interpolating cubic through every key point (≥ 2 points, finite). Consecutive
   /// duplicates are merged; throws std::invalid_argument with the reason otherwise.
   static Centerline interpolate(const std::vector<Vec3>& points, const InterpolationOptions& opt = {});
+  /// As above with explicit parameters, one per key point (opt.knots is ignored; consecutive
+  /// duplicates take their first point's parameter), increasing across distinct points.
+  static Centerline interpolate(const std::vector<Vec3>& points, const std::vector<double>& parameters,
+                                const InterpolationOptions& opt);
   /// Degree-1 curve through the points (a polyline exactly as given).
   static Centerline polyline(const std::vector<Vec3>& points);
 
@@ -52,6 +58,9 @@ class Centerline {
   /// Parameter of each key point it interpolates (empty if built from raw data).
   const std::vector<double>& key_parameters() const { return key_params_; }
   bool empty() const { return cps_.empty(); }
+  /// Records the parameters of the key points this curve represents (e.g. after fairing
+  /// moved them). Throws std::invalid_argument if one is outside [u_min, u_max] or they decrease.
+  void set_key_parameters(std::vector<double> u);
 
   double u_min() const;
   double u_max() const;
@@ -73,14 +82,40 @@ class Centerline {
   /// Smallest bend radius and where it occurs (dense search + local refinement).
   BendExtremum min_bend_radius() const;
 
+  /// Writes C⁽ᵏ⁾(u) for k = 0..nder (nder ≤ 3) into out[0..nder]; u is clamped to the
+  /// domain. With left_limit, at an interior knot the span to the left is used (one-sided
+  /// derivatives: tangent kinks, third-derivative jumps).
+  void evaluate(double u, int nder, Vec3* out, bool left_limit = false) const;
+  /// Distinct knot values u_min = v_0 < v_1 < ... < v_K = u_max (span boundaries).
+  const std::vector<double>& breakpoints() const { return span_u_; }
+
  private:
   int degree_ = 3;
   std::vector<double> knots_;
   std::vector<Vec3> cps_;
   std::vector<double> key_params_;
   std::vector<double> span_len_;  ///< cumulative arc length at each distinct knot
+  std::vector<double> span_u_;    ///< the distinct knot values (span boundaries)
+  std::vector<int> span_index_;   ///< knot-span index of each non-empty span
+  double typical_speed_ = 1.0;    ///< control-polygon length / parameter range
+  double scale_length_ = 1.0;     ///< control-polygon length
   void build_length_table();
   int find_span(double u) const;
+  std::vector<Vec3> poly_;        ///< Taylor coefficients of each piece about its start
+  std::size_t piece_of(double u, bool left_limit) const;
+  void evaluate_on_span(int piece, double u, int nder, Vec3* out) const;
+  double curvature_from(const Vec3& d1, const Vec3& d2) const;
+  double locate_fold(double a, double b) const;
+  double span_length(int span, double a, double b) const;
+  double solve_length_in_span(std::size_t k, double u0, double s0, double target) const;
 };
+
+/// Nonzero B-spline basis functions of `degree` over `knots` at u and their derivatives:
+/// returns the index i0 of the first nonzero function and writes
+/// ders[k * (degree + 1) + j] = N⁽ᵏ⁾_{i0+j}(u) for k = 0..nder, j = 0..degree (nder ≤ degree
+/// is not required: higher orders are 0). u is clamped to [knots[degree], knots[n+1]] where
+/// n + 1 = knots.size() − degree − 1 basis functions exist. Throws std::invalid_argument on
+/// an invalid knot vector or degree outside 1..7.
+int bspline_basis(const std::vector<double>& knots, int degree, double u, int nder, double* ders);
 
 }  // namespace loom

@@ -1,5 +1,6 @@
 #include "routing/cable_geometry.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace loom {
@@ -76,6 +77,18 @@ std::optional<Centerline> segment_centerline(const Harness& h, int segment) {
   if (int p = h.find_port(s.from); p >= 0) opt.start_tangent = h.ports[p].direction;
   if (int p = h.find_port(s.to); p >= 0) opt.end_tangent = -h.ports[p].direction;
   return Centerline::interpolate(pts, opt);
+}
+
+double breakout_length(const HarnessTopology& topo, const std::string& node) {
+  const Harness& h = topo.harness();
+  double len = 0.0;
+  for (int s : topo.incident_segments(node)) {
+    if (topo.segment_cables(s).empty()) continue;
+    double bend = 0.0;
+    for (int c : topo.segment_cables(s)) bend = std::max(bend, h.cables[c].physical.min_bend_radius);
+    len = std::max({len, bend, topo.segment_diameter(s)});
+  }
+  return len;
 }
 
 std::optional<Centerline> cable_centerline(const HarnessTopology& topo, int cable) {

@@ -22,4 +22,11 @@ std::optional<Centerline> segment_centerline(const Harness& h, int segment);
 /// nullopt if any segment of the chain is not routed.
 std::optional<Centerline> cable_centerline(const HarnessTopology& topo, int cable);
 
+/// Length of the breakout at a node: the stretch next to it over which cables that meet
+/// there run bundled before they separate. Over incident segments, the larger of the biggest
+/// min bend radius of the cables carried and the segment diameter (scene units); 0 for a
+/// node with no cable. The router leaves branch points straight for this long, and the
+/// audit lets cables that share the node touch within this distance of it.
+double breakout_length(const HarnessTopology& topo, const std::string& node);
+
 }  // namespace loom

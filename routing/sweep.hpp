@@ -6,6 +6,7 @@
 #include "core/mesh.hpp"
 
 #include <functional>
+#include <vector>
 
 namespace loom {
 
@@ -23,10 +24,38 @@ struct SweepResult {
   double max_frame_turn = 0.0;  ///< largest angle between adjacent frames (radians)
 };
 
+/// One cross-section of a sweep: a circle in the plane normal to `tangent` (world
+/// coordinates, scene units). Mesh rings place vertex j at
+/// centre + radius·(cos 2πj/n · normal + sin 2πj/n · tangent × normal).
+struct SweepSection {
+  double u = 0.0;       ///< curve parameter
+  double s = 0.0;       ///< arc length from the start
+  Vec3 point;           ///< C(u)
+  Vec3 centre;          ///< circle centre M (eq. 7; = point for a tube)
+  Vec3 tangent;         ///< unit tangent of the centerline
+  Vec3 normal;          ///< first in-plane axis of the rotation-minimising frame
+  double radius = 0.0;  ///< circle radius R (eq. 8; = r for a tube)
+};
+
 /// Tube of constant radius r around the centerline.
 SweepResult sweep_tube(const Centerline& c, double radius, const SweepOptions& opt = {});
 /// Canal surface of radius r(s), s = arc length from the start.
 SweepResult sweep_canal(const Centerline& c, const std::function<double(double)>& radius_of_s,
                         const SweepOptions& opt = {});
+
+/// The cross-sections sweep_tube places (their spacing keeps the sagitta along the tube
+/// within half the chord tolerance), with rotation-minimising frames.
+std::vector<SweepSection> tube_sections(const Centerline& c, double radius, const SweepOptions& opt = {});
+/// The cross-sections sweep_canal places.
+std::vector<SweepSection> canal_sections(const Centerline& c, const std::function<double(double)>& radius_of_s,
+                                         const SweepOptions& opt = {});
+/// Vertices per ring that keep the polygon within `tolerance` of a circle of radius r.
+int circumferential_resolution(double radius, double tolerance);
+
+/// Closed sphere mesh around a branch junction: circumscribes the ball of radius r about
+/// `centre` (no point of the ball lies outside it) and stays within opt.chord_tolerance of
+/// its sphere. With tubes whose end caps meet at `centre`, it fills the wedges between
+/// them, so the union has no gap. `rings` = latitude rings, `circumferential` = longitudes.
+SweepResult sweep_junction(const Vec3& centre, double radius, const SweepOptions& opt = {});
 
 }  // namespace loom

@@ -5,6 +5,11 @@
 #include "core/io/mesh_write.hpp"
 #include "core/io/tessellation_cache.hpp"
 
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCylinder.hxx>
+#include <IGESControl_Controller.hxx>
+#include <IGESControl_Writer.hxx>
+#include <STEPControl_Writer.hxx>
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -70,6 +75,62 @@ TEST_F(TempDir, AsciiStlOffAndDae) {
     EXPECT_EQ(r.triangle_count(), 4u) << name;
     EXPECT_TRUE(analyse_topology(r).closed) << name;
   }
+}
+
+TEST_F(TempDir, ColladaTriangles) {
+  std::ofstream(dir_ / "t.dae") << R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Z_UP</up_axis></asset>
+  <library_geometries><geometry id="g"><mesh>
+    <source id="p"><float_array id="pa" count="12">0 0 0 10 0 0 0 10 0 0 0 10</float_array>
+      <technique_common><accessor source="#pa" count="4" stride="3">
+        <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+      </accessor></technique_common></source>
+    <vertices id="v"><input semantic="POSITION" source="#p"/></vertices>
+    <triangles count="4"><input semantic="VERTEX" source="#v" offset="0"/><p>0 2 1 0 1 3 0 3 2 1 2 3</p></triangles>
+  </mesh></geometry></library_geometries>
+  <library_visual_scenes><visual_scene id="s"><node id="n"><instance_geometry url="#g"/></node></visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#s"/></scene>
+</COLLADA>
+)";
+  Mesh r = read_mesh_file(dir_ / "t.dae");
+  EXPECT_EQ(r.triangle_count(), 4u);
+  EXPECT_TRUE(analyse_topology(r).closed);
+  EXPECT_NEAR(std::abs(r.signed_volume()), 1000.0 / 6.0, 1e-3);
+}
+
+TEST_F(TempDir, StepAndIgesWrittenByOpenCascadeReadBack) {
+  // A 10 x 20 x 30 box and an r = 5, h = 40 cylinder: closed forms for volume.
+  const TopoDS_Shape box = BRepPrimAPI_MakeBox(10, 20, 30).Shape();
+  const TopoDS_Shape cyl = BRepPrimAPI_MakeCylinder(5, 40).Shape();
+  {
+    STEPControl_Writer w;
+    w.Transfer(box, STEPControl_AsIs);
+    ASSERT_EQ(w.Write((dir_ / "box.step").c_str()), IFSelect_RetDone);
+  }
+  {
+    IGESControl_Controller::Init();
+    IGESControl_Writer w("MM", 1);
+    w.AddShape(cyl);
+    w.ComputeModel();
+    ASSERT_TRUE(w.Write((dir_ / "cyl.igs").c_str()));
+  }
+  TessellationParams tp;
+  tp.linear_deflection = 0.001;
+  auto b = read_cad_file(dir_ / "box.step", tp, true);
+  ASSERT_EQ(b.size(), 1u);
+  EXPECT_EQ(b[0].brep_faces, 6);
+  EXPECT_TRUE(analyse_topology(b[0].mesh).closed);
+  EXPECT_NEAR(b[0].mesh.signed_volume(), 6000.0, 1e-6);
+  auto c = read_cad_file(dir_ / "cyl.igs", tp, false);
+  ASSERT_EQ(c.size(), 1u);
+  // A tessellated cylinder lies inside the true one: volume error O(deflection / r).
+  EXPECT_NEAR(std::abs(c[0].mesh.signed_volume()), M_PI * 25 * 40, M_PI * 25 * 40 * 2 * tp.linear_deflection / 5 * 2);
+  // Scene unit metres: lengths divided by 1000.
+  tp.unit_in_mm = 1000.0;
+  tp.linear_deflection = 0.001 / 1000.0;
+  auto m = read_cad_file(dir_ / "box.step", tp, true);
+  EXPECT_NEAR(m[0].mesh.bounds().size().z(), 0.03, 1e-12);
 }
 
 TEST_F(TempDir, BadMeshFiles) {

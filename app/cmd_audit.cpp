@@ -1,0 +1,145 @@
+// `loom audit SCENE [--routes FILE] [--method certified|discrete] [--no-index] [--spacing L]
+// [--tolerance T] [--threads N] [--out DIR] [--json] [--quiet]`: clash, bend and clearance
+// audit of a harness in its scene; writes DIR/report.json (DESIGN §4).
+#include "app/commands.hpp"
+
+#include "core/error.hpp"
+#include "routing/audit.hpp"
+#include "routing/report_json.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+
+namespace loom::app {
+
+namespace {
+
+/// Flags of `loom audit`.
+struct AuditFlags {
+  std::string scene;
+  std::string routes;
+  std::string method = "certified";
+  bool method_given = false;
+  bool no_index = false;
+  double spacing = 0.0;
+  double tolerance = 0.0;
+  int threads = 0;
+  std::string out = "loom-audit";
+  bool json = false;
+  bool quiet = false;
+};
+
+/// Most clashes listed on the terminal (the report has them all).
+constexpr std::size_t kListedClashes = 20;
+
+void print_summary(const AuditReport& rep, const std::filesystem::path& report_path) {
+  const ClashResult& r = rep.result;
+  const char* u = rep.units.c_str();
+  std::printf("audit %s: %zu cables (%zu checked), %zu parts, %zu triangles\n", rep.scene.c_str(), rep.cables.size(),
+              rep.check_ids.size(), rep.part_names.size(), rep.triangles);
+  if (rep.method == ClashMethod::Certified)
+    std::printf("method certified, tolerance %.4g %s (%s), index %s\n", r.tolerance, u, r.tolerance_source.c_str(),
+                rep.index_name.c_str());
+  else
+    std::printf("method discrete (%s), not certified\n", rep.use_index ? "indexed" : "brute force, no index");
+  std::size_t n = 0;
+  for (const ClashEntry& e : r.clashes) {
+    if (n++ == kListedClashes) {
+      std::printf("  ... %zu more in the report\n", r.clashes.size() - kListedClashes);
+      break;
+    }
+    const std::string& cable = rep.check_ids[static_cast<std::size_t>(e.cable)];
+    if (e.kind == ClashKind::CableStructure)
+      std::printf("  clash  %-12s %-8s part %-20s clearance %9.4f %s at s = %.2f%s%s\n", cable.c_str(),
+                  e.keep_out ? "keep-out" : "", rep.part_names[static_cast<std::size_t>(e.part)].c_str(), e.clearance,
+                  u, e.s, e.inside ? " (inside)" : "", "");
+    else
+      std::printf("  clash  %-12s %-8s %-25s clearance %9.4f %s at s = %.2f / %.2f\n", cable.c_str(),
+                  clash_kind_name(e.kind), rep.check_ids[static_cast<std::size_t>(e.other)].c_str(), e.clearance, u,
+                  e.s, e.s_other);
+  }
+  for (const Violation& v : r.violations) {
+    const std::string& cable = rep.check_ids[static_cast<std::size_t>(v.cable)];
+    if (v.kind == ViolationKind::BendRadius)
+      std::printf("  bend   %-12s radius %.4g < %.4g %s at s = %.2f\n", cable.c_str(), v.value, v.limit, u, v.s);
+    else
+      std::printf("  gap    %-12s part %-20s clearance %.4f < %.4g %s at s = %.2f\n", cable.c_str(),
+                  rep.part_names[static_cast<std::size_t>(v.part)].c_str(), v.value, v.limit, u, v.s);
+  }
+  for (const auto& note : rep.notes) std::printf("  note: %s\n", note.c_str());
+  std::printf("%zu clashes, %zu violations; load %.0f ms, index %.1f ms, check %.1f ms, %lld distance queries\n",
+              r.clashes.size(), r.violations.size(), rep.load_ms, rep.index_ms, rep.check_ms,
+              static_cast<long long>(r.counters.distance_queries));
+  std::printf("report: %s\n", report_path.string().c_str());
+}
+
+int run_audit_command(const AuditFlags& f) {
+  AuditOptions opt;
+  if (f.method == "certified") {
+    opt.check.method = ClashMethod::Certified;
+  } else if (f.method == "discrete") {
+    opt.check.method = ClashMethod::Discrete;
+  } else {
+    throw InputError({"", 0, "--method"}, "unknown method '" + f.method + "' (use certified or discrete)");
+  }
+  if (f.no_index) {
+    if (f.method_given && opt.check.method == ClashMethod::Certified)
+      throw InputError({"", 0, "--no-index"}, "--no-index is the brute-force discrete baseline; it cannot be certified");
+    opt.check.method = ClashMethod::Discrete;
+    opt.check.use_index = false;
+  }
+  if (f.spacing < 0.0 || !std::isfinite(f.spacing)) throw InputError({"", 0, "--spacing"}, "must be positive");
+  if (f.tolerance < 0.0 || !std::isfinite(f.tolerance)) throw InputError({"", 0, "--tolerance"}, "must be positive");
+  opt.check.spacing = f.spacing;
+  opt.check.tolerance = f.tolerance;
+  opt.check.threads = f.threads;
+  if (!f.routes.empty()) opt.routes = f.routes;
+  const bool show_progress = !f.quiet && !f.json && isatty(STDERR_FILENO);
+  if (show_progress)
+    opt.check.progress = [](double frac) {
+      std::fprintf(stderr, "\raudit: %3.0f%%", 100.0 * frac);
+      if (frac >= 1.0) std::fprintf(stderr, "\r            \r");
+      std::fflush(stderr);
+    };
+  const AuditReport rep = audit_scene_file(f.scene, opt);
+  const std::filesystem::path report_path = std::filesystem::path(f.out) / "report.json";
+  write_audit_report(rep, report_path);
+  if (f.json)
+    std::cout << audit_report_json(rep).dump(2) << "\n";
+  else if (!f.quiet)
+    print_summary(rep, report_path);
+  return rep.exit_code();
+}
+
+}  // namespace
+
+void add_audit_command(CLI::App& app, int& exit_code) {
+  auto* cmd = app.add_subcommand("audit", "Check a harness for clashes, bend and clearance violations; write report.json");
+  auto f = std::make_shared<AuditFlags>();
+  cmd->add_option("SCENE", f->scene, "Scene file (TOML)")->required();
+  cmd->add_option("--routes", f->routes, "Routed harness XML replacing the scene's harness");
+  auto* m = cmd->add_option("--method", f->method, "certified (exact to --tolerance) or discrete (the paper's sampling)")
+                ->check(CLI::IsMember({"certified", "discrete"}))
+                ->capture_default_str();
+  cmd->add_flag("--no-index", f->no_index, "Brute-force discrete baseline: every sample against every triangle");
+  cmd->add_option("--spacing", f->spacing, "Discrete sample spacing (default: each cable's diameter)");
+  cmd->add_option("--tolerance", f->tolerance, "Certified accuracy (default: smallest cable radius / 100)");
+  cmd->add_option("--threads", f->threads, "Worker threads (default: all cores)");
+  cmd->add_option("--out", f->out, "Output directory for report.json")->capture_default_str();
+  cmd->add_flag("--json", f->json, "Print the report as JSON instead of the summary");
+  cmd->add_flag("--quiet", f->quiet, "Print nothing (exit status and report only)");
+  cmd->callback([f, m, &exit_code]() {
+    f->method_given = m->count() > 0;
+    exit_code = run_audit_command(*f);
+  });
+}
+
+}  // namespace loom::app

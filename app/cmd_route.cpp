@@ -1,0 +1,99 @@
+// `loom route SCENE ...`: plan, spline, audit and repair every cable; write routed.xml,
+// report.json and cables.ply.
+#include "app/commands.hpp"
+
+#include "core/error.hpp"
+#include "core/io/scene_load.hpp"
+#include "routing/route_report.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <unistd.h>
+
+namespace loom::app {
+
+namespace {
+
+void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
+  const auto& a = rep.audit;
+  std::size_t routed = 0;
+  for (const auto& c : a.cables) routed += c.routed ? 1 : 0;
+  std::printf("route %s: %zu/%zu cables routed (%s, seed %u), clearance %.4g %s\n", a.scene.c_str(),
+              routed - std::min(routed, rep.unrouted.size()), a.cables.size(), rep.planner.c_str(), rep.seed,
+              rep.clearance, a.units.c_str());
+  std::printf("  time: load %.0f ms, simplify %.0f ms, index %.0f ms, plan %.0f ms, spline %.0f ms, audit %.0f ms, "
+              "repair %.0f ms, total %.0f ms\n",
+              rep.timing.load, rep.timing.simplify, rep.timing.index, rep.timing.plan, rep.timing.spline,
+              rep.timing.audit, rep.timing.repair, rep.timing.total + rep.timing.load);
+  std::printf("  audit (%s, exact triangles): %zu clashes, %zu violations\n", clash_method_name(a.method),
+              a.result.clashes.size(), a.result.violations.size());
+  for (const auto& u : rep.unrouted)
+    std::printf("  NOT ROUTED %s (segment %s): %s — %s\n", u.cable.c_str(), u.segment.c_str(), u.reason.c_str(),
+                u.message.c_str());
+  std::size_t shown = 0;
+  for (const auto& c : a.result.clashes) {
+    if (++shown > 10) break;
+    std::printf("  clash %s %s at s=%.1f: clearance %.3f\n", clash_kind_name(c.kind),
+                a.check_ids[c.cable].c_str(), c.s, c.clearance);
+  }
+  for (const auto& v : a.result.violations) {
+    if (++shown > 20) break;
+    std::printf("  %s %s at s=%.1f: %.3f (limit %.3f)\n", violation_kind_name(v.kind), a.check_ids[v.cable].c_str(),
+                v.s, v.value, v.limit);
+  }
+  std::printf("  wrote %s/{routed.xml, report.json, cables.ply}\n", out.string().c_str());
+}
+
+}  // namespace
+
+int run_route(const std::string& scene_path, const RouteCommandOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  SceneLoadReport lr;
+  Scene scene = load_scene(scene_path, {}, &lr);
+  if (!scene.has_harness) throw InputError({scene_path, 0, "[harness]"}, "the scene has no harness to route");
+  RouteOptions ro;
+  ro.planner = o.planner;
+  ro.time_limit = o.time_limit;
+  ro.seed = o.seed;
+  ro.threads = o.threads;
+  ro.simplify = !o.no_simplify;
+  const bool tty = !o.quiet && ::isatty(STDERR_FILENO);
+  if (tty)
+    ro.progress = [](const std::string& stage, double f) {
+      std::fprintf(stderr, "\r%-8s %5.1f%%", stage.c_str(), 100.0 * f);
+      if (f >= 1.0) std::fprintf(stderr, "\n");
+    };
+  RouteReport rep = route_scene(scene, ro);
+  rep.timing.load = lr.load_ms;
+  rep.audit.load_ms = lr.load_ms;
+  for (const auto& n : lr.notes) rep.notes.push_back(n);
+  // Tube resolution: a tenth of the smallest cable radius is finer than any viewer needs.
+  const double chord = 0.1 * 0.5 * scene.harness.smallest_diameter();
+  write_route_outputs(rep, o.out, chord > 0 ? chord : 0.01);
+  (void)t0;
+  if (o.json) std::cout << route_report_json(rep).dump(2) << "\n";
+  else if (!o.quiet) print_summary(rep, o.out);
+  return rep.exit_code();
+}
+
+void add_route_command(CLI::App& app, int& exit_code) {
+  auto* cmd = app.add_subcommand("route", "Route every cable of a scene's harness, then audit it against the exact geometry");
+  auto scene = std::make_shared<std::string>();
+  auto o = std::make_shared<RouteCommandOptions>();
+  cmd->add_option("SCENE", *scene, "Scene file (TOML)")->required();
+  cmd->add_option("--out", o->out, "Output directory (routed.xml, report.json, cables.ply)")->capture_default_str();
+  cmd->add_option("--planner", o->planner, "OMPL planner (rrtconnect, rrtstar, bitstar, prmstar, lazyprmstar, ...)");
+  cmd->add_option("--time-limit", o->time_limit, "Planning seconds per segment (default: scene [routing])");
+  cmd->add_option("--seed", o->seed, "Random seed (default: scene [routing])");
+  cmd->add_option("--threads", o->threads, "Audit threads (default: all cores)");
+  cmd->add_flag("--no-simplify", o->no_simplify, "Plan among the exact parts instead of α-simplified ones");
+  cmd->add_flag("--json", o->json, "Print the report as JSON");
+  cmd->add_flag("--quiet", o->quiet, "Print nothing (exit status only)");
+  cmd->callback([scene, o, &exit_code]() { exit_code = run_route(*scene, *o); });
+}
+
+}  // namespace loom::app

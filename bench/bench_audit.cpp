@@ -1,0 +1,336 @@
+// Audit benchmark: a generated scene at the seed paper's "complex" scale (≥ 100 cables of
+// 1–3 m, d = 2–10 mm, among ≥ 200 closed parts, ~1 M triangles) and a 10× larger one.
+// Measures, in one process: index build; the certified audit (all clash kinds + bend +
+// clearance) with 1 and 2 threads; the indexed discrete method; the brute-force discrete
+// baseline (every sample against every triangle — measured on a subset of cables and
+// scaled, it is O(n·m)); time against cables and against triangles; and sample spacing
+// against time and missed clashes for discrete vs certified.
+// Writes bench/results/audit*.csv and charts (gnuplot). Fixed seeds.
+//
+//   bench_audit [--quick]      (--quick: smaller scenes, for a smoke run)
+#include "index/embree_index.hpp"
+#include "routing/clash_check.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <set>
+#include <string>
+#include <tuple>
+#include <vector>
+
+using namespace loom;
+
+namespace {
+
+/// Parts: closed ellipsoids (UV spheres), capped cylinders (pipes, rods) and boxes.
+Mesh uv_sphere(int n_lat, int n_lon) {
+  Mesh m;
+  m.vertices.emplace_back(0, 0, 1);
+  for (int i = 1; i < n_lat; ++i) {
+    const double th = M_PI * i / n_lat;
+    for (int j = 0; j < n_lon; ++j) {
+      const double ph = 2 * M_PI * j / n_lon;
+      m.vertices.emplace_back(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
+    }
+  }
+  m.vertices.emplace_back(0, 0, -1);
+  const auto S = static_cast<std::uint32_t>(m.vertices.size() - 1);
+  auto ring = [&](int i, int j) { return static_cast<std::uint32_t>(1 + (i - 1) * n_lon + (j % n_lon)); };
+  for (int j = 0; j < n_lon; ++j) m.triangles.push_back({0, ring(1, j), ring(1, j + 1)});
+  for (int i = 1; i + 1 < n_lat; ++i)
+    for (int j = 0; j < n_lon; ++j) {
+      m.triangles.push_back({ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)});
+      m.triangles.push_back({ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
+    }
+  for (int j = 0; j < n_lon; ++j) m.triangles.push_back({S, ring(n_lat - 1, j + 1), ring(n_lat - 1, j)});
+  return m;
+}
+
+/// Unit cylinder radius 1, z in [0, 1], closed by fans.
+Mesh cylinder(int n_seg, int n_len) {
+  Mesh m;
+  for (int i = 0; i <= n_len; ++i)
+    for (int j = 0; j < n_seg; ++j) {
+      const double ph = 2 * M_PI * j / n_seg;
+      m.vertices.emplace_back(std::cos(ph), std::sin(ph), static_cast<double>(i) / n_len);
+    }
+  const auto c0 = static_cast<std::uint32_t>(m.vertices.size());
+  m.vertices.emplace_back(0, 0, 0);
+  m.vertices.emplace_back(0, 0, 1);
+  auto v = [&](int i, int j) { return static_cast<std::uint32_t>(i * n_seg + (j % n_seg)); };
+  for (int i = 0; i < n_len; ++i)
+    for (int j = 0; j < n_seg; ++j) {
+      m.triangles.push_back({v(i, j), v(i, j + 1), v(i + 1, j + 1)});
+      m.triangles.push_back({v(i, j), v(i + 1, j + 1), v(i + 1, j)});
+    }
+  for (int j = 0; j < n_seg; ++j) {
+    m.triangles.push_back({c0, v(0, j + 1), v(0, j)});
+    m.triangles.push_back({c0 + 1, v(n_len, j), v(n_len, j + 1)});
+  }
+  return m;
+}
+
+/// Clamped uniform cubic B-spline on the given control points (a smooth centerline).
+Centerline cubic_from_controls(const std::vector<Vec3>& cps) {
+  const int n = static_cast<int>(cps.size());
+  std::vector<double> knots(4, 0.0);
+  for (int i = 1; i < n - 3; ++i) knots.push_back(static_cast<double>(i));
+  for (int i = 0; i < 4; ++i) knots.push_back(static_cast<double>(n - 3));
+  return Centerline(3, knots, cps);
+}
+
+struct BenchScene {
+  std::vector<Part> parts;
+  std::vector<CableInput> cables;
+  std::size_t triangles = 0;
+};
+
+/// `n_parts` parts of ~`tris_per_part` triangles in a 3 × 1 × 1 m section, `n_cables`
+/// cubic cables of 1–3 m through it, d = 2–10 mm.
+BenchScene make_scene(int n_parts, int tris_per_part, int n_cables, double scale, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> U(0, 1);
+  BenchScene sc;
+  const Vec3 extent = Vec3(3000, 1000, 1000) * scale;
+  for (int i = 0; i < n_parts; ++i) {
+    Part p;
+    p.name = "part-" + std::to_string(i);
+    const int kind = i % 3;
+    const int n = std::max(4, static_cast<int>(std::sqrt(tris_per_part / 2.0)));
+    Mesh m = kind == 0 ? uv_sphere(n, n) : cylinder(n, std::max(1, n / 2));
+    Eigen::Affine3d t = Eigen::Affine3d::Identity();
+    t.translate(Vec3(U(rng) * extent.x(), U(rng) * extent.y(), U(rng) * extent.z()));
+    t.rotate(Eigen::AngleAxisd(U(rng) * M_PI, Vec3(U(rng) - 0.5, U(rng) - 0.5, U(rng) - 0.5).normalized()));
+    if (kind == 0) t.scale(Vec3(20 + 60 * U(rng), 20 + 60 * U(rng), 20 + 60 * U(rng)));
+    else if (kind == 1) t.scale(Vec3(3 + 10 * U(rng), 3 + 10 * U(rng), 100 + 300 * U(rng)));  // rods, pipes
+    else t.scale(Vec3(30 + 60 * U(rng), 30 + 60 * U(rng), 20 + 80 * U(rng)));              // drums
+    m.transform(t);
+    p.mesh = std::move(m);
+    p.closed = true;
+    p.clearance = (i % 10 == 0) ? 2.0 : 0.0;
+    sc.triangles += p.mesh.triangle_count();
+    sc.parts.push_back(std::move(p));
+  }
+  for (int c = 0; c < n_cables; ++c) {
+    const double len = (1000 + 2000 * U(rng)) * std::min(scale, 1.0 + 0.0 * scale);
+    const Vec3 a(U(rng) * (extent.x() - len), U(rng) * extent.y(), U(rng) * extent.z());
+    const Vec3 b = a + Vec3(len * 0.9, (U(rng) - 0.5) * 200, (U(rng) - 0.5) * 200);
+    std::vector<Vec3> pts;
+    const int k = 5;
+    for (int i = 0; i <= k; ++i) {
+      Vec3 q = a + (b - a) * (static_cast<double>(i) / k);
+      if (i > 0 && i < k) q += Vec3(0, (U(rng) - 0.5) * 150, (U(rng) - 0.5) * 150);
+      pts.push_back(q);
+    }
+    CableInput in;
+    in.id = "W" + std::to_string(c);
+    in.curve = cubic_from_controls(pts);
+    in.radius = 1.0 + 4.0 * U(rng);
+    in.min_bend_radius = 6.0 * in.radius;
+    sc.cables.push_back(std::move(in));
+  }
+  return sc;
+}
+
+double now_ms() {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+struct Timed {
+  ClashResult res;
+  double ms = 0.0;
+};
+
+/// Best of `reps` runs.
+Timed timed_check(const BenchScene& sc, const ObstacleIndex* idx, ClashRequest req, int reps = 3) {
+  Timed t;
+  t.ms = 1e300;
+  for (int i = 0; i < reps; ++i) {
+    const double t0 = now_ms();
+    ClashResult r = check_clashes(sc.cables, sc.parts, idx, req);
+    const double dt = now_ms() - t0;
+    if (dt < t.ms) {
+      t.ms = dt;
+      t.res = std::move(r);
+    }
+  }
+  return t;
+}
+
+using ClashKey = std::tuple<int, int, int>;  // kind, cable, part or other cable
+std::set<ClashKey> clash_keys(const ClashResult& r) {
+  std::set<ClashKey> k;
+  for (const auto& e : r.clashes)
+    k.emplace(static_cast<int>(e.kind), e.cable, e.kind == ClashKind::CableStructure ? e.part : e.other);
+  return k;
+}
+int missed(const std::set<ClashKey>& truth, const std::set<ClashKey>& found) {
+  int n = 0;
+  for (const auto& k : truth)
+    if (!found.count(k)) ++n;
+  return n;
+}
+
+void gnuplot(const std::string& script) {
+  const std::string path = std::string(LOOM_SOURCE_DIR) + "/bench/results/audit_plot.gp";
+  std::ofstream(path) << script;
+  const std::string cmd = "gnuplot " + path + " 2>/dev/null";
+  if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "gnuplot failed (charts not drawn)\n");
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const bool quick = argc > 1 && std::string(argv[1]) == "--quick";
+  const std::string dir = std::string(LOOM_SOURCE_DIR) + "/bench/results/";
+  std::filesystem::create_directories(dir);
+  const int base_parts = quick ? 40 : 200, base_cables = quick ? 20 : 100, tris = 5000;
+
+  // ---- 1. paper scale and 10× -------------------------------------------------------
+  std::ofstream main_csv(dir + "audit.csv");
+  main_csv << "scene,parts,triangles,cables,index_ms,certified_1t_ms,certified_2t_ms,speedup_2t,"
+              "discrete_indexed_ms,brute_discrete_ms_extrapolated,ratio_vs_brute,clashes,violations,"
+              "distance_queries\n";
+  for (int mult : {1, 10}) {
+    if (quick && mult == 10) break;
+    const BenchScene sc = make_scene(base_parts * mult, tris, base_cables * mult, std::cbrt(mult), 42);
+    double t0 = now_ms();
+    EmbreeIndex idx(sc.parts);
+    const double index_ms = now_ms() - t0;
+    ClashRequest req;
+    req.routing_clearance = 3.0;
+    req.threads = 1;
+    const Timed c1 = timed_check(sc, &idx, req);
+    req.threads = 2;
+    const Timed c2 = timed_check(sc, &idx, req);
+    ClashRequest dreq = req;
+    dreq.method = ClashMethod::Discrete;
+    const Timed d2 = timed_check(sc, &idx, dreq, 1);
+    // Brute force (the paper's O(n·m)): every sample against every triangle. Its cost per
+    // sample is the same everywhere, so it is measured on a probe cable of 41 samples and
+    // scaled to the scene's sample count; cable pairs (quadratic in samples) on 20 cables,
+    // scaled by the number of pairs.
+    double brute_ms = 0.0;
+    {
+      double total_samples = 0.0;
+      for (const auto& c : sc.cables) total_samples += std::ceil(c.curve.length() / (2.0 * c.radius)) + 1.0;
+      BenchScene probe;
+      probe.parts = sc.parts;
+      CableInput pc = sc.cables[0];
+      const Vec3 a = pc.curve.position(pc.curve.u_min());
+      pc.curve = Centerline::polyline({a, a + Vec3(80.0 * pc.radius, 0, 0)});
+      probe.cables.push_back(pc);
+      ClashRequest b = dreq;
+      b.use_index = false;
+      b.check_cable_cable = false;
+      const Timed bs = timed_check(probe, nullptr, b, 1);
+      brute_ms += bs.ms / static_cast<double>(bs.res.counters.samples) * total_samples;
+      const int kc = std::min<int>(20, static_cast<int>(sc.cables.size()));
+      BenchScene sub2;
+      sub2.cables.assign(sc.cables.begin(), sc.cables.begin() + kc);
+      ClashRequest b2 = b;
+      b2.check_structure = false;
+      b2.check_self = true;
+      b2.check_cable_cable = true;
+      const Timed bc = timed_check(sub2, nullptr, b2, 1);
+      const double n = static_cast<double>(sc.cables.size());
+      brute_ms += bc.ms * (n * (n - 1)) / (kc * (kc - 1.0));
+    }
+    std::printf("scene x%d: %zu parts, %zu tris, %zu cables: index %.0f ms, certified 1t %.1f ms, 2t %.1f ms "
+                "(%.2fx), discrete %.1f ms, brute ~%.0f ms (%.0fx), %zu clashes, %zu violations\n",
+                mult, sc.parts.size(), sc.triangles, sc.cables.size(), index_ms, c1.ms, c2.ms, c1.ms / c2.ms, d2.ms,
+                brute_ms, brute_ms / c2.ms, c2.res.clashes.size(), c2.res.violations.size());
+    main_csv << "x" << mult << "," << sc.parts.size() << "," << sc.triangles << "," << sc.cables.size() << ","
+             << index_ms << "," << c1.ms << "," << c2.ms << "," << c1.ms / c2.ms << "," << d2.ms << "," << brute_ms
+             << "," << brute_ms / c2.ms << "," << c2.res.clashes.size() << "," << c2.res.violations.size() << ","
+             << c2.res.counters.distance_queries << "\n";
+  }
+  main_csv.close();
+
+  // ---- 2. time vs cables (fixed parts) and vs triangles (fixed cables) -----------------
+  {
+    std::ofstream csv(dir + "audit_scaling.csv");
+    csv << "series,cables,triangles,certified_ms\n";
+    const BenchScene big = make_scene(base_parts, tris, quick ? 80 : 400, 1.0, 7);
+    EmbreeIndex idx(big.parts);
+    for (int n : {25, 50, 100, 200, 400}) {
+      if (n > static_cast<int>(big.cables.size())) break;
+      BenchScene sub;
+      sub.parts = big.parts;
+      sub.cables.assign(big.cables.begin(), big.cables.begin() + n);
+      ClashRequest req;
+      req.routing_clearance = 3.0;
+      req.threads = 2;
+      const Timed t = timed_check(sub, &idx, req);
+      csv << "cables," << n << "," << big.triangles << "," << t.ms << "\n";
+      std::printf("cables %d: %.1f ms\n", n, t.ms);
+    }
+    for (int tp : {500, 1500, 5000, 15000, 50000}) {
+      if (quick && tp > 5000) break;
+      const BenchScene sc = make_scene(base_parts, tp, base_cables, 1.0, 7);
+      EmbreeIndex ix(sc.parts);
+      ClashRequest req;
+      req.routing_clearance = 3.0;
+      req.threads = 2;
+      const Timed t = timed_check(sc, &ix, req);
+      csv << "triangles," << sc.cables.size() << "," << sc.triangles << "," << t.ms << "\n";
+      std::printf("triangles %zu: %.1f ms\n", sc.triangles, t.ms);
+    }
+  }
+
+  // ---- 3. speed vs accuracy: spacing (discrete) and tolerance (certified) ---------------
+  {
+    std::ofstream csv(dir + "audit_accuracy.csv");
+    csv << "method,parameter,time_ms,clashes,missed\n";
+    const BenchScene sc = make_scene(base_parts, tris, base_cables, 1.0, 42);
+    EmbreeIndex idx(sc.parts);
+    ClashRequest req;
+    req.routing_clearance = 3.0;
+    req.threads = 2;
+    req.tolerance = 0.001;
+    const Timed truth = timed_check(sc, &idx, req, 1);
+    const auto truth_keys = clash_keys(truth.res);
+    for (double tol : {0.1, 0.03, 0.01, 0.003, 0.001}) {
+      req.tolerance = tol;
+      const Timed t = timed_check(sc, &idx, req);
+      csv << "certified," << tol << "," << t.ms << "," << t.res.clashes.size() << ","
+          << missed(truth_keys, clash_keys(t.res)) << "\n";
+    }
+    for (double sp : {16.0, 8.0, 4.0, 2.0, 1.0, 0.5, 0.25}) {
+      ClashRequest d = req;
+      d.method = ClashMethod::Discrete;
+      d.spacing = sp;
+      const Timed t = timed_check(sc, &idx, d, 1);
+      const int m = missed(truth_keys, clash_keys(t.res));
+      csv << "discrete," << sp << "," << t.ms << "," << t.res.clashes.size() << "," << m << "\n";
+      std::printf("discrete spacing %.2f: %.1f ms, missed %d of %zu\n", sp, t.ms, m, truth_keys.size());
+    }
+    ClashRequest d = req;
+    d.method = ClashMethod::Discrete;
+    d.spacing = 0.0;  // the paper's rule, 2r per cable
+    const Timed t = timed_check(sc, &idx, d, 1);
+    csv << "discrete-2r,0," << t.ms << "," << t.res.clashes.size() << "," << missed(truth_keys, clash_keys(t.res))
+        << "\n";
+  }
+
+  gnuplot("set datafile separator ','\nset terminal pngcairo size 1400,450\nset output '" + dir +
+          "audit.png'\nset multiplot layout 1,3\n"
+          "set title 'certified audit time vs cables (200 parts)'\nset xlabel 'cables'\nset ylabel 'ms'\nset key off\n"
+          "plot '" + dir + "audit_scaling.csv' using (strcol(1) eq 'cables' ? $2 : 1/0):4 with linespoints pt 7\n"
+          "set title 'certified audit time vs triangles (100 cables)'\nset xlabel 'triangles'\nset logscale x\n"
+          "plot '" + dir + "audit_scaling.csv' using (strcol(1) eq 'triangles' ? $3 : 1/0):4 with linespoints pt 7\n"
+          "unset logscale x\nset title 'speed vs accuracy'\nset xlabel 'time (ms)'\nset ylabel 'missed clashes'\n"
+          "set logscale x\nset key top right\n"
+          "plot '" + dir + "audit_accuracy.csv' using (strcol(1) eq 'discrete' ? $3 : 1/0):5:(sprintf('%g', $2)) "
+          "with labels offset 0,1 notitle, '' using (strcol(1) eq 'discrete' ? $3 : 1/0):5 with linespoints pt 7 "
+          "title 'discrete (label: spacing mm)', '' using (strcol(1) eq 'certified' ? $3 : 1/0):5 with linespoints "
+          "pt 5 title 'certified (tolerance 0.1 .. 0.001)'\nunset multiplot\n");
+  return 0;
+}

@@ -1,0 +1,21 @@
+#pragma once
+/// The scene TOML (DESIGN §3) of the wing-section example: every part placed from the
+/// generated STEP files with transforms (repeated parts share one file), the keep-out
+/// envelope of the actuator, the harness file and the routing and α-SIM settings.
+
+#include <string>
+
+namespace loom::examples {
+
+/// Required cable-to-structure clearance written to [routing], mm.
+constexpr double kSceneClearance = 3.0;
+/// Extra clearance asked for around the actuator (moving, hot), mm.
+constexpr double kActuatorExtraClearance = 5.0;
+/// α-SIM level of detail written to [simplify], mm: rivet holes (Ø4), slots (3 mm) and the
+/// rod's thread rings vanish; lightening holes (Ø110) and receptacle bores (Ø22) stay.
+constexpr double kSceneDimPre = 8.0;
+
+/// The scene.toml text; file names are relative to the scene file's directory.
+std::string wing_scene_toml();
+
+}  // namespace loom::examples

@@ -1,0 +1,476 @@
+#include "index/alpha_shape_2d.hpp"
+
+#include <CGAL/Delaunay_triangulation_2.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_face_base_with_info_2.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <cstdio>
+#include <cstdlib>
+
+namespace loom {
+
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Vb = CGAL::Triangulation_vertex_base_2<K>;
+using Fb = CGAL::Triangulation_face_base_with_info_2<int, K>;
+using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
+using DT = CGAL::Delaunay_triangulation_2<K, Tds>;
+using CPoint = K::Point_2;
+using Face = DT::Face_handle;
+
+Vec2 to_vec(const CPoint& p) { return Vec2(p.x(), p.y()); }
+
+double tri_area(const std::array<Vec2, 3>& t) {
+  return 0.5 * ((t[1] - t[0]).x() * (t[2] - t[0]).y() - (t[1] - t[0]).y() * (t[2] - t[0]).x());
+}
+
+double point_segment_distance(const Vec2& p, const Vec2& a, const Vec2& b) {
+  const Vec2 ab = b - a;
+  const double len2 = ab.squaredNorm();
+  double t = len2 > 0.0 ? (p - a).dot(ab) / len2 : 0.0;
+  t = std::clamp(t, 0.0, 1.0);
+  return (a + t * ab - p).norm();
+}
+
+/// Uniform bucket grid over triangles and segments (CSR storage).
+struct BucketGrid {
+  Vec2 origin = Vec2::Zero();
+  double cell = 1.0;
+  int nx = 0, ny = 0;
+  std::vector<std::uint32_t> start, items;
+
+  bool empty() const { return nx == 0; }
+  int cx(double x) const { return std::clamp(static_cast<int>(std::floor((x - origin.x()) / cell)), 0, nx - 1); }
+  int cy(double y) const { return std::clamp(static_cast<int>(std::floor((y - origin.y()) / cell)), 0, ny - 1); }
+
+  /// Builds the grid over `boxes` (min, max per item) covering `lo`..`hi`.
+  void build(const std::vector<std::array<Vec2, 2>>& boxes, const Vec2& lo, const Vec2& hi) {
+    start.clear();
+    items.clear();
+    nx = ny = 0;
+    if (boxes.empty()) return;
+    const Vec2 ext = (hi - lo).cwiseMax(Vec2::Constant(1e-300));
+    // About two items per cell, at most 2^22 cells.
+    const double target = std::clamp(static_cast<double>(boxes.size()) / 2.0, 1.0, 4194304.0);
+    cell = std::sqrt(ext.x() * ext.y() / target);
+    if (!(cell > 0.0) || !std::isfinite(cell)) cell = std::max(ext.x(), ext.y());
+    cell = std::max(cell, std::max(ext.x(), ext.y()) / 2048.0);
+    origin = lo;
+    nx = std::max(1, static_cast<int>(std::ceil(ext.x() / cell)));
+    ny = std::max(1, static_cast<int>(std::ceil(ext.y() / cell)));
+    std::vector<std::uint32_t> count(static_cast<std::size_t>(nx) * ny + 1, 0);
+    for (const auto& b : boxes)
+      for (int y = cy(b[0].y()); y <= cy(b[1].y()); ++y)
+        for (int x = cx(b[0].x()); x <= cx(b[1].x()); ++x) ++count[static_cast<std::size_t>(y) * nx + x + 1];
+    for (std::size_t i = 1; i < count.size(); ++i) count[i] += count[i - 1];
+    start = count;
+    items.resize(count.back());
+    if (std::getenv("LOOM_ALPHA_DEBUG"))
+      std::fprintf(stderr, "grid %d x %d, %zu boxes, %u items\n", nx, ny, boxes.size(), count.back());
+    for (std::uint32_t k = 0; k < boxes.size(); ++k) {
+      const auto& b = boxes[k];
+      for (int y = cy(b[0].y()); y <= cy(b[1].y()); ++y)
+        for (int x = cx(b[0].x()); x <= cx(b[1].x()); ++x) items[count[static_cast<std::size_t>(y) * nx + x]++] = k;
+    }
+  }
+  template <class F>
+  void for_cell(int x, int y, F&& f) const {
+    const std::size_t c = static_cast<std::size_t>(y) * nx + x;
+    for (std::uint32_t i = start[c]; i < start[c + 1]; ++i) f(items[i]);
+  }
+};
+
+}  // namespace
+
+struct AlphaShape2D::Impl {
+  double alpha = 0.0;
+  DT dt;
+  std::vector<Face> faces;                  // finite faces, indexed by info()
+  std::vector<std::array<Vec2, 3>> coords;  // their corners (CCW)
+  std::vector<char> kept;
+  // Derived (rebuilt by refresh()).
+  std::vector<std::uint32_t> kept_list;
+  std::vector<std::array<Vec2, 3>> kept_coords;  // corners of kept_list, contiguous
+  std::vector<std::array<Vec2, 2>> segments;  // boundary edges, kept side on the left
+  std::vector<std::array<int, 2>> segment_edge;  // (face id, edge index)
+  BucketGrid tri_grid, seg_grid;
+  double area = 0.0;
+
+  bool is_kept(Face f) const { return !dt.is_infinite(f) && kept[static_cast<std::size_t>(f->info())]; }
+
+  void refresh() {
+    kept_list.clear();
+    kept_coords.clear();
+    segments.clear();
+    segment_edge.clear();
+    area = 0.0;
+    Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity());
+    Vec2 hi = -lo;
+    std::vector<std::array<Vec2, 2>> tri_boxes, seg_boxes;
+    for (std::uint32_t i = 0; i < faces.size(); ++i) {
+      if (!kept[i]) continue;
+      kept_list.push_back(i);
+      kept_coords.push_back(coords[i]);
+      const auto& c = coords[i];
+      area += tri_area(c);
+      Vec2 bl = c[0].cwiseMin(c[1]).cwiseMin(c[2]), bh = c[0].cwiseMax(c[1]).cwiseMax(c[2]);
+      tri_boxes.push_back({bl, bh});
+      lo = lo.cwiseMin(bl);
+      hi = hi.cwiseMax(bh);
+      for (int e = 0; e < 3; ++e) {
+        if (is_kept(faces[i]->neighbor(e))) continue;
+        const Vec2 a = c[(e + 1) % 3], b = c[(e + 2) % 3];
+        segments.push_back({a, b});
+        segment_edge.push_back({static_cast<int>(i), e});
+        seg_boxes.push_back({a.cwiseMin(b), a.cwiseMax(b)});
+      }
+    }
+    tri_grid.build(tri_boxes, lo, hi);
+    seg_grid.build(seg_boxes, lo, hi);
+  }
+
+  bool in_kept_triangle(const Vec2& p) const {
+    if (tri_grid.empty()) return false;
+    const double slack = 1e-12 * tri_grid.cell;
+    if (p.x() < tri_grid.origin.x() - slack || p.y() < tri_grid.origin.y() - slack ||
+        p.x() > tri_grid.origin.x() + tri_grid.nx * tri_grid.cell + slack ||
+        p.y() > tri_grid.origin.y() + tri_grid.ny * tri_grid.cell + slack)
+      return false;
+    bool inside = false;
+    tri_grid.for_cell(tri_grid.cx(p.x()), tri_grid.cy(p.y()), [&](std::uint32_t k) {
+      if (inside) return;
+      const auto& c = kept_coords[k];
+      // Floating-point orientations decide clear cases; near an edge the exact CGAL
+      // predicate decides, so that points on shared edges count as inside.
+      bool near = false;
+      for (int e = 0; e < 3; ++e) {
+        const Vec2 a = c[e], b = c[(e + 1) % 3];
+        const double o = (b.x() - a.x()) * (p.y() - a.y()) - (b.y() - a.y()) * (p.x() - a.x());
+        const double scale = (std::abs(b.x() - a.x()) + std::abs(b.y() - a.y())) *
+                             (std::abs(p.x() - a.x()) + std::abs(p.y() - a.y()));
+        if (o < -1e-12 * scale) return;  // clearly right of an edge: outside
+        if (o <= 1e-12 * scale) near = true;
+      }
+      if (!near) {
+        inside = true;
+        return;
+      }
+      const CPoint q(p.x(), p.y());
+      const CPoint a(c[0].x(), c[0].y()), b(c[1].x(), c[1].y()), d(c[2].x(), c[2].y());
+      if (CGAL::orientation(a, b, q) != CGAL::RIGHT_TURN && CGAL::orientation(b, d, q) != CGAL::RIGHT_TURN &&
+          CGAL::orientation(d, a, q) != CGAL::RIGHT_TURN)
+        inside = true;
+    });
+    return inside;
+  }
+
+  double boundary_distance(const Vec2& p, double stop_below = -1.0) const {
+    double best = std::numeric_limits<double>::infinity();
+    if (seg_grid.empty()) return best;
+    const int x0 = seg_grid.cx(p.x()), y0 = seg_grid.cy(p.y());
+    const int max_ring = std::max(seg_grid.nx, seg_grid.ny);
+    for (int r = 0; r <= max_ring; ++r) {
+      for (int y = y0 - r; y <= y0 + r; ++y) {
+        if (y < 0 || y >= seg_grid.ny) continue;
+        const bool edge_row = (y == y0 - r || y == y0 + r);
+        for (int x = x0 - r; x <= x0 + r; x += (edge_row ? 1 : 2 * r)) {
+          if (x >= 0 && x < seg_grid.nx)
+            seg_grid.for_cell(x, y, [&](std::uint32_t k) {
+              best = std::min(best, point_segment_distance(p, segments[k][0], segments[k][1]));
+            });
+          if (r == 0) break;
+        }
+      }
+      if (best <= stop_below) return best;
+      if (best <= r * seg_grid.cell) return best;
+    }
+    return best;
+  }
+};
+
+AlphaShape2D::AlphaShape2D(const std::vector<Vec2>& points, double alpha) : impl_(std::make_unique<Impl>()) {
+  impl_->alpha = alpha;
+  std::vector<CPoint> pts;
+  pts.reserve(points.size());
+  for (const auto& p : points) pts.emplace_back(p.x(), p.y());
+  impl_->dt.insert(pts.begin(), pts.end());
+  int id = 0;
+  const double a2 = alpha * alpha;
+  for (auto f = impl_->dt.finite_faces_begin(); f != impl_->dt.finite_faces_end(); ++f) {
+    f->info() = id++;
+    impl_->faces.push_back(f);
+    const auto& p0 = f->vertex(0)->point();
+    const auto& p1 = f->vertex(1)->point();
+    const auto& p2 = f->vertex(2)->point();
+    impl_->coords.push_back({to_vec(p0), to_vec(p1), to_vec(p2)});
+    const double r2 = CGAL::squared_radius(p0, p1, p2);
+    impl_->kept.push_back(r2 < a2 ? 1 : 0);
+  }
+  impl_->refresh();
+}
+
+AlphaShape2D::~AlphaShape2D() = default;
+AlphaShape2D::AlphaShape2D(AlphaShape2D&&) noexcept = default;
+AlphaShape2D& AlphaShape2D::operator=(AlphaShape2D&&) noexcept = default;
+
+double AlphaShape2D::alpha() const { return impl_->alpha; }
+bool AlphaShape2D::degenerate() const { return impl_->dt.dimension() < 2; }
+std::size_t AlphaShape2D::delaunay_triangle_count() const { return impl_->faces.size(); }
+std::size_t AlphaShape2D::kept_triangle_count() const { return impl_->kept_list.size(); }
+double AlphaShape2D::area() const { return impl_->area; }
+
+double AlphaShape2D::hull_area() const {
+  double a = 0.0;
+  for (const auto& c : impl_->coords) a += tri_area(c);
+  return a;
+}
+
+void AlphaShape2D::keep_all() {
+  std::fill(impl_->kept.begin(), impl_->kept.end(), 1);
+  impl_->refresh();
+}
+
+double AlphaShape2D::cover(const std::vector<Vec2>& points, double tol, std::size_t* uncovered) {
+  Impl& m = *impl_;
+  const double before = m.area;
+  if (m.faces.empty()) {
+    if (uncovered) *uncovered = points.size();
+    return 0.0;
+  }
+  bool changed = false;
+  Face hint = m.faces.front();
+  // Every triangulation vertex (a sample) must touch a kept triangle: checked on the
+  // incidence structure, without point location.
+  for (auto v = m.dt.finite_vertices_begin(); v != m.dt.finite_vertices_end(); ++v) {
+    auto fc = m.dt.incident_faces(v), done = fc;
+    Face best;
+    double best_r2 = std::numeric_limits<double>::infinity();
+    bool touched = false;
+    do {
+      if (m.dt.is_infinite(fc)) continue;
+      if (m.kept[static_cast<std::size_t>(fc->info())]) {
+        touched = true;
+        break;
+      }
+      const double r2 = CGAL::squared_radius(fc->vertex(0)->point(), fc->vertex(1)->point(), fc->vertex(2)->point());
+      if (r2 < best_r2) {
+        best_r2 = r2;
+        best = fc;
+      }
+    } while (++fc != done);
+    if (!touched && best != Face()) {
+      m.kept[static_cast<std::size_t>(best->info())] = 1;
+      changed = true;
+    }
+  }
+  for (const auto& p : points) {
+    if (m.in_kept_triangle(p)) continue;
+    if (tol > 0.0 && m.boundary_distance(p, tol) <= tol) continue;
+    DT::Locate_type lt;
+    int li = 0;
+    const Face f = m.dt.locate(CPoint(p.x(), p.y()), lt, li, hint);
+    auto keep = [&](Face g) {
+      if (m.dt.is_infinite(g)) return;
+      auto& k = m.kept[static_cast<std::size_t>(g->info())];
+      if (!k) {
+        k = 1;
+        changed = true;
+      }
+      hint = g;
+    };
+    switch (lt) {
+      case DT::FACE:
+        keep(f);
+        break;
+      case DT::EDGE:
+        keep(f);
+        keep(f->neighbor(li));
+        break;
+      case DT::VERTEX: {
+        // Keep the incident triangle with the smallest circumradius.
+        auto fc = m.dt.incident_faces(f->vertex(li)), done = fc;
+        Face best;
+        double best_r2 = std::numeric_limits<double>::infinity();
+        do {
+          if (!m.dt.is_infinite(fc)) {
+            const double r2 = CGAL::squared_radius(fc->vertex(0)->point(), fc->vertex(1)->point(),
+                                                   fc->vertex(2)->point());
+            if (r2 < best_r2) {
+              best_r2 = r2;
+              best = fc;
+            }
+          }
+        } while (++fc != done);
+        if (best != Face()) keep(best);
+        break;
+      }
+      case DT::OUTSIDE_CONVEX_HULL:
+        // Just outside the hull (within rounding): keep the finite face across the hull edge.
+        keep(f->neighbor(f->index(m.dt.infinite_vertex())));
+        break;
+      default:
+        break;
+    }
+  }
+  if (changed) m.refresh();
+  if (uncovered) {
+    std::size_t n = 0;
+    for (const auto& p : points)
+      if (!contains(p, tol)) ++n;
+    *uncovered = n;
+  }
+  return m.area - before;
+}
+
+bool AlphaShape2D::contains(const Vec2& p, double tol) const {
+  if (impl_->in_kept_triangle(p)) return true;
+  return tol > 0.0 && impl_->boundary_distance(p, tol) <= tol;
+}
+
+double AlphaShape2D::signed_distance(const Vec2& p) const {
+  const double d = impl_->boundary_distance(p);
+  return impl_->in_kept_triangle(p) ? -d : d;
+}
+
+std::vector<PolygonWithHoles2> AlphaShape2D::polygons() const {
+  const Impl& m = *impl_;
+  const std::size_t nseg = m.segments.size();
+  // Boundary edge lookup: (face id, edge index) → segment index.
+  std::map<std::pair<int, int>, std::size_t> seg_of;
+  for (std::size_t s = 0; s < nseg; ++s) seg_of[{m.segment_edge[s][0], m.segment_edge[s][1]}] = s;
+  std::vector<char> used(nseg, 0);
+  struct Loop {
+    std::vector<Vec2> ring;
+    int face = -1;  // a kept face on the loop's left
+    double area = 0.0;
+  };
+  std::vector<Loop> loops;
+  for (std::size_t s0 = 0; s0 < nseg; ++s0) {
+    if (used[s0]) continue;
+    Loop loop;
+    loop.face = m.segment_edge[s0][0];
+    std::size_t s = s0;
+    while (!used[s]) {
+      used[s] = 1;
+      Face f = m.faces[static_cast<std::size_t>(m.segment_edge[s][0])];
+      const int e = m.segment_edge[s][1];
+      loop.ring.push_back(m.segments[s][0]);
+      // Next boundary edge leaving the target vertex v: rotate clockwise around v
+      // through kept faces until the neighbour across the outgoing edge is not kept.
+      const auto v = f->vertex(DT::cw(e));
+      Face g = f;
+      for (std::size_t guard = 0; guard < 1000000; ++guard) {
+        const int j = g->index(v);
+        const int out = DT::cw(j);  // edge of g from v to g->vertex(ccw(j))
+        const Face n = g->neighbor(out);
+        if (!m.is_kept(n)) {
+          auto it = seg_of.find({g->info(), out});
+          s = it == seg_of.end() ? s0 : it->second;
+          break;
+        }
+        g = n;
+      }
+    }
+    loop.area = ring_signed_area(loop.ring);
+    loops.push_back(std::move(loop));
+  }
+  std::vector<PolygonWithHoles2> out;
+  std::vector<std::size_t> outer_ids;
+  for (std::size_t i = 0; i < loops.size(); ++i)
+    if (loops[i].area > 0.0) {
+      outer_ids.push_back(i);
+      PolygonWithHoles2 p;
+      p.outer = loops[i].ring;
+      out.push_back(std::move(p));
+    }
+  auto point_in_ring = [](const Vec2& p, const std::vector<Vec2>& r) {
+    bool in = false;
+    for (std::size_t i = 0, j = r.size() - 1; i < r.size(); j = i++) {
+      if ((r[i].y() > p.y()) != (r[j].y() > p.y()) &&
+          p.x() < (r[j].x() - r[i].x()) * (p.y() - r[i].y()) / (r[j].y() - r[i].y()) + r[i].x())
+        in = !in;
+    }
+    return in;
+  };
+  for (auto& loop : loops) {
+    if (loop.area > 0.0) continue;
+    // The owner is the smallest outer ring containing the centroid of a kept triangle
+    // that borders the hole.
+    const auto& c = m.coords[static_cast<std::size_t>(loop.face)];
+    const Vec2 probe = (c[0] + c[1] + c[2]) / 3.0;
+    int owner = -1;
+    double owner_area = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < outer_ids.size(); ++k) {
+      const double a = loops[outer_ids[k]].area;
+      if (a < owner_area && point_in_ring(probe, out[k].outer)) {
+        owner = static_cast<int>(k);
+        owner_area = a;
+      }
+    }
+    if (owner >= 0) out[static_cast<std::size_t>(owner)].holes.push_back(std::move(loop.ring));
+  }
+  return out;
+}
+
+std::size_t merge_collinear(std::vector<Vec2>& ring, double angle_tol_rad, double dist_tol) {
+  const std::size_t n0 = ring.size();
+  // Drop exact repeats first.
+  std::vector<Vec2> r;
+  r.reserve(n0);
+  for (const auto& p : ring)
+    if (r.empty() || p != r.back()) r.push_back(p);
+  while (r.size() > 1 && r.front() == r.back()) r.pop_back();
+  if (r.size() < 3) {
+    ring = std::move(r);
+    return n0 - ring.size();
+  }
+  // Start at the lexicographically lowest vertex: an extreme point, hence a corner.
+  std::size_t s0 = 0;
+  for (std::size_t i = 1; i < r.size(); ++i)
+    if (r[i].x() < r[s0].x() || (r[i].x() == r[s0].x() && r[i].y() < r[s0].y())) s0 = i;
+  std::rotate(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(s0), r.end());
+  r.push_back(r.front());  // closed for the sweep
+  const double sin_tol = std::sin(angle_tol_rad);
+  // Greedy: extend the segment anchor → r[j] while every skipped vertex lies within
+  // max(dist_tol, sin_tol·|segment|) of it, strictly between its ends.
+  auto fits = [&](std::size_t a, std::size_t j) {
+    const Vec2 d = r[j] - r[a];
+    const double len = d.norm();
+    if (len == 0.0) return false;
+    const double lim = std::max(dist_tol, sin_tol * len);
+    for (std::size_t k = a + 1; k < j; ++k) {
+      const Vec2 w = r[k] - r[a];
+      const double along = w.dot(d) / len;
+      if (along <= 0.0 || along >= len) return false;
+      if (std::abs(d.x() * w.y() - d.y() * w.x()) / len > lim) return false;
+    }
+    return true;
+  };
+  std::vector<Vec2> out;
+  std::size_t a = 0;
+  out.push_back(r[0]);
+  while (a + 1 < r.size()) {
+    std::size_t j = a + 1;
+    while (j + 1 < r.size() && fits(a, j + 1)) ++j;
+    if (j + 1 < r.size()) out.push_back(r[j]);
+    a = j;
+  }
+  ring = std::move(out);
+  return n0 - ring.size();
+}
+
+double ring_signed_area(const std::vector<Vec2>& ring) {
+  double a = 0.0;
+  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++)
+    a += ring[j].x() * ring[i].y() - ring[i].x() * ring[j].y();
+  return 0.5 * a;
+}
+
+}  // namespace loom

@@ -1,0 +1,80 @@
+#pragma once
+/// The 2D α-shape of the α-SIM paper (seed: alpha-sim, §3.1 step 3): the union of the
+/// triangles of the Delaunay triangulation DT(S) whose circumradius is < α, with its outer
+/// and inner boundaries. Built on CGAL's exact-predicate Delaunay_triangulation_2 (CGAL's
+/// Alpha_shape_2 in GENERAL mode never marks vertices exterior, DESIGN §9). Coordinates
+/// are those of the projection plane the caller chose (scene units).
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+namespace loom {
+
+/// A point in a projection plane (scene units).
+using Vec2 = Eigen::Vector2d;
+
+/// One connected piece of an α-shape: outer boundary counter-clockwise, holes clockwise.
+struct PolygonWithHoles2 {
+  std::vector<Vec2> outer;               ///< CCW, not repeated at the end
+  std::vector<std::vector<Vec2>> holes;  ///< each CW, not repeated at the end
+};
+
+/// The kept-triangle region of a 2D Delaunay triangulation with membership, distance and
+/// boundary queries. The region starts as the paper's α-shape and can only grow
+/// (cover(), keep_all()), never shrink. Queries are const and thread-safe.
+class AlphaShape2D {
+ public:
+  /// Triangulates `points` (duplicates allowed) and keeps every triangle whose
+  /// circumradius is < alpha (alpha ≥ 0; +inf keeps the convex hull).
+  AlphaShape2D(const std::vector<Vec2>& points, double alpha);
+  ~AlphaShape2D();
+  AlphaShape2D(AlphaShape2D&&) noexcept;
+  AlphaShape2D& operator=(AlphaShape2D&&) noexcept;
+
+  /// The α this shape was built with.
+  double alpha() const;
+  /// True if the points have fewer than three non-collinear members: no triangle exists.
+  bool degenerate() const;
+  /// Number of finite Delaunay triangles.
+  std::size_t delaunay_triangle_count() const;
+  /// Number of kept triangles (the region).
+  std::size_t kept_triangle_count() const;
+  /// Area of the kept region (scene units²).
+  double area() const;
+  /// Area of the convex hull of the points (= area after keep_all()).
+  double hull_area() const;
+
+  /// Keeps every finite Delaunay triangle: the region becomes the convex hull.
+  void keep_all();
+  /// Makes the region contain every triangulation vertex (an isolated one gets its incident
+  /// triangle of smallest circumradius kept) and every given point: a point farther than `tol` from the
+  /// region gets the Delaunay triangle(s) containing it kept. Points outside the convex
+  /// hull by more than tol cannot be covered and are counted in *uncovered (if given).
+  /// Returns the area added (scene units²).
+  double cover(const std::vector<Vec2>& points, double tol, std::size_t* uncovered = nullptr);
+
+  /// True if p lies in the region or within tol of it.
+  bool contains(const Vec2& p, double tol = 0.0) const;
+  /// Signed distance to the region's boundary: negative inside, +inf if the region is empty.
+  double signed_distance(const Vec2& p) const;
+  /// Boundary loops grouped per connected piece (outer CCW, holes CW), in deterministic order.
+  std::vector<PolygonWithHoles2> polygons() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Replaces runs of a closed polygon's vertices that are collinear (paper step 4: included
+/// angle < angle_tol_rad) or within dist_tol of the chord that replaces them by that chord,
+/// and removes repeated vertices. Every removed vertex stays within
+/// max(dist_tol, sin(angle_tol)·chord) of the new boundary. Returns the number removed.
+std::size_t merge_collinear(std::vector<Vec2>& ring, double angle_tol_rad, double dist_tol = 0.0);
+
+/// Signed area of a closed polygon (positive when counter-clockwise).
+double ring_signed_area(const std::vector<Vec2>& ring);
+
+}  // namespace loom

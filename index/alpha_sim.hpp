@@ -1,0 +1,172 @@
+#pragma once
+/// α-SIM (seed: alpha-sim; DESIGN §6–§7): simplify a part to the level of detail a cable
+/// needs. Sample the surface (L_max = 0.5·dim_pre), project onto XY, XZ, YZ (+ user planes),
+/// take the 2D α-shape of each projection (α = 0.95·dim_pre), extrude each along its plane
+/// normal over the part's extent and intersect. The result must CONTAIN the original part
+/// (a route clear of it is clear of the real part): it is verified on dense samples, and
+/// where the method fails the failure is reported and a safe fallback is used.
+/// All coordinates are world frame, scene units.
+
+#include "core/mesh.hpp"
+#include "core/part.hpp"
+#include "index/alpha_shape_2d.hpp"
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace loom {
+
+/// How a part is simplified. dim_pre is required; every other value has the paper's default.
+struct AlphaSimOptions {
+  double dim_pre = 0.0;          ///< features smaller than this vanish (scene units, > 0)
+  double sampling_factor = 0.5;  ///< L_max = sampling_factor·dim_pre (paper §3.2: 0.5)
+  double alpha_factor = 0.95;    ///< α = alpha_factor·dim_pre (paper §3.2: 0.95)
+  bool coordinate_planes = true;  ///< project onto XY, XZ, YZ
+  std::vector<Vec3> extra_planes;  ///< normals of user projection planes (need not be unit)
+  /// Scene size used for tolerances (bbox diagonal); ≤ 0: the part's own diagonal.
+  double scene_size = 0.0;
+  /// "Inside or on" tolerance = containment_tolerance_factor·scene_size (issue: 1e-6).
+  double containment_tolerance_factor = 1e-6;
+  /// A projection whose repaired (added) area exceeds this fraction of its final area is
+  /// "torn" (α too small for the sampling) and replaced by its convex hull.
+  double torn_fraction = 0.05;
+  /// A part thinner than thin_factor·dim_pre along a plane normal is a sheet: kept as is.
+  double thin_factor = 1e-4;
+  /// Lost-space check (the paper's "blocked projection"): if a ball of radius
+  /// lost_space_factor·dim_pre fits inside the simplified part but outside the original,
+  /// a feature was hidden in every projection → status Blocked, original part kept.
+  bool detect_lost_space = true;
+  double lost_space_factor = 2.0;
+  std::size_t lost_space_max_samples = 1u << 18;  ///< grid points probed at most
+  /// Dense containment samples of the original surface: about this many per L_max² of area
+  /// (at least the vertices, edge midpoints, centroids and two random points per triangle).
+  double containment_density = 4.0;
+  std::size_t containment_max_samples = 400000;
+  bool build_mesh = true;       ///< OpenCASCADE prisms ∩ → triangle mesh (else implicit only)
+  bool measure = true;          ///< containment of the mesh + Hausdorff distance
+  std::filesystem::path step_dir;  ///< if set, writes <step_dir>/<part>.step (OpenCASCADE)
+  std::uint64_t seed = 1;       ///< random containment samples
+};
+
+/// What happened to one projection plane.
+enum class ProjectionStatus {
+  Ok,        ///< the α-shape covered every sample
+  Repaired,  ///< a few Delaunay triangles were added so that every sample is covered
+  Empty,     ///< α too small for the sampling: no triangle kept → convex hull
+  Torn,      ///< too much had to be repaired → convex hull
+  Eroded,    ///< the α-shape missed dense samples of the surface → convex hull
+};
+/// "ok" | "repaired" | "empty" | "torn" | "eroded".
+const char* projection_status_name(ProjectionStatus s);
+
+/// Outcome of simplifying one part.
+enum class AlphaSimStatus {
+  Ok,          ///< simplified, every projection an α-shape
+  HullFallback,///< simplified, some projection replaced by its convex hull (see projections)
+  Thin,        ///< too thin along a projection normal (a sheet): original kept
+  Blocked,     ///< a feature hidden in every projection: space a cable could use was filled; original kept
+  Failed,      ///< the mesh could not be built or did not contain the original: original kept
+  EmptyInput,  ///< the part has no triangles
+};
+/// "ok" | "hull_fallback" | "thin" | "blocked" | "failed" | "empty_input".
+const char* alpha_sim_status_name(AlphaSimStatus s);
+
+/// Which fallback was used.
+enum class AlphaSimFallback { None, ConvexHull, Original };
+/// "none" | "convex_hull" | "original".
+const char* alpha_sim_fallback_name(AlphaSimFallback f);
+
+/// Report of one projection plane.
+struct ProjectionReport {
+  std::string plane;  ///< "XY", "XZ", "YZ" or "user0"...
+  Vec3 normal = Vec3::UnitZ();
+  ProjectionStatus status = ProjectionStatus::Ok;
+  std::size_t points = 0;              ///< projected cloud points
+  std::size_t delaunay_triangles = 0;
+  std::size_t kept_triangles = 0;      ///< after repair / fallback
+  double alpha_area = 0.0;             ///< area of the plain α-shape (scene units²)
+  double area = 0.0;                   ///< final area
+  double hull_area = 0.0;              ///< convex hull area
+  std::size_t polygon_vertices = 0;    ///< boundary vertices after merging collinear ones
+  std::size_t polygons = 0;            ///< connected pieces
+  std::size_t holes = 0;
+};
+
+/// Per-part result (DESIGN §4 simplify.json fields + diagnostics).
+struct AlphaSimResult {
+  std::string name;
+  AlphaSimStatus status = AlphaSimStatus::Ok;
+  AlphaSimFallback fallback = AlphaSimFallback::None;
+  std::string reason;  ///< why a fallback was used (empty when none)
+  double dim_pre = 0.0, alpha = 0.0, l_max = 0.0, tolerance = 0.0;
+  std::size_t sample_points = 0;       ///< 3D cloud size
+  std::size_t triangles_before = 0, triangles_after = 0;
+  int faces_before = 0, faces_after = 0;  ///< B-rep faces (STEP sources), OpenCASCADE result faces
+  bool closed_before = false, closed_after = false;
+  double volume_before = 0.0, volume_after = 0.0;  ///< 0 when the mesh is not closed
+  double containment = 1.0;           ///< fraction of dense original samples inside/on the output mesh
+  double containment_implicit = 1.0;  ///< same against the implicit solid
+  std::size_t containment_samples = 0;
+  double hausdorff = 0.0;             ///< max over the output surface of the distance to the original
+  double lost_space_radius = 0.0;     ///< largest probed ball radius filled by the simplification
+  double lost_space_resolution = 0.0; ///< grid spacing of that probe
+  double time_ms = 0.0;
+  double shapes_ms = 0.0;   ///< sampling + α-shapes + repair + implicit verification
+  double mesh_ms = 0.0;     ///< OpenCASCADE prisms, Booleans, meshing
+  double measure_ms = 0.0;  ///< mesh containment, Hausdorff, lost-space probe
+  std::vector<ProjectionReport> projections;
+};
+
+/// One extrusion: a 2D region in a plane frame swept over a depth range.
+struct AlphaSimPrism {
+  Vec3 u = Vec3::UnitX(), v = Vec3::UnitY(), n = Vec3::UnitZ();  ///< orthonormal, n = u × v
+  double depth_min = 0.0, depth_max = 0.0;  ///< range of p·n
+  std::shared_ptr<const AlphaShape2D> shape;
+  /// Projection coordinates (p·u, p·v).
+  Vec2 project(const Vec3& p) const { return Vec2(p.dot(u), p.dot(v)); }
+};
+
+/// The implicit simplified solid: p is inside iff every projection lies in its 2D shape and
+/// p lies within every prism's depth range. Queries are const and thread-safe.
+class AlphaSimSolid {
+ public:
+  AlphaSimSolid() = default;
+  explicit AlphaSimSolid(std::vector<AlphaSimPrism> prisms);
+  /// True if p is inside or within tol of every prism.
+  bool contains(const Vec3& p, double tol = 0.0) const;
+  /// Signed distance bound: max over prisms of the signed distance to the prism.
+  /// Exact sign; outside, a lower bound on the true distance (never overestimates clearance).
+  double distance_bound(const Vec3& p) const;
+  /// The prisms.
+  const std::vector<AlphaSimPrism>& prisms() const { return prisms_; }
+
+ private:
+  std::vector<AlphaSimPrism> prisms_;
+};
+
+/// A simplified part: the mesh for viewing and indices, the implicit solid, the report.
+struct AlphaSimPart {
+  Mesh mesh;                                   ///< world frame; the original mesh on fallback Original
+  std::shared_ptr<const AlphaSimSolid> solid;  ///< null when the original is kept
+  AlphaSimResult result;
+};
+
+/// Simplifies one part. Throws std::invalid_argument if opt.dim_pre is not finite and > 0.
+AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt);
+
+/// Simplifies every part in parallel (TBB) and returns them with the simplified meshes
+/// (names, roles, clearances kept), ready for any ObstacleIndex. opt.scene_size ≤ 0 is
+/// replaced by the diagonal of all parts. Results in part order if `results` is given.
+std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimOptions& opt,
+                                 std::vector<AlphaSimResult>* results);
+
+/// Dense samples of a mesh surface: vertices, edge midpoints, centroids and random points
+/// (≈ density per spacing² of area, at least two per triangle), capped at max_samples
+/// random ones; deterministic for a seed. World frame.
+std::vector<Vec3> dense_surface_samples(const Mesh& mesh, double spacing, double density,
+                                        std::size_t max_samples, std::uint64_t seed);
+
+}  // namespace loom

@@ -1,0 +1,60 @@
+#pragma once
+/// BruteForceIndex: every query loops over every triangle in double precision (no culling,
+/// not even by part bounding boxes, except that inside tests skip parts whose box does
+/// not contain the point). It is the
+/// test oracle for the other indices and the benchmark baseline (the seed paper's brute
+/// force). Inside tests use the generalized winding number of closed parts.
+
+#include "core/part.hpp"
+#include "index/obstacle_index.hpp"
+
+#include <array>
+#include <vector>
+
+namespace loom {
+
+/// The triangles of one part as explicit corners (world frame, double), with its bounds.
+struct PartTriangles {
+  std::vector<std::array<Vec3, 3>> triangles;  ///< corners of each triangle, mesh order
+  AABB bounds;                                 ///< box of the corners (empty for no triangles)
+  bool closed = false;                         ///< Part::closed
+};
+
+/// Copies the parts' triangles into PartTriangles (same part and triangle indices).
+std::vector<PartTriangles> extract_part_triangles(const std::vector<Part>& parts);
+
+/// Winding number of a closed triangle soup around p: ≈1 inside, ≈0 outside (outward
+/// orientation); sum of signed solid angles / 4π.
+double winding_number(const PartTriangles& part, const Vec3& p);
+
+/// Exact O(n) obstacle queries; see ObstacleIndex for the contract of each method.
+class BruteForceIndex : public ObstacleIndex {
+ public:
+  /// Copies the parts' triangles (world frame).
+  explicit BruteForceIndex(const std::vector<Part>& parts);
+
+  std::string name() const override { return "brute"; }
+  IndexAccuracy accuracy() const override;
+  int part_count() const override { return static_cast<int>(parts_.size()); }
+
+  ClosestHit closest(const Vec3& p, double max_radius = std::numeric_limits<double>::infinity()) const override;
+  ClosestHit closest_on_part(const Vec3& p, int part,
+                             double max_radius = std::numeric_limits<double>::infinity()) const override;
+  bool inside(const Vec3& p, int* part = nullptr) const override;
+  RayHit ray(const Vec3& origin, const Vec3& dir,
+             double t_max = std::numeric_limits<double>::infinity()) const override;
+  bool any_within(const Vec3& p, double r) const override;
+  bool segment_within(const Vec3& a, const Vec3& b, double r) const override;
+  ClosestHit segment_closest(const Vec3& a, const Vec3& b,
+                             double max_radius = std::numeric_limits<double>::infinity(),
+                             double* segment_param = nullptr) const override;
+
+  /// Winding number of closed part `part` around p (throws std::out_of_range on a bad id).
+  double part_winding_number(int part, const Vec3& p) const;
+
+ private:
+  void scan_part(int part, const Vec3& p, ClosestHit& best) const;
+  std::vector<PartTriangles> parts_;
+};
+
+}  // namespace loom

@@ -1,0 +1,599 @@
+#include "index/embree_index.hpp"
+
+#include "core/error.hpp"
+#include "index/triangle_distance.hpp"
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#if defined(__SSE__) || defined(__x86_64__)
+#include <xmmintrin.h>
+#define LOOM_HAVE_MXCSR 1
+#endif
+
+namespace loom {
+
+namespace {
+
+/// Relative rounding of a float (2^-24) inflated ×16 to cover the query point's rounding,
+/// Embree's own box arithmetic and the radius conversion: the culling pad per unit extent.
+constexpr double kFloatPadRel = 16.0 / 16777216.0;
+/// Barycentric margin under which a ray is said to graze an edge or vertex of a triangle
+/// it crosses; such a ray is discarded from the inside vote.
+constexpr double kGrazeBary = 1e-6;
+/// Directions of the inside-test rays: fixed, irrational-looking, pairwise far apart, so
+/// that no axis-aligned CAD edge is parallel to any of them.
+const Vec3 kInsideDirs[] = {
+    Vec3(0.5773, 0.5831, 0.5714), Vec3(-0.6207, 0.2931, 0.7270), Vec3(0.3139, -0.8467, 0.4297),
+    Vec3(-0.4523, -0.5174, -0.7264), Vec3(0.8123, 0.1451, -0.5651), Vec3(-0.1031, 0.9154, -0.3892),
+    Vec3(0.6617, -0.4327, -0.6123), Vec3(-0.8832, -0.2123, 0.4184), Vec3(0.0737, 0.0813, 0.9940)};
+constexpr int kMaxInsideDirs = 9;
+/// A segment is split into at most this many pieces for sphere point queries.
+constexpr int kMaxSegmentPieces = 256;
+/// Target piece length as a fraction of the scene diagonal for segment_closest.
+constexpr double kSegmentPieceRel = 1.0 / 128.0;
+
+/// Sets FTZ/DAZ for the current thread while alive (Embree's recommendation), restoring the
+/// caller's MXCSR afterwards.
+class FlushDenormals {
+ public:
+  FlushDenormals() {
+#ifdef LOOM_HAVE_MXCSR
+    saved_ = _mm_getcsr();
+    _mm_setcsr(saved_ | 0x8040u);  // FTZ (bit 15) | DAZ (bit 6)
+#endif
+  }
+  ~FlushDenormals() {
+#ifdef LOOM_HAVE_MXCSR
+    _mm_setcsr(saved_);
+#endif
+  }
+  FlushDenormals(const FlushDenormals&) = delete;
+  FlushDenormals& operator=(const FlushDenormals&) = delete;
+
+ private:
+  unsigned saved_ = 0;
+};
+
+float to_float_up(double v) {
+  if (!(v < static_cast<double>(std::numeric_limits<float>::max()))) return std::numeric_limits<float>::infinity();
+  const float f = static_cast<float>(v);
+  return static_cast<double>(f) >= v ? f : std::nextafter(f, std::numeric_limits<float>::infinity());
+}
+
+void check_part_id(int part, std::size_t n) {
+  if (part < 0 || static_cast<std::size_t>(part) >= n)
+    throw std::out_of_range("embree index: part id " + std::to_string(part) + " out of range");
+}
+
+Vec3 unit_dir(const Vec3& dir) {
+  const double n = dir.norm();
+  if (!(n > 0.0) || !std::isfinite(n)) throw std::invalid_argument("embree index: ray direction is zero or not finite");
+  return dir / n;
+}
+
+enum class Mode { Closest, AnyWithin, Segment, SegmentAny };
+
+/// State of one point query, passed as userPtr to the callback.
+struct QueryState {
+  const std::vector<EmbreeIndex::PartData>* parts = nullptr;
+  Mode mode = Mode::Closest;
+  int only_part = -1;  ///< geomID filter (part scenes: the part id, geomID there is 0)
+  Vec3 p = Vec3::Zero();
+  Vec3 a = Vec3::Zero(), b = Vec3::Zero();  ///< segment piece
+  double s0 = 0.0, s1 = 1.0;                ///< piece parameters on the whole segment
+  double r2 = 0.0;                          ///< any-within threshold²
+  double best2 = std::numeric_limits<double>::infinity();
+  double best_s = 0.0;
+  double radius_offset = 0.0;  ///< added to the best distance when shrinking (piece half length)
+  double pad = 0.0;
+  ClosestHit hit;
+  bool done = false;
+};
+
+bool point_query_callback(RTCPointQueryFunctionArguments* args) {
+  auto* q = static_cast<QueryState*>(args->userPtr);
+  if (q->done) return false;
+  const int part = q->only_part >= 0 ? q->only_part : static_cast<int>(args->geomID);
+  const auto c = (*q->parts)[part].corners(args->primID);
+  double d2;
+  Vec3 point;
+  double s = 0.0;
+  if (q->mode == Mode::Closest || q->mode == Mode::AnyWithin) {
+    // Cheap rejection first: the triangle's box is farther than what we already have.
+    const Vec3 lo = c[0].cwiseMin(c[1]).cwiseMin(c[2]), hi = c[0].cwiseMax(c[1]).cwiseMax(c[2]);
+    const double box2 = point_box_dist2(q->p, lo, hi);
+    if (box2 > (q->mode == Mode::Closest ? q->best2 : q->r2)) return false;
+    const TrianglePointResult r = closest_point_on_triangle(q->p, c[0], c[1], c[2]);
+    d2 = r.dist2;
+    point = r.point;
+  } else {
+    const SegmentTriangleResult r = closest_segment_triangle(q->a, q->b, c[0], c[1], c[2]);
+    d2 = r.dist2;
+    point = r.triangle_point;
+    s = q->s0 + r.s * (q->s1 - q->s0);
+  }
+  if (q->mode == Mode::AnyWithin || q->mode == Mode::SegmentAny) {
+    if (d2 <= q->r2) {
+      q->done = true;
+      args->query->radius = 0.0f;
+      return true;
+    }
+    return false;
+  }
+  if (d2 < q->best2 || (d2 == q->best2 && (part < q->hit.part || (part == q->hit.part &&
+                                                                   static_cast<std::int64_t>(args->primID) < q->hit.triangle)))) {
+    q->best2 = d2;
+    q->best_s = s;
+    q->hit.point = point;
+    q->hit.part = part;
+    q->hit.triangle = args->primID;
+    const float nr = to_float_up(std::sqrt(d2) + q->radius_offset + q->pad);
+    if (nr < args->query->radius) {
+      args->query->radius = nr;
+      return true;
+    }
+  }
+  return false;
+}
+
+/// Collects every hit along a ray (rejecting each so that traversal continues).
+struct CollectContext {
+  RTCIntersectContext ctx;  // must be first: Embree passes &ctx back to the filter
+  std::vector<std::pair<unsigned, unsigned>>* hits;
+};
+
+void collect_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* cc = reinterpret_cast<const CollectContext*>(args->context);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    cc->hits->emplace_back(RTCHitN_geomID(args->hit, args->N, i), RTCHitN_primID(args->hit, args->N, i));
+    args->valid[i] = 0;
+  }
+}
+
+/// How the line p + t·u (any t) meets a triangle, in double.
+struct LineCrossing {
+  enum Status { Miss, Through, Grazing } status = Miss;
+  double t = 0.0;
+};
+
+/// Classifies the line's crossing of triangle abc: Through when the barycentrics are all
+/// at least kGrazeBary, Miss when one is below -kGrazeBary, Grazing otherwise (near an
+/// edge or vertex, or the line lies in the plane of a non-degenerate triangle).
+LineCrossing line_crossing(const Vec3& p, const Vec3& u, const Vec3& a, const Vec3& b, const Vec3& c) {
+  LineCrossing out;
+  const Vec3 e1 = b - a, e2 = c - a;
+  const Vec3 pv = u.cross(e2);
+  const double det = e1.dot(pv);
+  const double scale = e1.norm() * e2.norm();
+  if (!(std::abs(det) > 1e-12 * scale)) {
+    // Parallel: a line in the plane of a real triangle is ambiguous; degenerate ones are ignored.
+    const Vec3 n = e1.cross(e2);
+    if (n.squaredNorm() > 0.0 && std::abs(n.normalized().dot(p - a)) <= 1e-12 * std::sqrt(scale))
+      out.status = LineCrossing::Grazing;
+    return out;
+  }
+  const double inv = 1.0 / det;
+  const Vec3 tv = p - a;
+  const double bu = tv.dot(pv) * inv;
+  const Vec3 qv = tv.cross(e1);
+  const double bv = u.dot(qv) * inv;
+  const double m = std::min({bu, bv, 1.0 - bu - bv});
+  out.t = e2.dot(qv) * inv;
+  out.status = m >= kGrazeBary ? LineCrossing::Through : m < -kGrazeBary ? LineCrossing::Miss : LineCrossing::Grazing;
+  return out;
+}
+
+bool memory_monitor(void* ptr, ssize_t bytes, bool /*post*/) {
+  static_cast<std::atomic<long long>*>(ptr)->fetch_add(bytes);
+  return true;
+}
+
+}  // namespace
+
+struct EmbreeIndex::Impl {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::vector<RTCGeometry> geoms;            // per part (null for empty parts)
+  mutable std::vector<RTCScene> part_scenes;  // lazily built, one per part
+  mutable std::unique_ptr<std::once_flag[]> part_once;
+  std::atomic<long long> embree_bytes{0};
+  std::string last_error;
+};
+
+namespace {
+void device_error(void* user, RTCError code, const char* str) {
+  auto* impl = static_cast<EmbreeIndex::Impl*>(user);
+  impl->last_error = "embree error " + std::to_string(static_cast<int>(code)) + ": " + (str ? str : "");
+}
+}  // namespace
+
+EmbreeIndex::EmbreeIndex(const std::vector<Part>& parts, const EmbreeOptions& opt)
+    : impl_(std::make_unique<Impl>()), parts_(parts.size()), opt_(opt) {
+  if (opt_.inside_rays < 1) opt_.inside_rays = 1;
+  if (opt_.inside_rays > kMaxInsideDirs) opt_.inside_rays = kMaxInsideDirs;
+  if (opt_.inside_rays % 2 == 0) ++opt_.inside_rays;
+  // Copy the geometry and validate it.
+  AABB all;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const Mesh& m = parts[i].mesh;
+    PartData& pd = parts_[i];
+    pd.closed = parts[i].closed;
+    pd.vertices = m.vertices;
+    pd.triangles = m.triangles;
+    for (std::size_t t = 0; t < pd.triangles.size(); ++t)
+      for (std::uint32_t v : pd.triangles[t]) {
+        if (v >= pd.vertices.size())
+          throw InputError({parts[i].source_file, 0, parts[i].name},
+                           "triangle " + std::to_string(t) + " references vertex " + std::to_string(v) +
+                               " but the mesh has " + std::to_string(pd.vertices.size()));
+        if (!pd.vertices[v].allFinite())
+          throw InputError({parts[i].source_file, 0, parts[i].name},
+                           "vertex " + std::to_string(v) + " is not finite");
+        pd.bounds.extend(pd.vertices[v]);
+      }
+    all.extend(pd.bounds);
+    triangle_count_ += pd.triangles.size();
+  }
+  centre_ = all.center();
+  if (!all.empty()) half_extent_ = (all.max - centre_).cwiseAbs().cwiseMax((all.min - centre_).cwiseAbs()).maxCoeff();
+
+  Impl& im = *impl_;
+  im.device = rtcNewDevice(nullptr);
+  if (!im.device) throw std::runtime_error("embree index: rtcNewDevice failed");
+  rtcSetDeviceErrorFunction(im.device, device_error, &im);
+  rtcSetDeviceMemoryMonitorFunction(im.device, memory_monitor, &im.embree_bytes);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  FlushDenormals ftz;
+  im.scene = rtcNewScene(im.device);
+  rtcSetSceneFlags(im.scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+  const RTCBuildQuality q = opt_.build_quality <= 0   ? RTC_BUILD_QUALITY_LOW
+                            : opt_.build_quality == 1 ? RTC_BUILD_QUALITY_MEDIUM
+                                                      : RTC_BUILD_QUALITY_HIGH;
+  rtcSetSceneBuildQuality(im.scene, q);
+  im.geoms.assign(parts_.size(), nullptr);
+  for (std::size_t i = 0; i < parts_.size(); ++i) {
+    PartData& pd = parts_[i];
+    if (pd.triangles.empty()) continue;
+    pd.vertices_f.resize(3 * pd.vertices.size() + 4, 0.0f);
+    for (std::size_t v = 0; v < pd.vertices.size(); ++v) {
+      const Vec3 d = pd.vertices[v] - centre_;
+      for (int k = 0; k < 3; ++k) pd.vertices_f[3 * v + k] = static_cast<float>(d[k]);
+    }
+    RTCGeometry g = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, pd.vertices_f.data(), 0,
+                               3 * sizeof(float), pd.vertices.size());
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, pd.triangles.data(), 0,
+                               3 * sizeof(std::uint32_t), pd.triangles.size());
+    rtcSetGeometryBuildQuality(g, q);
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(im.scene, g, static_cast<unsigned>(i));
+    im.geoms[i] = g;
+  }
+  rtcCommitScene(im.scene);
+  build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (rtcGetDeviceError(im.device) != RTC_ERROR_NONE || !im.last_error.empty())
+    throw std::runtime_error("embree index: build failed: " + im.last_error);
+  im.part_scenes.assign(parts_.size(), nullptr);
+  im.part_once.reset(new std::once_flag[parts_.size()]);
+}
+
+EmbreeIndex::~EmbreeIndex() {
+  if (!impl_) return;
+  for (RTCScene s : impl_->part_scenes)
+    if (s) rtcReleaseScene(s);
+  for (RTCGeometry g : impl_->geoms)
+    if (g) rtcReleaseGeometry(g);
+  if (impl_->scene) rtcReleaseScene(impl_->scene);
+  if (impl_->device) rtcReleaseDevice(impl_->device);
+}
+
+void* EmbreeIndex::part_scene(int part) const {
+  Impl& im = *impl_;
+  std::call_once(im.part_once[part], [&] {
+    if (!im.geoms[part]) return;
+    FlushDenormals ftz;
+    RTCScene s = rtcNewScene(im.device);
+    rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
+    rtcAttachGeometryByID(s, im.geoms[part], 0);
+    rtcCommitScene(s);
+    im.part_scenes[part] = s;
+  });
+  return im.part_scenes[part];
+}
+
+std::size_t EmbreeIndex::memory_bytes() const {
+  std::size_t b = static_cast<std::size_t>(std::max<long long>(0, impl_->embree_bytes.load()));
+  for (const PartData& pd : parts_)
+    b += pd.vertices.capacity() * sizeof(Vec3) + pd.triangles.capacity() * sizeof(pd.triangles[0]) +
+         pd.vertices_f.capacity() * sizeof(float);
+  return b;
+}
+
+double EmbreeIndex::float_pad(const Vec3& p, double radius) const {
+  const double far = (p - centre_).cwiseAbs().maxCoeff();
+  const double r = std::isfinite(radius) ? radius : 0.0;
+  return kFloatPadRel * (half_extent_ + far + r) + std::numeric_limits<float>::min();
+}
+
+IndexAccuracy EmbreeIndex::accuracy() const {
+  IndexAccuracy a;
+  a.exact = true;
+  const double extent = centre_.cwiseAbs().maxCoeff() + half_extent_;
+  a.abs_error = 16.0 * std::numeric_limits<double>::epsilon() * extent;
+  a.description = "embree float BVH re-centred on (" + full_precision(centre_.x()) + ", " +
+                  full_precision(centre_.y()) + ", " + full_precision(centre_.z()) +
+                  "), culling radius padded by " + full_precision(kFloatPadRel * half_extent_) +
+                  " (float rounding); distances exact in double: <= " + full_precision(a.abs_error) +
+                  " scene units; inside/ray origins rounded to float: <= " +
+                  full_precision(half_extent_ / 16777216.0) + " scene units";
+  return a;
+}
+
+namespace {
+ClosestHit finish_closest(QueryState& q, double max_radius) {
+  ClosestHit h = q.hit;
+  if (h.found()) {
+    h.distance = std::sqrt(q.best2);
+    if (h.distance > max_radius) h = ClosestHit{};
+  }
+  return h;
+}
+}  // namespace
+
+ClosestHit EmbreeIndex::closest(const Vec3& p, double max_radius) const {
+  if (triangle_count_ == 0 || !(max_radius >= 0.0)) return {};
+  FlushDenormals ftz;
+  QueryState q;
+  q.parts = &parts_;
+  q.p = p;
+  q.pad = float_pad(p, max_radius);
+  if (std::isfinite(max_radius)) q.best2 = max_radius * max_radius * (1.0 + 1e-15);
+  const Vec3 pc = p - centre_;
+  RTCPointQuery pq;
+  pq.x = static_cast<float>(pc.x());
+  pq.y = static_cast<float>(pc.y());
+  pq.z = static_cast<float>(pc.z());
+  pq.time = 0.0f;
+  pq.radius = to_float_up(max_radius + q.pad);
+  RTCPointQueryContext ctx;
+  rtcInitPointQueryContext(&ctx);
+  rtcPointQuery(impl_->scene, &pq, &ctx, point_query_callback, &q);
+  return finish_closest(q, max_radius);
+}
+
+ClosestHit EmbreeIndex::closest_on_part(const Vec3& p, int part, double max_radius) const {
+  check_part_id(part, parts_.size());
+  if (parts_[part].triangles.empty() || !(max_radius >= 0.0)) return {};
+  auto scene = static_cast<RTCScene>(part_scene(part));
+  FlushDenormals ftz;
+  QueryState q;
+  q.parts = &parts_;
+  q.only_part = part;
+  q.p = p;
+  q.pad = float_pad(p, max_radius);
+  if (std::isfinite(max_radius)) q.best2 = max_radius * max_radius * (1.0 + 1e-15);
+  const Vec3 pc = p - centre_;
+  RTCPointQuery pq;
+  pq.x = static_cast<float>(pc.x());
+  pq.y = static_cast<float>(pc.y());
+  pq.z = static_cast<float>(pc.z());
+  pq.time = 0.0f;
+  pq.radius = to_float_up(max_radius + q.pad);
+  RTCPointQueryContext ctx;
+  rtcInitPointQueryContext(&ctx);
+  rtcPointQuery(scene, &pq, &ctx, point_query_callback, &q);
+  return finish_closest(q, max_radius);
+}
+
+bool EmbreeIndex::any_within(const Vec3& p, double r) const {
+  if (triangle_count_ == 0 || !(r >= 0.0)) return false;
+  FlushDenormals ftz;
+  QueryState q;
+  q.parts = &parts_;
+  q.mode = Mode::AnyWithin;
+  q.p = p;
+  q.r2 = r * r;
+  const Vec3 pc = p - centre_;
+  RTCPointQuery pq;
+  pq.x = static_cast<float>(pc.x());
+  pq.y = static_cast<float>(pc.y());
+  pq.z = static_cast<float>(pc.z());
+  pq.time = 0.0f;
+  pq.radius = to_float_up(r + float_pad(p, r));
+  RTCPointQueryContext ctx;
+  rtcInitPointQueryContext(&ctx);
+  rtcPointQuery(impl_->scene, &pq, &ctx, point_query_callback, &q);
+  return q.done;
+}
+
+bool EmbreeIndex::segment_within(const Vec3& a, const Vec3& b, double r) const {
+  if (triangle_count_ == 0 || !(r >= 0.0)) return false;
+  FlushDenormals ftz;
+  const double len = (b - a).norm();
+  const double target = std::max(4.0 * r, 2.0 * half_extent_ * kSegmentPieceRel);
+  const int n = target > 0.0 ? std::clamp(static_cast<int>(std::ceil(len / target)), 1, kMaxSegmentPieces) : 1;
+  QueryState q;
+  q.parts = &parts_;
+  q.mode = Mode::SegmentAny;
+  q.r2 = r * r;
+  RTCPointQueryContext ctx;
+  for (int k = 0; k < n && !q.done; ++k) {
+    q.a = a + (b - a) * (static_cast<double>(k) / n);
+    q.b = a + (b - a) * (static_cast<double>(k + 1) / n);
+    const Vec3 mid = 0.5 * (q.a + q.b);
+    const double half = 0.5 * (q.b - q.a).norm();
+    const Vec3 pc = mid - centre_;
+    RTCPointQuery pq;
+    pq.x = static_cast<float>(pc.x());
+    pq.y = static_cast<float>(pc.y());
+    pq.z = static_cast<float>(pc.z());
+    pq.time = 0.0f;
+    pq.radius = to_float_up(half + r + float_pad(mid, half + r));
+    rtcInitPointQueryContext(&ctx);
+    rtcPointQuery(impl_->scene, &pq, &ctx, point_query_callback, &q);
+  }
+  return q.done;
+}
+
+ClosestHit EmbreeIndex::segment_closest(const Vec3& a, const Vec3& b, double max_radius,
+                                        double* segment_param) const {
+  if (triangle_count_ == 0 || !(max_radius >= 0.0)) return {};
+  FlushDenormals ftz;
+  const double len = (b - a).norm();
+  const double target = 2.0 * half_extent_ * kSegmentPieceRel;
+  const int n = target > 0.0 ? std::clamp(static_cast<int>(std::ceil(len / target)), 1, kMaxSegmentPieces) : 1;
+  QueryState q;
+  q.parts = &parts_;
+  q.mode = Mode::Segment;
+  q.best2 = std::isfinite(max_radius) ? max_radius * max_radius * (1.0 + 1e-15) : q.best2;
+  RTCPointQueryContext ctx;
+  // Visit pieces from the middle outwards? Plain order: the shrinking radius carries over.
+  for (int k = 0; k < n; ++k) {
+    q.s0 = static_cast<double>(k) / n;
+    q.s1 = static_cast<double>(k + 1) / n;
+    q.a = a + (b - a) * q.s0;
+    q.b = a + (b - a) * q.s1;
+    const Vec3 mid = 0.5 * (q.a + q.b);
+    const double half = 0.5 * (q.b - q.a).norm();
+    q.radius_offset = half;
+    const double cur = std::isfinite(q.best2) ? std::sqrt(q.best2) : std::numeric_limits<double>::infinity();
+    q.pad = float_pad(mid, half + (std::isfinite(cur) ? cur : 0.0));
+    const Vec3 pc = mid - centre_;
+    RTCPointQuery pq;
+    pq.x = static_cast<float>(pc.x());
+    pq.y = static_cast<float>(pc.y());
+    pq.z = static_cast<float>(pc.z());
+    pq.time = 0.0f;
+    pq.radius = to_float_up(half + cur + q.pad);
+    rtcInitPointQueryContext(&ctx);
+    rtcPointQuery(impl_->scene, &pq, &ctx, point_query_callback, &q);
+  }
+  ClosestHit h = finish_closest(q, max_radius);
+  if (h.found() && segment_param) *segment_param = q.best_s;
+  return h;
+}
+
+RayHit EmbreeIndex::ray(const Vec3& origin, const Vec3& dir, double t_max) const {
+  const Vec3 u = unit_dir(dir);
+  if (triangle_count_ == 0 || !(t_max >= 0.0)) return {};
+  FlushDenormals ftz;
+  const Vec3 oc = origin - centre_;
+  const double pad = float_pad(origin, 0.0);
+  RTCRayHit rh;
+  rh.ray.org_x = static_cast<float>(oc.x());
+  rh.ray.org_y = static_cast<float>(oc.y());
+  rh.ray.org_z = static_cast<float>(oc.z());
+  rh.ray.dir_x = static_cast<float>(u.x());
+  rh.ray.dir_y = static_cast<float>(u.y());
+  rh.ray.dir_z = static_cast<float>(u.z());
+  rh.ray.tnear = 0.0f;
+  rh.ray.tfar = to_float_up(t_max + pad);
+  rh.ray.time = 0.0f;
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  rtcIntersect1(impl_->scene, &ctx, &rh);
+  RayHit out;
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return out;
+  const int part = static_cast<int>(rh.hit.geomID);
+  const auto c = parts_[part].corners(rh.hit.primID);
+  // Refine t in double on the exact triangle; keep Embree's t if the double test misses
+  // (the ray grazes an edge within float rounding).
+  const RayTriangleResult r = intersect_ray_triangle(origin, u, c[0], c[1], c[2]);
+  const double t = r.hit ? r.t : static_cast<double>(rh.ray.tfar);
+  if (t > t_max) return out;
+  out.t = t;
+  out.part = part;
+  out.triangle = rh.hit.primID;
+  const Vec3 n = (c[1] - c[0]).cross(c[2] - c[0]);
+  out.normal = n.norm() > 0.0 ? Vec3(n.normalized()) : Vec3(-u);
+  return out;
+}
+
+bool EmbreeIndex::inside(const Vec3& p, int* part) const {
+  // Candidate closed parts whose box contains p.
+  std::vector<int> cand;
+  for (int i = 0; i < part_count(); ++i)
+    if (parts_[i].closed && !parts_[i].triangles.empty() && parts_[i].bounds.contains(p)) cand.push_back(i);
+  if (cand.empty()) return false;
+  FlushDenormals ftz;
+  const Vec3 pc = p - centre_;
+  const double back = 4.0 * float_pad(p, 0.0);
+  std::vector<int> votes_in(cand.size(), 0);
+  int valid_rays = 0;
+  std::vector<std::pair<unsigned, unsigned>> hits;
+  std::vector<int> crossings(cand.size(), 0);
+  for (int k = 0; k < kMaxInsideDirs && valid_rays < opt_.inside_rays; ++k) {
+    const Vec3 u = kInsideDirs[k].normalized();
+    // Start the float ray `back` behind p so that a crossing right at p, which float
+    // rounding of the origin could hide, is still collected; the double test below
+    // decides on which side of p each crossing lies.
+    const Vec3 org = pc - back * u;
+    hits.clear();
+    CollectContext cc;
+    rtcInitIntersectContext(&cc.ctx);
+    cc.ctx.filter = collect_filter;
+    cc.hits = &hits;
+    RTCRayHit rh;
+    rh.ray.org_x = static_cast<float>(org.x());
+    rh.ray.org_y = static_cast<float>(org.y());
+    rh.ray.org_z = static_cast<float>(org.z());
+    rh.ray.dir_x = static_cast<float>(u.x());
+    rh.ray.dir_y = static_cast<float>(u.y());
+    rh.ray.dir_z = static_cast<float>(u.z());
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = std::numeric_limits<float>::infinity();
+    rh.ray.time = 0.0f;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(impl_->scene, &cc.ctx, &rh);
+    std::sort(hits.begin(), hits.end());
+    hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
+    std::fill(crossings.begin(), crossings.end(), 0);
+    bool grazing = false;
+    for (const auto& h : hits) {
+      const auto it = std::find(cand.begin(), cand.end(), static_cast<int>(h.first));
+      if (it == cand.end()) continue;
+      const auto c = parts_[h.first].corners(h.second);
+      const LineCrossing x = line_crossing(p, u, c[0], c[1], c[2]);
+      if (x.status == LineCrossing::Grazing) {
+        grazing = true;  // the ray passes by an edge or vertex, or lies in the plane
+        break;
+      }
+      if (x.status == LineCrossing::Through && x.t == 0.0) {
+        grazing = true;  // p on the surface
+        break;
+      }
+      if (x.status == LineCrossing::Through && x.t > 0.0) ++crossings[it - cand.begin()];
+    }
+    if (grazing) continue;
+    ++valid_rays;
+    for (std::size_t i = 0; i < cand.size(); ++i) votes_in[i] += crossings[i] % 2;
+  }
+  if (valid_rays == 0) valid_rays = 1;  // every ray grazed: treat as outside (on the surface)
+  for (std::size_t i = 0; i < cand.size(); ++i)
+    if (2 * votes_in[i] > valid_rays) {
+      if (part) *part = cand[i];
+      return true;
+    }
+  return false;
+}
+
+}  // namespace loom

@@ -1,0 +1,76 @@
+#pragma once
+/// Exact double-precision kernels on single triangles, shared by every ObstacleIndex
+/// implementation and by the tests: closest point, segment distance, ray intersection and
+/// solid angle (generalized winding number). All inputs and outputs are in the caller's
+/// frame and units; nothing here allocates. Degenerate triangles (zero area, repeated
+/// corners) are handled: they behave as the segment or point they collapse to.
+
+#include "core/geometry.hpp"
+
+namespace loom {
+
+/// Closest point on a triangle to a point.
+struct TrianglePointResult {
+  Vec3 point = Vec3::Zero();  ///< closest point on the triangle
+  double dist2 = 0.0;         ///< squared distance from the query point to `point`
+};
+
+/// Closest point on triangle abc to p (exact up to double rounding).
+TrianglePointResult closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b,
+                                              const Vec3& c);
+
+/// Closest points between two segments.
+struct SegmentSegmentResult {
+  double s = 0.0;  ///< parameter on the first segment, in [0,1]
+  double t = 0.0;  ///< parameter on the second segment, in [0,1]
+  Vec3 p = Vec3::Zero();  ///< point on the first segment
+  Vec3 q = Vec3::Zero();  ///< point on the second segment
+  double dist2 = 0.0;     ///< squared distance |p - q|²
+};
+
+/// Closest points between segments p0p1 and q0q1 (either may be a point).
+SegmentSegmentResult closest_segment_segment(const Vec3& p0, const Vec3& p1, const Vec3& q0,
+                                             const Vec3& q1);
+
+/// Closest points between a segment and a triangle.
+struct SegmentTriangleResult {
+  double s = 0.0;                   ///< parameter on the segment ab, in [0,1]
+  Vec3 segment_point = Vec3::Zero();   ///< a + s (b - a)
+  Vec3 triangle_point = Vec3::Zero();  ///< closest point on the triangle
+  double dist2 = 0.0;                  ///< squared distance between the two points
+};
+
+/// Closest points between segment ab and triangle t0t1t2; distance 0 when they intersect.
+SegmentTriangleResult closest_segment_triangle(const Vec3& a, const Vec3& b, const Vec3& t0,
+                                               const Vec3& t1, const Vec3& t2);
+
+/// Result of a ray–triangle intersection in double precision.
+struct RayTriangleResult {
+  bool hit = false;
+  double t = 0.0;      ///< ray parameter: hit point = origin + t·dir
+  double u = 0.0;      ///< barycentric weight of t1
+  double v = 0.0;      ///< barycentric weight of t2 (weight of t0 is 1 - u - v)
+};
+
+/// Möller–Trumbore intersection of origin + t·dir (t ≥ 0) with triangle t0t1t2, both faces,
+/// closed triangle (barycentrics ≥ 0). Parallel or degenerate triangles never hit.
+RayTriangleResult intersect_ray_triangle(const Vec3& origin, const Vec3& dir, const Vec3& t0,
+                                         const Vec3& t1, const Vec3& t2);
+
+/// Signed solid angle (steradians, in [-2π, 2π]) subtended at p by the oriented triangle abc
+/// (Van Oosterom–Strackee). Summed over a closed outward mesh and divided by 4π it gives
+/// the winding number: 1 inside, 0 outside.
+double triangle_solid_angle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
+/// True if triangle abc has (numerically) zero area: |(b−a)×(c−a)|² ≤ 1e-24·(longest edge)⁴.
+/// Such triangles are treated as the segments they collapse to.
+bool triangle_is_degenerate(const Vec3& a, const Vec3& b, const Vec3& c);
+
+/// Squared distance from p to the box [lo, hi] (0 inside).
+double point_box_dist2(const Vec3& p, const Vec3& lo, const Vec3& hi);
+
+/// Lower bound on the squared distance from segment ab to the box [lo, hi] (exact when
+/// the segment is a point; otherwise uses the box around the segment's midpoint sphere).
+double segment_box_dist2_lower(const Vec3& a, const Vec3& b, const Vec3& lo, const Vec3& hi);
+
+}  // namespace loom

@@ -1,0 +1,73 @@
+#pragma once
+/// The audit pipeline (DESIGN §4): scene → obstacle index (timed as timing_ms.index) →
+/// clash, bend and clearance checks (timed as timing_ms.check) → an AuditReport, which
+/// report_json writes as report.json.
+
+#include "core/scene.hpp"
+#include "routing/clash_check.hpp"
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace loom {
+
+/// What `loom audit` was asked to do.
+struct AuditOptions {
+  ClashRequest check;  ///< method, tolerance, spacing, threads, progress, …
+  /// A routed harness XML that replaces the scene's harness (nullopt: the scene's own).
+  std::optional<std::filesystem::path> routes;
+  /// A prebuilt exact index of the scene's parts (e.g. SceneIndices::embree, shared with
+  /// planning); null: run_audit builds an EmbreeIndex and times it.
+  const ObstacleIndex* index = nullptr;
+};
+
+/// One cable of the harness as audited.
+struct AuditCable {
+  std::string id;
+  bool routed = false;  ///< false: some segment of its chain has no curve yet (not checked)
+  std::string reason;   ///< why it is not routed
+  int check_index = -1; ///< index into ClashResult::cables (−1 if not routed)
+};
+
+/// Everything report.json says.
+struct AuditReport {
+  std::string scene;
+  std::string units;
+  ClashMethod method = ClashMethod::Certified;
+  bool use_index = true;
+  std::string index_name;        ///< "embree", or "none" for the brute-force baseline
+  std::string index_accuracy;    ///< the index's own description of its accuracy
+  std::vector<std::string> part_names;
+  std::vector<bool> part_keep_out;
+  std::vector<AuditCable> cables;       ///< every harness cable, in harness order
+  std::vector<std::string> check_ids;   ///< ids of the checked (routed) cables, by check index
+  ClashResult result;                   ///< indices refer to check_ids / part_names
+  double load_ms = 0.0;
+  double index_ms = 0.0;
+  double check_ms = 0.0;
+  std::size_t triangles = 0;
+  std::vector<std::string> notes;
+
+  /// True when any clash or violation was found.
+  bool found_problems() const { return !result.clashes.empty() || !result.violations.empty(); }
+  /// DESIGN §4 exit status of a completed audit: 0 clean, 1 clashes or violations.
+  int exit_code() const { return found_problems() ? 1 : 0; }
+};
+
+/// The cables of a harness as the checker sees them (routed ones only): centerlines, radii,
+/// the harness segments each runs through and the junctions where bundled cables may touch.
+/// `cables` receives one AuditCable per harness cable.
+std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCable>& cables);
+
+/// Audits a loaded scene (its parts and harness). Builds the index unless the request is
+/// the brute-force baseline (use_index = false, discrete). Throws InputError for an
+/// inconsistent harness.
+AuditReport run_audit(const Scene& scene, const AuditOptions& opt);
+
+/// Loads the scene file (timed as timing_ms.load), applies --routes, and audits it.
+/// Throws InputError (exit 2) for bad input.
+AuditReport audit_scene_file(const std::filesystem::path& scene_file, const AuditOptions& opt);
+
+}  // namespace loom

@@ -1,0 +1,1098 @@
+// Clash checking: the seed paper's discrete-point method and the certified variant
+// (Lipschitz sphere tracing + exact chord distances). See clash_check.hpp for the contract.
+#include "routing/clash_check.hpp"
+
+#include "index/triangle_distance.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <numeric>
+#include <stdexcept>
+#include <thread>
+#include <unordered_map>
+
+namespace loom {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+/// Default tolerance as a fraction of the smallest cable radius (DESIGN §7).
+constexpr double kDefaultToleranceOfRadius = 0.01;
+/// Default longest sphere-tracing step, in cable radii.
+constexpr double kDefaultMaxStepRadii = 50.0;
+/// Share of the tolerance left to the chords' distance from the curve; the rest covers the
+/// index's own error (structure: chord + index ≤ tol; cable–cable: 2 · chord ≤ tol).
+constexpr double kChordShareOfTolerance = 0.5;
+/// Stretches of the sphere trace shorter than this many cable radii that cannot be proven
+/// clear are handed to the exact chord measurement.
+constexpr double kLeafRadii = 1.0;
+/// Longest chord, in cable radii (keeps the self rule |s − t| ≥ πr sharp).
+constexpr double kMaxChordRadii = 1.0;
+/// Chords per block in the cable–cable narrow phase.
+constexpr std::size_t kBlock = 8;
+/// Arc-length slack (relative to the cable length) when deciding that two chord or sample
+/// intervals touch.
+constexpr double kTouchRel = 1e-9;
+
+std::int64_t as_i64(std::size_t v) { return static_cast<std::int64_t>(v); }
+
+/// Work counters shared by the worker threads.
+struct AtomicCounters {
+  std::atomic<std::int64_t> distance{0}, inside{0}, pairs{0}, samples{0};
+  /// Adds a thread's local counts (one atomic add per counter, not one per query).
+  void add(const ClashCounters& c) {
+    distance += c.distance_queries;
+    inside += c.inside_queries;
+    pairs += c.pair_tests;
+    samples += c.samples;
+  }
+  ClashCounters snapshot() const {
+    ClashCounters c;
+    c.distance_queries = distance.load();
+    c.inside_queries = inside.load();
+    c.pair_tests = pairs.load();
+    c.samples = samples.load();
+    return c;
+  }
+};
+
+/// Runs body(i), i in [0, n), on `threads` workers (≤ 0: all cores), grain 1.
+template <class Body>
+void parallel_indices(std::size_t n, int threads, const Body& body) {
+  if (n == 0) return;
+  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
+    });
+  });
+}
+
+/// What the checker needs to know about one part.
+struct PartInfo {
+  AABB box;
+  double required = 0.0;  ///< routing clearance + part clearance
+  bool keep_out = false;
+  bool closed = false;
+};
+
+// ---------------------------------------------------------------------------------------
+// Per-part stretch tracking: one entry per contiguous stretch within a part's band.
+
+/// One observation of a part along the centerline.
+struct PartObservation {
+  int part = -1;
+  double key = kInf;  ///< clearance, and −r − depth when the axis is inside (ranking)
+  Vec3 point = Vec3::Zero();
+  double s = 0.0;
+  bool inside = false;
+};
+
+/// Collects observations in s order. A part's band stretch (clearance < required) ends
+/// when a step no longer sees it; inside it, each contiguous contact stretch (clearance < 0)
+/// becomes one clash at its deepest point, and a band stretch without contact becomes one
+/// clearance violation at its smallest clearance.
+class StretchTracker {
+ public:
+  StretchTracker(int cable, double radius, const std::vector<PartInfo>& parts)
+      : cable_(cable), radius_(radius), parts_(parts) {}
+
+  /// One step along the cable (a chord, a sample or a free interval) seeing `obs` (parts
+  /// within their band), spanning arc lengths [s0, s1].
+  void step(const std::vector<PartObservation>& obs, double s0, double s1) {
+    for (auto it = open_.begin(); it != open_.end();) {
+      const bool seen = std::any_of(obs.begin(), obs.end(), [&](const PartObservation& o) { return o.part == it->first; });
+      if (!seen) {
+        close(it->second);
+        it = open_.erase(it);
+      } else {
+        ++it;
+      }
+    }
+    for (const auto& o : obs) {
+      Open& st = open_[o.part];
+      min_key = std::min(min_key, o.key);
+      if (o.key < st.band.deepest.key) st.band.deepest = o;
+      if (!st.started) {
+        st.started = true;
+        st.band.s_begin = s0;
+      }
+      st.band.s_end = s1;
+      if (o.key < 0.0) {
+        if (!st.contact_open) {
+          st.contacts.push_back({o, s0, s1});
+          st.contact_open = true;
+        } else {
+          Stretch& c = st.contacts.back();
+          if (o.key < c.deepest.key) c.deepest = o;
+          c.s_end = s1;
+        }
+      } else {
+        st.contact_open = false;
+      }
+    }
+  }
+  /// Closes every open stretch (end of the cable or of a proven-clear gap).
+  void flush() {
+    for (auto& kv : open_) close(kv.second);
+    open_.clear();
+  }
+  std::vector<ClashEntry> clashes;
+  std::vector<Violation> violations;
+  double min_key = kInf;  ///< smallest key seen in any band
+
+ private:
+  struct Stretch {
+    PartObservation deepest;
+    double s_begin = 0.0, s_end = 0.0;
+  };
+  struct Open {
+    bool started = false;
+    Stretch band;
+    std::vector<Stretch> contacts;
+    bool contact_open = false;
+  };
+  void close(const Open& st) {
+    for (const Stretch& c : st.contacts) {
+      const PartObservation& d = c.deepest;
+      ClashEntry e;
+      e.kind = ClashKind::CableStructure;
+      e.cable = cable_;
+      e.part = d.part;
+      e.other = -1;
+      e.clearance = std::max(d.key, -radius_);  // dist is 0 inside a closed part
+      e.point = d.point;
+      e.s = d.s;
+      e.s_begin = c.s_begin;
+      e.s_end = c.s_end;
+      e.keep_out = parts_[d.part].keep_out;
+      e.inside = d.inside;
+      clashes.push_back(e);
+    }
+    const PartObservation& d = st.band.deepest;
+    if (st.contacts.empty() && d.part >= 0 && d.key < parts_[d.part].required) {
+      Violation v;
+      v.kind = ViolationKind::Clearance;
+      v.cable = cable_;
+      v.part = d.part;
+      v.value = std::max(d.key, 0.0);
+      v.limit = parts_[d.part].required;
+      v.s = d.s;
+      v.point = d.point;
+      violations.push_back(v);
+    }
+  }
+  int cable_;
+  double radius_;
+  const std::vector<PartInfo>& parts_;
+  std::map<int, Open> open_;
+};
+
+// ---------------------------------------------------------------------------------------
+// Flattening a B-spline into chords with a proven deviation bound.
+
+/// Polyline approximation of a stretch of a centerline.
+struct Chords {
+  std::vector<Vec3> p;     ///< vertices
+  std::vector<double> s;   ///< arc length at each vertex
+  std::size_t size() const { return p.empty() ? 0 : p.size() - 1; }
+};
+
+/// Appends to `out` chords of c over [u0, u1] deviating at most `eps` from the curve and no
+/// longer than `hmax`. On a span of a degree ≤ 3 spline C'' is affine, so the deviation
+/// of a chord over Δu is ≤ Δu²/8 · max(|C''| at the ends). Arc lengths at vertices are the
+/// exact span lengths shared out in proportion to the chord lengths.
+void flatten(const Centerline& c, double u0, double u1, double eps, double hmax, Chords& out) {
+  std::vector<double> br{u0};
+  for (double k : c.knots())
+    if (k > br.back() && k < u1) br.push_back(k);
+  br.push_back(u1);
+  if (out.p.empty()) {
+    out.p.push_back(c.position(u0));
+    out.s.push_back(c.arc_length_at(u0));
+  }
+  for (std::size_t i = 0; i + 1 < br.size(); ++i) {
+    const double a = br[i], b = br[i + 1];
+    if (!(b > a)) continue;
+    const double sa = out.s.back(), sb = c.arc_length_at(b);
+    double n_dev = 1.0;
+    if (c.degree() >= 2) {
+      const double inset = 1e-9 * (b - a);
+      double m = std::max(c.derivative(a + inset, 2).norm(), c.derivative(b - inset, 2).norm());
+      if (c.degree() > 3) {  // C'' not affine: sample densely and keep a safety factor
+        for (int k = 1; k < 16; ++k) m = std::max(m, c.derivative(a + (b - a) * k / 16.0, 2).norm());
+        m *= 1.5;
+      }
+      n_dev = (b - a) * std::sqrt(m / (8.0 * eps));
+    }
+    const double n_len = (sb - sa) / hmax;
+    const std::size_t n = static_cast<std::size_t>(std::max(1.0, std::ceil(std::max(n_dev, n_len))));
+    double acc = 0.0;
+    std::vector<double> lens;
+    lens.reserve(n);
+    for (std::size_t k = 1; k <= n; ++k) {
+      const double u = k == n ? b : a + (b - a) * static_cast<double>(k) / static_cast<double>(n);
+      out.p.push_back(c.position(u));
+      acc += (out.p.back() - out.p[out.p.size() - 2]).norm();
+      lens.push_back(acc);
+    }
+    for (std::size_t k = 0; k < n; ++k)
+      out.s.push_back(acc > 0.0 ? sa + (sb - sa) * lens[k] / acc : sa + (sb - sa) * (k + 1.0) / n);
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// Shared context.
+
+struct Context {
+  const std::vector<CableInput>& cables;
+  const std::vector<Part>& parts;
+  const ObstacleIndex* index;
+  const ClashRequest& req;
+  std::vector<PartInfo> info;
+  double tol = 0.0;
+  double chord_error = 0.0;
+  double abs_err = 0.0;
+  double band = 0.0;  ///< largest required clearance over parts
+  AtomicCounters counters;
+};
+
+/// Segment id of the cable at arc length s (−1 if unknown).
+int segment_at(const CableInput& c, double s) {
+  const double slack = kTouchRel * (1.0 + std::abs(s));
+  for (const auto& r : c.segments)
+    if (s >= r.s0 - slack && s <= r.s1 + slack) return r.segment;
+  return -1;
+}
+
+/// True when a contact between cables a (point p, arc s) and b (point q, arc t) is excused:
+/// both run in the same harness segment (a bundle) or both are at a node they share.
+bool excused(const CableInput& a, double s, const Vec3& p, const CableInput& b, double t, const Vec3& q) {
+  const int sa = segment_at(a, s);
+  if (sa >= 0 && sa == segment_at(b, t)) return true;
+  for (const auto& ja : a.junctions)
+    for (const auto& jb : b.junctions)
+      if (ja.node == jb.node) {
+        const double rad = std::max(ja.radius, jb.radius);
+        if ((p - ja.position).norm() <= rad && (q - ja.position).norm() <= rad) return true;
+      }
+  return false;
+}
+
+// ---------------------------------------------------------------------------------------
+// Certified cable–structure.
+
+/// Sphere-traces one cable, measures what cannot be proven clear exactly, tracks stretches.
+class StructureTracer {
+ public:
+  StructureTracer(Context& ctx, int cable)
+      : ctx_(ctx), cable_(cable), in_(ctx.cables[cable]), r_(in_.radius), tracker_(cable, r_, ctx.info) {
+    L_ = in_.curve.length();
+    margin_ = ctx.chord_error + ctx.abs_err;
+    thr_ = r_ + ctx.band + margin_;
+    leaf_ = std::max(kLeafRadii * r_, 4.0 * ctx.tol);
+    max_step_ = ctx.req.max_step > 0.0 ? ctx.req.max_step : kDefaultMaxStepRadii * r_;
+    max_step_ = std::max(max_step_, leaf_);
+  }
+
+  void run() {
+    const ObstacleIndex& idx = *ctx_.index;
+    // Inside status at the start; it can only change where the trace is not proven clear.
+    Sample s0 = sample(0.0, thr_ + max_step_);
+    inside_part_ = -1;
+    ++count_.inside_queries;
+    if (!idx.inside(s0.p, &inside_part_)) inside_part_ = -1;
+    Sample a = s0;
+    double s_prev = 0.0;
+    while (s_prev < L_) {
+      const double rho = a.d - thr_;
+      const double step = std::clamp(2.0 * rho, leaf_, max_step_);
+      const double s_next = std::min(L_, s_prev + step);
+      Sample b = sample(s_next, std::min(a.d + (s_next - s_prev), thr_ + max_step_));
+      refine(a, b);
+      a = b;
+      s_prev = s_next;
+    }
+    flush_free();
+    tracker_.flush();
+    summary_min_ = std::min(summary_min_, tracker_.min_key);
+    ctx_.counters.add(count_);
+  }
+
+  StretchTracker& tracker() { return tracker_; }
+  double min_clearance() const { return summary_min_; }
+  bool min_exact() const { return summary_min_ < ctx_.band; }
+
+ private:
+  struct Sample {
+    double s = 0.0;
+    double d = 0.0;  ///< lower bound on the distance to any part surface (≤ its query radius)
+    Vec3 p = Vec3::Zero();
+  };
+
+  Sample sample(double s, double radius) {
+    Sample x;
+    x.s = s;
+    x.p = in_.curve.position(in_.curve.parameter_at_length(s));
+    ++count_.samples;
+    ++count_.distance_queries;
+    const ClosestHit h = ctx_.index->closest(x.p, radius);
+    x.d = h.found() ? std::max(0.0, h.distance - ctx_.abs_err) : std::max(0.0, radius - ctx_.abs_err);
+    if (h.found()) summary_min_ = std::min(summary_min_, h.distance - r_);
+    return x;
+  }
+
+  /// Lipschitz bisection of [a, b]: clear, or a leaf handed to the exact measurement.
+  void refine(const Sample& a, const Sample& b) {
+    const double h = b.s - a.s;
+    const double lb = 0.5 * (a.d + b.d - h);
+    if (lb >= thr_) {
+      free_.push_back(a);
+      return;
+    }
+    if (h <= leaf_) {
+      near(a.s, b.s);
+      return;
+    }
+    const double sm = 0.5 * (a.s + b.s);
+    const Sample m = sample(sm, std::min(std::min(a.d, b.d) + 0.5 * h, thr_ + max_step_));
+    refine(a, m);
+    refine(m, b);
+  }
+
+  /// Records a proven-clear stretch starting at sample a: while inside a closed part it is
+  /// a clash stretch with that part (deepest = farthest from its surface).
+  void flush_free() {
+    // Free samples only matter while the trace is inside a closed part.
+    if (inside_part_ >= 0) {
+      for (const Sample& f : free_) {
+        PartObservation o;
+        o.part = inside_part_;
+        o.key = -r_ - f.d;
+        o.point = f.p;
+        o.s = f.s;
+        o.inside = true;
+        tracker_.step({o}, f.s, f.s);
+      }
+    } else if (!free_.empty()) {
+      tracker_.flush();  // a proven-clear gap ends every open stretch
+    }
+    free_.clear();
+  }
+
+  /// Exact measurement of [s0, s1] (merged with a directly preceding near stretch).
+  void near(double s0, double s1) {
+    flush_free();
+    Chords ch;
+    const Centerline& c = in_.curve;
+    flatten(c, c.parameter_at_length(s0), c.parameter_at_length(s1), ctx_.chord_error,
+            kMaxChordRadii * r_, ch);
+    count_.samples += as_i64(ch.p.size());
+    // Candidate parts for the secondary check: boxes within the band of this stretch.
+    AABB box;
+    for (const Vec3& p : ch.p) box.extend(p);
+    std::vector<int> cand;
+    for (std::size_t q = 0; q < ctx_.info.size(); ++q) {
+      const AABB& pb = ctx_.info[q].box;
+      const double reach = thr_ + 1e-9;
+      if ((box.min.array() - reach <= pb.max.array()).all() && (pb.min.array() <= box.max.array() + reach).all())
+        cand.push_back(static_cast<int>(q));
+    }
+    const double touch = std::max(4.0 * ctx_.abs_err, ctx_.chord_error);
+    std::vector<PartObservation> obs;
+    for (std::size_t k = 0; k < ch.size(); ++k) {
+      const Vec3& a = ch.p[k];
+      const Vec3& b = ch.p[k + 1];
+      obs.clear();
+      double t = 0.0;
+      ++count_.distance_queries;
+      const ClosestHit h = ctx_.index->segment_closest(a, b, thr_, &t);
+      const double sk = ch.s[k] + t * (ch.s[k + 1] - ch.s[k]);
+      int primary = -1;
+      if (h.found() && h.distance <= touch) {
+        // The chord touches or crosses a surface: the inside status may change here.
+        ++count_.inside_queries;
+        int part = -1;
+        inside_part_ = ctx_.index->inside(b, &part) ? part : -1;
+      }
+      if (h.found()) {
+        primary = h.part;
+        PartObservation o;
+        o.part = h.part;
+        o.key = h.distance - r_;
+        o.point = a + t * (b - a);
+        o.s = sk;
+        if (o.key < ctx_.info[h.part].required) obs.push_back(o);
+      }
+      if (inside_part_ >= 0) {
+        // Axis inside a closed part: dist = 0; rank by depth at the chord's end.
+        PartObservation o;
+        o.part = inside_part_;
+        ++count_.distance_queries;
+        const ClosestHit hb = ctx_.index->closest_on_part(b, inside_part_);
+        o.key = -r_ - (hb.found() ? hb.distance : 0.0);
+        o.point = b;
+        o.s = ch.s[k + 1];
+        o.inside = true;
+        obs.erase(std::remove_if(obs.begin(), obs.end(), [&](const PartObservation& x) { return x.part == o.part; }),
+                  obs.end());
+        obs.push_back(o);
+      }
+      if (primary >= 0 && cand.size() > 1) {
+        for (int q : cand)
+          if (q != primary && q != inside_part_) secondary(a, b, ch.s[k], ch.s[k + 1], q, obs);
+      }
+      tracker_.step(obs, ch.s[k], ch.s[k + 1]);
+    }
+  }
+
+  /// A part other than the nearest: Lipschitz bisection of the chord with closest_on_part
+  /// down to pieces of 2·chord_error (their midpoint distance is then within chord_error).
+  void secondary(const Vec3& a, const Vec3& b, double sa, double sb, int q, std::vector<PartObservation>& obs) {
+    const double thr_q = r_ + ctx_.info[q].required + margin_;
+    PartObservation best;
+    best.part = q;
+    struct Piece {
+      Vec3 a, b;
+      double sa, sb;
+    };
+    std::vector<Piece> stack{{a, b, sa, sb}};
+    while (!stack.empty()) {
+      Piece pc = stack.back();
+      stack.pop_back();
+      const double h = (pc.b - pc.a).norm();
+      const Vec3 m = 0.5 * (pc.a + pc.b);
+      ++count_.distance_queries;
+      const ClosestHit hm = ctx_.index->closest_on_part(m, q, thr_q + 0.5 * h);
+      if (!hm.found()) continue;
+      if (hm.distance - 0.5 * h >= thr_q) continue;
+      if (h <= 2.0 * ctx_.chord_error) {
+        const double key = hm.distance - r_;
+        if (key < best.key) {
+          best.key = key;
+          best.point = m;
+          best.s = 0.5 * (pc.sa + pc.sb);
+        }
+        continue;
+      }
+      const double sm = 0.5 * (pc.sa + pc.sb);
+      stack.push_back({m, pc.b, sm, pc.sb});
+      stack.push_back({pc.a, m, pc.sa, sm});
+    }
+    if (best.key < ctx_.info[q].required) obs.push_back(best);
+  }
+
+  Context& ctx_;
+  int cable_;
+  const CableInput& in_;
+  double r_;
+  StretchTracker tracker_;
+  double L_ = 0.0, thr_ = 0.0, leaf_ = 0.0, max_step_ = 0.0, margin_ = 0.0;
+  int inside_part_ = -1;
+  std::vector<Sample> free_;
+  double summary_min_ = kInf;
+  ClashCounters count_;
+};
+
+// ---------------------------------------------------------------------------------------
+// Cable–cable and self contacts, grouped into stretches.
+
+/// One measured contact between two cables (or a cable and itself), with the arc-length
+/// intervals of the chords/samples that produced it on each.
+struct PairContact {
+  int a = -1, b = -1;  ///< cables, a ≤ b (self: a == b, s < t)
+  double dist = 0.0;   ///< centerline distance
+  Vec3 p = Vec3::Zero(), q = Vec3::Zero();
+  double s = 0.0, t = 0.0;
+  double sa0 = 0.0, sa1 = 0.0, tb0 = 0.0, tb1 = 0.0;
+};
+
+/// One entry per connected group of contacts (intervals touching on both cables).
+void group_pair_contacts(std::vector<PairContact>& contacts, const std::vector<CableInput>& cables,
+                         std::vector<ClashEntry>& out) {
+  std::sort(contacts.begin(), contacts.end(), [](const PairContact& x, const PairContact& y) {
+    if (x.a != y.a) return x.a < y.a;
+    if (x.b != y.b) return x.b < y.b;
+    return x.sa0 < y.sa0;
+  });
+  std::size_t i = 0;
+  while (i < contacts.size()) {
+    std::size_t j = i;
+    while (j < contacts.size() && contacts[j].a == contacts[i].a && contacts[j].b == contacts[i].b) ++j;
+    const std::size_t n = j - i;
+    std::vector<std::size_t> parent(n);
+    std::iota(parent.begin(), parent.end(), 0);
+    std::function<std::size_t(std::size_t)> find = [&](std::size_t x) {
+      while (parent[x] != x) x = parent[x] = parent[parent[x]];
+      return x;
+    };
+    const double slack_a = kTouchRel * (1.0 + cables[contacts[i].a].curve.length());
+    const double slack_b = kTouchRel * (1.0 + cables[contacts[i].b].curve.length());
+    for (std::size_t x = 0; x < n; ++x) {
+      const PairContact& cx = contacts[i + x];
+      for (std::size_t y = x + 1; y < n; ++y) {
+        const PairContact& cy = contacts[i + y];
+        if (cy.sa0 > cx.sa1 + slack_a) break;  // sorted by sa0: nothing later touches x on a
+        const bool touch_b = cy.tb0 <= cx.tb1 + slack_b && cx.tb0 <= cy.tb1 + slack_b;
+        if (touch_b) parent[find(x)] = find(y);
+      }
+    }
+    std::map<std::size_t, std::size_t> best;  // root → index of deepest
+    std::map<std::size_t, std::pair<double, double>> range;
+    for (std::size_t x = 0; x < n; ++x) {
+      const std::size_t root = find(x);
+      const PairContact& cx = contacts[i + x];
+      auto it = best.find(root);
+      if (it == best.end() || cx.dist - 0.0 < contacts[i + it->second].dist) best[root] = x;
+      auto rt = range.find(root);
+      if (rt == range.end())
+        range[root] = {cx.sa0, cx.sa1};
+      else
+        rt->second = {std::min(rt->second.first, cx.sa0), std::max(rt->second.second, cx.sa1)};
+    }
+    for (const auto& kv : best) {
+      const PairContact& c = contacts[i + kv.second];
+      ClashEntry e;
+      e.kind = c.a == c.b ? ClashKind::Self : ClashKind::CableCable;
+      e.cable = c.a;
+      e.other = c.b;
+      const double r_sum = cables[c.a].radius + cables[c.b].radius;
+      e.clearance = c.dist - r_sum;
+      e.point = 0.5 * (c.p + c.q);
+      e.s = c.s;
+      e.s_other = c.t;
+      e.s_begin = range[kv.first].first;
+      e.s_end = range[kv.first].second;
+      out.push_back(e);
+    }
+    i = j;
+  }
+}
+
+/// A B-spline span of one cable with its control-polygon box (contains the span).
+struct SpanBox {
+  int cable = -1;
+  double u0 = 0.0, u1 = 0.0;
+  AABB box;  ///< inflated by the cable radius + chord error
+};
+
+std::vector<SpanBox> span_boxes(const Context& ctx, int cable) {
+  const Centerline& c = ctx.cables[cable].curve;
+  const auto& K = c.knots();
+  const auto& P = c.control_points();
+  const int p = c.degree();
+  const double infl = ctx.cables[cable].radius + ctx.chord_error;
+  std::vector<SpanBox> out;
+  for (int k = p; k + 1 < static_cast<int>(K.size()) && k < static_cast<int>(P.size()); ++k) {
+    if (!(K[k + 1] > K[k])) continue;
+    SpanBox sb;
+    sb.cable = cable;
+    sb.u0 = K[k];
+    sb.u1 = K[k + 1];
+    for (int j = k - p; j <= k; ++j) sb.box.extend(P[j]);
+    sb.box.min.array() -= infl;
+    sb.box.max.array() += infl;
+    out.push_back(sb);
+  }
+  return out;
+}
+
+bool boxes_overlap(const AABB& a, const AABB& b) {
+  return (a.min.array() <= b.max.array()).all() && (b.min.array() <= a.max.array()).all();
+}
+
+/// Chords of one span plus block boxes for the narrow phase.
+struct SpanChords {
+  Chords ch;
+  std::vector<AABB> blocks;  ///< box of chords [k·kBlock, (k+1)·kBlock), inflated by r + chord error
+};
+
+/// Exact chord–chord narrow phase of two spans (or a span and itself).
+void narrow_phase(Context& ctx, const SpanBox& A, const SpanChords& CA, const SpanBox& B, const SpanChords& CB,
+                  bool same_span, std::vector<PairContact>& out) {
+  const CableInput& ca = ctx.cables[A.cable];
+  const CableInput& cb = ctx.cables[B.cable];
+  const bool self = A.cable == B.cable;
+  const double r_sum = ca.radius + cb.radius;
+  const double self_gap = M_PI * ca.radius;
+  std::int64_t tests = 0;
+  for (std::size_t ba = 0; ba < CA.blocks.size(); ++ba) {
+    for (std::size_t bb = same_span ? ba : 0; bb < CB.blocks.size(); ++bb) {
+      if (!boxes_overlap(CA.blocks[ba], CB.blocks[bb])) continue;
+      const std::size_t ka1 = std::min(CA.ch.size(), (ba + 1) * kBlock);
+      const std::size_t kb1 = std::min(CB.ch.size(), (bb + 1) * kBlock);
+      if (self) {  // whole block pair closer in s than π r: excused
+        const double gap_max = std::max(std::abs(CB.ch.s[kb1] - CA.ch.s[ba * kBlock]),
+                                        std::abs(CA.ch.s[ka1] - CB.ch.s[bb * kBlock]));
+        if (gap_max < self_gap) continue;
+      }
+      for (std::size_t ka = ba * kBlock; ka < ka1; ++ka) {
+        for (std::size_t kb = (same_span && bb == ba) ? ka : bb * kBlock; kb < kb1; ++kb) {
+          const double sa0 = CA.ch.s[ka], sa1 = CA.ch.s[ka + 1];
+          const double tb0 = CB.ch.s[kb], tb1 = CB.ch.s[kb + 1];
+          if (self && std::max(std::abs(tb1 - sa0), std::abs(sa1 - tb0)) < self_gap) continue;
+          ++tests;
+          const SegmentSegmentResult r =
+              closest_segment_segment(CA.ch.p[ka], CA.ch.p[ka + 1], CB.ch.p[kb], CB.ch.p[kb + 1]);
+          const double d = std::sqrt(r.dist2);
+          if (!(d < r_sum)) continue;
+          double s = sa0 + r.s * (sa1 - sa0), t = tb0 + r.t * (tb1 - tb0);
+          if (self && std::abs(s - t) < self_gap) continue;
+          if (!self && excused(ca, s, r.p, cb, t, r.q)) continue;
+          PairContact pc;
+          pc.dist = d;
+          pc.a = A.cable;
+          pc.b = B.cable;
+          pc.p = r.p;
+          pc.q = r.q;
+          pc.s = s;
+          pc.t = t;
+          pc.sa0 = sa0;
+          pc.sa1 = sa1;
+          pc.tb0 = tb0;
+          pc.tb1 = tb1;
+          const bool swap = self ? s > t : A.cable > B.cable;
+          if (swap) {
+            std::swap(pc.a, pc.b);
+            std::swap(pc.p, pc.q);
+            std::swap(pc.s, pc.t);
+            std::swap(pc.sa0, pc.tb0);
+            std::swap(pc.sa1, pc.tb1);
+          }
+          out.push_back(pc);
+        }
+      }
+    }
+  }
+  ctx.counters.pairs += tests;
+}
+
+void certified_cable_pairs(Context& ctx, std::vector<ClashEntry>& out) {
+  if (!ctx.req.check_cable_cable && !ctx.req.check_self) return;
+  std::vector<SpanBox> spans;
+  for (std::size_t c = 0; c < ctx.cables.size(); ++c) {
+    auto sb = span_boxes(ctx, static_cast<int>(c));
+    spans.insert(spans.end(), sb.begin(), sb.end());
+  }
+  std::vector<std::size_t> order(spans.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return spans[x].box.min.x() < spans[y].box.min.x(); });
+  // Sweep and prune on x.
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const SpanBox& a = spans[order[i]];
+    if (ctx.req.check_self) pairs.emplace_back(order[i], order[i]);
+    for (std::size_t j = i + 1; j < order.size(); ++j) {
+      const SpanBox& b = spans[order[j]];
+      if (b.box.min.x() > a.box.max.x()) break;
+      if (!boxes_overlap(a.box, b.box)) continue;
+      if (a.cable == b.cable ? !ctx.req.check_self : !ctx.req.check_cable_cable) continue;
+      pairs.emplace_back(order[i], order[j]);
+    }
+  }
+  // Flatten every span that takes part in a pair (once).
+  std::vector<char> used(spans.size(), 0);
+  for (const auto& pr : pairs) used[pr.first] = used[pr.second] = 1;
+  std::vector<std::size_t> used_list;
+  for (std::size_t i = 0; i < spans.size(); ++i)
+    if (used[i]) used_list.push_back(i);
+  std::vector<SpanChords> chords(spans.size());
+  parallel_indices(used_list.size(), ctx.req.threads, [&](std::size_t k) {
+    const SpanBox& sb = spans[used_list[k]];
+    const CableInput& c = ctx.cables[sb.cable];
+    SpanChords& sc = chords[used_list[k]];
+    flatten(c.curve, sb.u0, sb.u1, ctx.chord_error, kMaxChordRadii * c.radius, sc.ch);
+    ctx.counters.samples += as_i64(sc.ch.p.size());
+    const double infl = c.radius + ctx.chord_error;
+    for (std::size_t b = 0; b * kBlock < sc.ch.size(); ++b) {
+      AABB box;
+      for (std::size_t v = b * kBlock; v <= std::min(sc.ch.size(), (b + 1) * kBlock); ++v) box.extend(sc.ch.p[v]);
+      box.min.array() -= infl;
+      box.max.array() += infl;
+      sc.blocks.push_back(box);
+    }
+  });
+  std::mutex mu;
+  std::vector<PairContact> contacts;
+  parallel_indices(pairs.size(), ctx.req.threads, [&](std::size_t k) {
+    std::vector<PairContact> local;
+    const auto& pr = pairs[k];
+    narrow_phase(ctx, spans[pr.first], chords[pr.first], spans[pr.second], chords[pr.second], pr.first == pr.second,
+                 local);
+    if (!local.empty()) {
+      std::lock_guard<std::mutex> lock(mu);
+      contacts.insert(contacts.end(), local.begin(), local.end());
+    }
+  });
+  group_pair_contacts(contacts, ctx.cables, out);
+}
+
+// ---------------------------------------------------------------------------------------
+// Discrete method (the seed paper).
+
+/// Nearest part to p by brute force over every triangle; inside via winding numbers.
+struct BruteHit {
+  int part = -1;
+  double dist = kInf;
+  bool inside = false;
+};
+
+BruteHit brute_point(const Context& ctx, const Vec3& p) {
+  BruteHit best;
+  for (std::size_t q = 0; q < ctx.parts.size(); ++q) {
+    const Mesh& m = ctx.parts[q].mesh;
+    double d2 = kInf;
+    double wind = 0.0;
+    const bool closed = ctx.info[q].closed;
+    for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+      const auto c = m.corners(t);
+      d2 = std::min(d2, closest_point_on_triangle(p, c[0], c[1], c[2]).dist2);
+      if (closed) wind += triangle_solid_angle(p, c[0], c[1], c[2]);
+    }
+    if (closed && std::abs(wind) > 2.0 * M_PI) {  // winding number > 1/2
+      best.inside = true;
+      best.part = static_cast<int>(q);
+      best.dist = 0.0;
+      return best;
+    }
+    const double d = std::sqrt(d2);
+    if (d < best.dist) {
+      best.dist = d;
+      best.part = static_cast<int>(q);
+    }
+  }
+  return best;
+}
+
+/// Samples of every cable for the discrete method.
+struct DiscreteSamples {
+  std::vector<double> s;
+  std::vector<Vec3> p;
+  double spacing = 0.0;
+};
+
+void discrete_structure(Context& ctx, int cable, const DiscreteSamples& ds, StretchTracker& tr) {
+  const double r = ctx.cables[cable].radius;
+  ClashCounters count;
+  for (std::size_t k = 0; k < ds.p.size(); ++k) {
+    const Vec3& p = ds.p[k];
+    const double s0 = k == 0 ? 0.0 : 0.5 * (ds.s[k - 1] + ds.s[k]);
+    const double s1 = k + 1 == ds.p.size() ? ds.s[k] : 0.5 * (ds.s[k] + ds.s[k + 1]);
+    PartObservation o;
+    o.point = p;
+    o.s = ds.s[k];
+    if (ctx.req.use_index) {
+      int part = -1;
+      ++count.inside_queries;
+      if (ctx.index->inside(p, &part)) {
+        o.part = part;
+        o.key = -r;
+        o.inside = true;
+      } else {
+        ++count.distance_queries;
+        const ClosestHit h = ctx.index->closest(p, r + ctx.band);
+        if (h.found()) {
+          o.part = h.part;
+          o.key = h.distance - r;
+        }
+      }
+    } else {
+      ++count.distance_queries;
+      ++count.inside_queries;
+      const BruteHit h = brute_point(ctx, p);
+      if (h.part >= 0) {
+        o.part = h.part;
+        o.key = h.inside ? -r : h.dist - r;
+        o.inside = h.inside;
+      }
+    }
+    if (o.part >= 0 && o.key < ctx.info[o.part].required)
+      tr.step({o}, s0, s1);
+    else
+      tr.step({}, s0, s1);
+  }
+  tr.flush();
+  ctx.counters.add(count);
+}
+
+/// Cable–cable (min sample distance < r₁ + r₂) and self (non-adjacent samples < 2r, then
+/// the midpoint test) contacts, through a uniform grid or all pairs (no index).
+void discrete_cable_pairs(Context& ctx, const std::vector<DiscreteSamples>& ds, std::vector<ClashEntry>& out) {
+  if (!ctx.req.check_cable_cable && !ctx.req.check_self) return;
+  const auto& cables = ctx.cables;
+  std::vector<PairContact> contacts;
+  std::mutex mu;
+  // Test point k of cable a (or the midpoint of k, k+1 when mid) against sample m of b.
+  auto test = [&](int a, std::size_t k, bool mid, int b, std::size_t m, std::vector<PairContact>& local,
+                  std::int64_t& tests) {
+    const bool self = a == b;
+    if (self) {
+      // Non-adjacent samples (|k − m| ≥ 2, the paper at l = 2r) and midpoints of pairs away
+      // from the judged point; at a finer spacing also |s − t| ≥ π r (DESIGN §5), else
+      // every pair of neighbours closer than 2r would count.
+      const long dk = static_cast<long>(m) - static_cast<long>(k);
+      if (!mid && dk < 2) return;  // each unordered pair once
+      if (mid && dk >= -1 && dk <= 2) return;
+      const double sk = mid ? 0.5 * (ds[a].s[k] + ds[a].s[k + 1]) : ds[a].s[k];
+      if (std::abs(ds[b].s[m] - sk) < M_PI * cables[a].radius) return;
+    } else if (a > b) {
+      return;
+    }
+    const Vec3 p = mid ? Vec3(0.5 * (ds[a].p[k] + ds[a].p[k + 1])) : ds[a].p[k];
+    const Vec3& q = ds[b].p[m];
+    ++tests;
+    const double d = (p - q).norm();
+    const double limit = cables[a].radius + cables[b].radius;
+    if (!(d < limit)) return;
+    const double s = mid ? 0.5 * (ds[a].s[k] + ds[a].s[k + 1]) : ds[a].s[k];
+    const double t = ds[b].s[m];
+    if (!self && excused(cables[a], s, p, cables[b], t, q)) return;
+    PairContact pc;
+    pc.a = a;
+    pc.b = b;
+    pc.dist = d;
+    pc.p = p;
+    pc.q = q;
+    pc.s = s;
+    pc.t = t;
+    const double ha = ds[a].spacing, hb = ds[b].spacing;
+    pc.sa0 = s - ha;
+    pc.sa1 = s + ha;
+    pc.tb0 = t - hb;
+    pc.tb1 = t + hb;
+    if (self && s > t) {
+      std::swap(pc.p, pc.q);
+      std::swap(pc.s, pc.t);
+      std::swap(pc.sa0, pc.tb0);
+      std::swap(pc.sa1, pc.tb1);
+    }
+    local.push_back(pc);
+  };
+  auto want = [&](int a, int b) { return a == b ? ctx.req.check_self : ctx.req.check_cable_cable; };
+  if (!ctx.req.use_index) {
+    // The paper: every sample pair of every cable pair.
+    parallel_indices(cables.size(), ctx.req.threads, [&](std::size_t ai) {
+      const int a = static_cast<int>(ai);
+      std::vector<PairContact> local;
+      std::int64_t tests = 0;
+      for (int b = a; b < static_cast<int>(cables.size()); ++b) {
+        if (!want(a, b)) continue;
+        for (std::size_t k = 0; k < ds[a].p.size(); ++k) {
+          for (std::size_t m = 0; m < ds[b].p.size(); ++m) {
+            test(a, k, false, b, m, local, tests);
+            if (a == b && k + 1 < ds[a].p.size()) test(a, k, true, b, m, local, tests);
+          }
+        }
+      }
+      ctx.counters.pairs += tests;
+      std::lock_guard<std::mutex> lock(mu);
+      contacts.insert(contacts.end(), local.begin(), local.end());
+    });
+  } else {
+    // Uniform grid of samples, cell = the largest contact distance.
+    double rmax = 0.0;
+    for (const auto& c : cables) rmax = std::max(rmax, c.radius);
+    const double cell = std::max(2.0 * rmax, 1e-12);
+    auto key = [&](const Vec3& p) {
+      const std::int64_t x = static_cast<std::int64_t>(std::floor(p.x() / cell));
+      const std::int64_t y = static_cast<std::int64_t>(std::floor(p.y() / cell));
+      const std::int64_t z = static_cast<std::int64_t>(std::floor(p.z() / cell));
+      return std::array<std::int64_t, 3>{x, y, z};
+    };
+    struct KeyHash {
+      std::size_t operator()(const std::array<std::int64_t, 3>& k) const {
+        return static_cast<std::size_t>(k[0] * 73856093LL ^ k[1] * 19349663LL ^ k[2] * 83492791LL);
+      }
+    };
+    std::unordered_map<std::array<std::int64_t, 3>, std::vector<std::pair<int, std::size_t>>, KeyHash> grid;
+    for (std::size_t c = 0; c < cables.size(); ++c)
+      for (std::size_t k = 0; k < ds[c].p.size(); ++k) grid[key(ds[c].p[k])].emplace_back(static_cast<int>(c), k);
+    parallel_indices(cables.size(), ctx.req.threads, [&](std::size_t ai) {
+      const int a = static_cast<int>(ai);
+      std::vector<PairContact> local;
+      std::int64_t tests = 0;
+      for (std::size_t k = 0; k < ds[a].p.size(); ++k) {
+        for (int mid = 0; mid < 2; ++mid) {
+          if (mid && k + 1 >= ds[a].p.size()) continue;
+          const Vec3 p = mid ? Vec3(0.5 * (ds[a].p[k] + ds[a].p[k + 1])) : ds[a].p[k];
+          const auto kk = key(p);
+          for (int dx = -1; dx <= 1; ++dx)
+            for (int dy = -1; dy <= 1; ++dy)
+              for (int dz = -1; dz <= 1; ++dz) {
+                auto it = grid.find({kk[0] + dx, kk[1] + dy, kk[2] + dz});
+                if (it == grid.end()) continue;
+                for (const auto& e : it->second) {
+                  if (mid && e.first != a) continue;  // the midpoint test is for self only
+                  if (!want(a, e.first)) continue;
+                  test(a, k, mid != 0, e.first, e.second, local, tests);
+                }
+              }
+        }
+      }
+      ctx.counters.pairs += tests;
+      std::lock_guard<std::mutex> lock(mu);
+      contacts.insert(contacts.end(), local.begin(), local.end());
+    });
+  }
+  group_pair_contacts(contacts, cables, out);
+}
+
+void check_bend(const Context& ctx, std::size_t c, CableCheckSummary& sum, std::vector<Violation>& out) {
+  const CableInput& in = ctx.cables[c];
+  const BendExtremum b = in.curve.min_bend_radius();
+  sum.min_bend_radius = b.radius;
+  sum.min_bend_s = b.s;
+  if (ctx.req.check_bend && in.min_bend_radius > 0.0 && b.radius < in.min_bend_radius) {
+    Violation v;
+    v.kind = ViolationKind::BendRadius;
+    v.cable = static_cast<int>(c);
+    v.value = b.radius;
+    v.limit = in.min_bend_radius;
+    v.s = b.s;
+    v.point = in.curve.position(b.u);
+    out.push_back(v);
+  }
+}
+
+}  // namespace
+
+const char* clash_method_name(ClashMethod m) { return m == ClashMethod::Certified ? "certified" : "discrete"; }
+
+const char* clash_kind_name(ClashKind k) {
+  switch (k) {
+    case ClashKind::CableStructure: return "cable-structure";
+    case ClashKind::CableCable: return "cable-cable";
+    case ClashKind::Self: return "self";
+  }
+  return "?";
+}
+
+const char* violation_kind_name(ViolationKind k) {
+  return k == ViolationKind::BendRadius ? "bend-radius" : "clearance";
+}
+
+double default_clash_tolerance(const std::vector<CableInput>& cables, std::string* source) {
+  double rmin = kInf;
+  for (const auto& c : cables) rmin = std::min(rmin, c.radius);
+  if (source) *source = "smallest cable radius / 100";
+  return std::isfinite(rmin) ? kDefaultToleranceOfRadius * rmin : 0.01;
+}
+
+ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vector<Part>& parts,
+                          const ObstacleIndex* index, const ClashRequest& request) {
+  for (const auto& c : cables) {
+    if (c.curve.empty()) throw std::invalid_argument("check_clashes: cable '" + c.id + "' has no centerline");
+    if (!(c.radius > 0.0) || !std::isfinite(c.radius))
+      throw std::invalid_argument("check_clashes: cable '" + c.id + "' has a non-positive radius");
+  }
+  const bool need_index = request.use_index || request.method == ClashMethod::Certified;
+  if (need_index && index == nullptr) throw std::invalid_argument("check_clashes: an index is required");
+  if (index != nullptr && index->part_count() != static_cast<int>(parts.size()))
+    throw std::invalid_argument("check_clashes: the index does not index the given parts");
+
+  Context ctx{cables, parts, index, request, {}, 0.0, 0.0, 0.0, 0.0, {}};
+  ClashResult res;
+  ctx.info.resize(parts.size());
+  for (std::size_t q = 0; q < parts.size(); ++q) {
+    ctx.info[q].box = parts[q].mesh.bounds();
+    ctx.info[q].required = std::max(0.0, request.routing_clearance + parts[q].clearance);
+    ctx.info[q].keep_out = parts[q].role == PartRole::KeepOut;
+    ctx.info[q].closed = parts[q].closed;
+    ctx.band = std::max(ctx.band, ctx.info[q].required);
+    if (!parts[q].closed) res.notes.push_back("part '" + parts[q].name + "' is open: surface checks only");
+  }
+  if (request.tolerance > 0.0) {
+    ctx.tol = request.tolerance;
+    res.tolerance_source = "request";
+  } else {
+    ctx.tol = default_clash_tolerance(cables, &res.tolerance_source);
+  }
+  if (index) ctx.abs_err = index->accuracy().abs_error;
+  if (request.method == ClashMethod::Certified && !(ctx.abs_err < 0.5 * ctx.tol))
+    throw std::invalid_argument("check_clashes: tolerance " + std::to_string(ctx.tol) +
+                                " is not above twice the index error " + std::to_string(ctx.abs_err));
+  ctx.chord_error = kChordShareOfTolerance * (ctx.tol - ctx.abs_err);
+  res.cables.resize(cables.size());
+  std::vector<std::vector<ClashEntry>> per_clash(cables.size());
+  std::vector<std::vector<Violation>> per_viol(cables.size());
+  std::atomic<std::size_t> done{0};
+  const auto caller = std::this_thread::get_id();
+  auto report = [&](std::size_t total) {
+    const std::size_t d = ++done;
+    if (request.progress && std::this_thread::get_id() == caller)
+      request.progress(0.9 * static_cast<double>(d) / static_cast<double>(std::max<std::size_t>(total, 1)));
+  };
+
+  if (request.method == ClashMethod::Certified) {
+    res.tolerance = ctx.tol;
+    res.chord_error = ctx.chord_error;
+    parallel_indices(cables.size(), request.threads, [&](std::size_t c) {
+      CableCheckSummary& sum = res.cables[c];
+      sum.length = cables[c].curve.length();
+      if (request.check_structure && !parts.empty()) {
+        StructureTracer tr(ctx, static_cast<int>(c));
+        tr.run();
+        per_clash[c] = std::move(tr.tracker().clashes);
+        per_viol[c] = std::move(tr.tracker().violations);
+        sum.min_clearance = std::max(tr.min_clearance(), -cables[c].radius);
+        sum.min_clearance_exact = tr.min_exact();
+      } else {
+        sum.min_clearance = kInf;
+      }
+      check_bend(ctx, c, sum, per_viol[c]);
+      report(cables.size());
+    });
+  } else {
+    std::vector<DiscreteSamples> ds(cables.size());
+    res.spacing = request.spacing > 0.0 ? request.spacing : 0.0;
+    parallel_indices(cables.size(), request.threads, [&](std::size_t c) {
+      const double l = request.spacing > 0.0 ? request.spacing : 2.0 * cables[c].radius;
+      const auto samples = cables[c].curve.sample_by_arc_length(l);
+      ds[c].spacing = samples.size() > 1 ? samples[1].first - samples[0].first : l;
+      for (const auto& sp : samples) {
+        ds[c].s.push_back(sp.first);
+        ds[c].p.push_back(sp.second);
+      }
+      ctx.counters.samples += as_i64(samples.size());
+      CableCheckSummary& sum = res.cables[c];
+      sum.length = cables[c].curve.length();
+      sum.min_clearance = kInf;
+      if (request.check_structure && !parts.empty()) {
+        StretchTracker tr(static_cast<int>(c), cables[c].radius, ctx.info);
+        discrete_structure(ctx, static_cast<int>(c), ds[c], tr);
+        per_clash[c] = std::move(tr.clashes);
+        per_viol[c] = std::move(tr.violations);
+        sum.min_clearance = std::max(tr.min_key, -cables[c].radius);
+      }
+      check_bend(ctx, c, sum, per_viol[c]);
+      report(cables.size());
+    });
+    std::vector<ClashEntry> pair_out;
+    discrete_cable_pairs(ctx, ds, pair_out);
+    for (const auto& e : pair_out) per_clash[e.cable].push_back(e);
+  }
+  if (request.method == ClashMethod::Certified) {
+    std::vector<ClashEntry> pair_out;
+    certified_cable_pairs(ctx, pair_out);
+    for (const auto& e : pair_out) per_clash[e.cable].push_back(e);
+  }
+  for (std::size_t c = 0; c < cables.size(); ++c) {
+    std::sort(per_clash[c].begin(), per_clash[c].end(), [](const ClashEntry& a, const ClashEntry& b) { return a.s < b.s; });
+    std::sort(per_viol[c].begin(), per_viol[c].end(), [](const Violation& a, const Violation& b) { return a.s < b.s; });
+    res.clashes.insert(res.clashes.end(), per_clash[c].begin(), per_clash[c].end());
+    res.violations.insert(res.violations.end(), per_viol[c].begin(), per_viol[c].end());
+  }
+  res.counters = ctx.counters.snapshot();
+  if (request.progress) request.progress(1.0);
+  return res;
+}
+
+}  // namespace loom

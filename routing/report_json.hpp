@@ -1,0 +1,20 @@
+#pragma once
+/// report.json of `loom audit` exactly as DESIGN §4 lists its fields (plus a few extra
+/// fields that say more: keep_out, inside, stretch ends, notes). Never NaN or infinity:
+/// unbounded values are omitted and the reason is given beside them.
+
+#include "routing/audit.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+
+namespace loom {
+
+/// The report as JSON (numbers in scene units, times in milliseconds).
+nlohmann::json audit_report_json(const AuditReport& report);
+
+/// Writes audit_report_json(report) to `path` atomically (pretty-printed).
+void write_audit_report(const AuditReport& report, const std::filesystem::path& path);
+
+}  // namespace loom

@@ -1,0 +1,78 @@
+#pragma once
+/// The main job (issue 7, DESIGN §3–§7): scene → indices (built once) → α-simplified
+/// planning obstacles → OMPL key points per harness segment in the patent's order (bundles
+/// by cable count, largest first) → unplaced branch points placed → cubic B-splines with
+/// port exit tangents → bend-radius repair/fairing → exact certified audit → repair
+/// (denser key points where the smooth curve clashes) → routed harness + report.
+
+#include "core/scene.hpp"
+#include "routing/audit.hpp"
+#include "routing/path_planner.hpp"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace loom {
+
+/// What `loom route` was asked to do. Unset values come from the scene's [routing].
+struct RouteOptions {
+  std::string planner;       ///< empty: scene.routing.planner
+  double time_limit = -1.0;  ///< seconds per segment; < 0: scene.routing.time_limit
+  long seed = -1;            ///< < 0: scene.routing.seed
+  int threads = 0;           ///< audit threads (≤ 0: all cores)
+  bool simplify = true;      ///< plan among α-simplified obstacles (false: the exact parts)
+  int max_repair_rounds = 4; ///< audit → densify → re-spline rounds per segment
+  /// Called with (stage, fraction done) from the calling thread; may be empty.
+  std::function<void(const std::string&, double)> progress;
+};
+
+/// How one harness segment was routed.
+struct SegmentRouteInfo {
+  int segment = -1;
+  bool planned = false;       ///< planned now (false: kept from the input, or failed)
+  bool kept_from_input = false;  ///< the input already had its path or spline
+  PlanResult plan;            ///< the planner's answer (when planned)
+  std::size_t key_points = 0; ///< interior key points in the routed file
+  int repair_rounds = 0;      ///< densification rounds after the audit
+  std::string bend_status;    ///< outcome of the bend-radius repair
+};
+
+/// Why a cable has no route.
+struct UnroutedCable {
+  std::string cable;
+  std::string segment;  ///< "FROM -> TO" of the segment that failed
+  std::string reason;   ///< reason_name() of the planner, or "branch_blocked"
+  std::string message;  ///< human-readable, with coordinates
+};
+
+/// Time split of a route run, milliseconds.
+struct RouteTimings {
+  double load = 0, index = 0, simplify = 0, plan = 0, spline = 0, audit = 0, repair = 0, total = 0;
+};
+
+/// Everything `loom route` reports.
+struct RouteReport {
+  Harness routed;                        ///< the harness with branch positions, paths, splines
+  std::vector<SegmentRouteInfo> segments;  ///< in routing order
+  std::vector<UnroutedCable> unrouted;
+  AuditReport audit;                     ///< the final exact audit of the routed cables
+  RouteTimings timing;
+  std::string planner;
+  unsigned seed = 0;
+  double clearance = 0.0;                ///< required clearance used
+  std::vector<std::string> notes;
+  /// DESIGN §4: 3 if a cable could not be routed, else 1 if clashes/violations remain, else 0.
+  int exit_code() const { return !unrouted.empty() ? 3 : audit.exit_code(); }
+};
+
+/// Routes every unrouted segment of the scene's harness and audits the result.
+RouteReport route_scene(const Scene& scene, const RouteOptions& opt);
+
+/// Places branch points that have no position: each at the point minimising the summed
+/// distance to its three neighbours (Weiszfeld iterations over the tree), then moved clear
+/// of obstacles by at least `clearance_of(branch)` using `index`. Returns the ids placed.
+std::vector<std::string> place_branch_points(Harness& h, const ObstacleIndex& index,
+                                             const std::function<double(int branch)>& clearance_of);
+
+}  // namespace loom

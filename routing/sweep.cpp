@@ -1,0 +1,365 @@
+// Sphere-moving sweep (seed: cable-scan-centerline-and-sphere-sweep §4, eqs. 7–9): each
+// ring is the circle where the moving sphere S(s) of radius r(s) touches its envelope,
+// centre M = C − r·r'·T and radius R = r·√(1 − r'²) (r' = dr/ds, T the unit tangent).
+// The ring's in-plane axes come from a rotation-minimising frame (double reflection, Wang
+// et al. 2008), not from the seed's Frenet frame (undefined on straight runs, flips at
+// inflections).
+#include "routing/sweep.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace loom {
+
+namespace {
+
+/// Share of the chord tolerance given to the ring polygons (sagitta across the tube); the
+/// rest goes to the spacing of the rings along it (sagitta along the outer fibre). A point
+/// inside a quad is off by at most the sum of the two.
+constexpr double kCircumferentialShare = 0.5;
+/// Fewest vertices per ring (a triangle) and most (beyond this the tolerance is absurd for
+/// the radius).
+constexpr int kMinCircumferential = 3;
+constexpr int kMaxCircumferential = 1 << 16;
+/// Most rings a sweep may produce before it reports the tolerance as unreasonable.
+constexpr std::size_t kMaxRings = 1u << 22;
+/// A step never exceeds this fraction of its knot span, so that curvature sampled at the
+/// step's ends and middle sees every feature of the (cubic) span.
+constexpr double kMaxSpanFraction = 0.25;
+/// Attempts to shrink one step until the curvature inside it is consistent with its length.
+constexpr int kStepShrinkIterations = 4;
+/// |C'| below this fraction of the average speed: the tangent is taken from C'' instead.
+constexpr double kStationaryRelSpeed = 1e-12;
+
+
+/// Unit tangent at u from the first (or, at a stationary point, second) derivative.
+Vec3 unit_tangent(const Vec3* d, double min_speed, const Vec3& fallback) {
+  const double v = d[1].norm();
+  if (v > min_speed) return d[1] / v;
+  const double a = d[2].norm();
+  if (a > 0.0) return d[2] / a;
+  return fallback;
+}
+
+double curvature_of(const Vec3* d, double min_speed) {
+  const double v = d[1].norm();
+  if (!(v > min_speed)) return 0.0;
+  return d[1].cross(d[2]).norm() / (v * v * v);
+}
+
+/// Largest axial step Δs whose outer-fibre sagitta κ(1 + rκ)Δs²/8 stays within tol.
+double axial_step(double kappa, double r, double tol) {
+  const double k = kappa * (1.0 + r * kappa);
+  if (!(k > 0.0)) return std::numeric_limits<double>::infinity();
+  return std::sqrt(8.0 * tol / k);
+}
+
+/// Any unit vector perpendicular to unit t.
+Vec3 any_perpendicular(const Vec3& t) {
+  const Vec3 a = std::abs(t.x()) <= std::abs(t.y()) && std::abs(t.x()) <= std::abs(t.z()) ? Vec3::UnitX()
+                 : std::abs(t.y()) <= std::abs(t.z())                                      ? Vec3::UnitY()
+                                                                                           : Vec3::UnitZ();
+  return (a - a.dot(t) * t).normalized();
+}
+
+/// Rotation angle (radians, [0, π]) taking the orthonormal frame (t0, b0, t0×b0) to
+/// (t1, b1, t1×b1): from R = Σ f1 f0ᵀ, tan θ = |axial(R)| / (tr R − 1), stable near 0 and π.
+double frame_turn(const Vec3& t0, const Vec3& b0, const Vec3& t1, const Vec3& b1) {
+  const Vec3 c0 = t0.cross(b0), c1 = t1.cross(b1);
+  const Eigen::Matrix3d R = t1 * t0.transpose() + b1 * b0.transpose() + c1 * c0.transpose();
+  const Vec3 axial(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1));
+  return std::atan2(0.5 * axial.norm(), 0.5 * (R.trace() - 1.0));
+}
+
+/// Cross-sections with rotation-minimising frames for any radius law (RadiusFn(s) returns
+/// {r, dr/ds}); `max_turn` receives the largest frame rotation between neighbours.
+template <class RadiusFn>
+std::vector<SweepSection> sections(const Centerline& c, const RadiusFn& radius_at, bool variable_radius,
+                                   const SweepOptions& opt, const char* who, double& max_turn) {
+  if (c.empty()) throw std::invalid_argument(std::string(who) + ": empty centerline");
+  if (!(opt.chord_tolerance > 0.0) || !std::isfinite(opt.chord_tolerance))
+    throw std::invalid_argument(std::string(who) + ": chord_tolerance must be positive and finite");
+  const double tol_axial = (1.0 - kCircumferentialShare) * opt.chord_tolerance;
+  const double u0 = c.u_min(), u1 = c.u_max();
+  const double L = c.length();
+  const double min_speed = kStationaryRelSpeed * std::max(L, 1e-300) / (u1 - u0);
+  const std::vector<double>& bp = c.breakpoints();
+
+  auto check_radius = [&](double s, double r, double rs) {
+    if (!(r > 0.0) || !std::isfinite(r))
+      throw std::invalid_argument(std::string(who) + ": radius " + std::to_string(r) + " at s = " +
+                                  std::to_string(s) + " is not positive and finite");
+    if (!(std::abs(rs) < 1.0))
+      throw std::invalid_argument(std::string(who) + ": |dr/ds| = " + std::to_string(std::abs(rs)) +
+                                  " ≥ 1 at s = " + std::to_string(s) +
+                                  ": the moving sphere swallows its neighbours, no envelope surface");
+  };
+
+  // --- rings along the curve ---------------------------------------------------------
+  std::vector<SweepSection> rings;
+  rings.reserve(64);
+  auto make_ring = [&](double u, double s, const Vec3* d, const Vec3& fallback) {
+    SweepSection g;
+    g.u = u;
+    g.s = s;
+    g.point = d[0];
+    g.tangent = unit_tangent(d, min_speed, fallback);
+    const auto [r, rs] = radius_at(s);
+    check_radius(s, r, rs);
+    g.centre = variable_radius ? Vec3(d[0] - r * rs * g.tangent) : d[0];  // eq. 7
+    g.radius = variable_radius ? r * std::sqrt(1.0 - rs * rs) : r;       // eq. 8
+    return g;
+  };
+
+  Vec3 d[3];
+  c.evaluate(u0, 2, d);
+  {
+    Vec3 fb = Vec3::UnitX();
+    if (c.length() > 0.0) fb = (c.position(u1) - d[0]).normalized();
+    if (!is_finite(fb)) fb = Vec3::UnitX();
+    rings.push_back(make_ring(u0, 0.0, d, fb));
+  }
+  double u = u0, s = 0.0;
+  std::size_t bpi = 0;  // breakpoint interval holding u
+  while (u < u1) {
+    while (bpi + 2 < bp.size() && u >= bp[bpi + 1]) ++bpi;
+    const double span_w = bp[bpi + 1] - bp[bpi];
+    const double speed0 = std::max(d[1].norm(), min_speed);
+    const double k0 = curvature_of(d, min_speed);
+    const double r0 = rings.back().radius;
+    double ds = axial_step(k0, r0, tol_axial);
+    if (variable_radius) {
+      // Keep the linear interpolation of r between rings within tolerance too: |r''|Δs²/8.
+      const double h = 1e-3 * std::max(std::min(ds, L), 1e-12);
+      const double rpp = std::abs(radius_at(std::min(s + h, L)).first - 2.0 * radius_at(s).first +
+                                  radius_at(std::max(s - h, 0.0)).first) /
+                         (h * h);
+      if (rpp > 0.0) ds = std::min(ds, std::sqrt(8.0 * tol_axial / rpp));
+    }
+    double du = std::min(ds / speed0, kMaxSpanFraction * span_w);
+    Vec3 dm[3], de[3];
+    for (int it = 0;; ++it) {
+      du = std::min(du, u1 - u);
+      c.evaluate(u + 0.5 * du, 2, dm);
+      c.evaluate(u + du, 2, de);
+      const double vmax = std::max({d[1].norm(), dm[1].norm(), de[1].norm(), min_speed});
+      const double kmax = std::max({k0, curvature_of(dm, min_speed), curvature_of(de, min_speed)});
+      const double allowed = axial_step(kmax, r0, tol_axial) / vmax;
+      if (du <= allowed * 1.0000001 || it >= kStepShrinkIterations) break;
+      du = allowed;
+    }
+    // Simpson on |C'| (the three derivatives we have) advances s for the radius law.
+    const double un = (u1 - (u + du) <= 1e-12 * (u1 - u0)) ? u1 : u + du;
+    if (un == u1 && un != u + du) c.evaluate(un, 2, de);
+    s += (un - u) / 6.0 * (d[1].norm() + 4.0 * dm[1].norm() + de[1].norm());
+    if (un == u1) s = L;
+    u = un;
+    d[0] = de[0];
+    d[1] = de[1];
+    d[2] = de[2];
+    rings.push_back(make_ring(u, std::min(s, L), d, rings.back().tangent));
+    if (rings.size() > kMaxRings)
+      throw std::invalid_argument(std::string(who) + ": chord tolerance " + std::to_string(opt.chord_tolerance) +
+                                  " needs more than " + std::to_string(kMaxRings) + " rings");
+  }
+
+  // --- rotation-minimising frame --------------------------------------------------------
+  const std::size_t nr = rings.size();
+  Vec3 b1 = any_perpendicular(rings[0].tangent);
+  rings[0].normal = b1;
+  Vec3 prev_x = rings[0].point;
+  max_turn = 0.0;
+  for (std::size_t i = 1; i < nr; ++i) {
+    SweepSection& g = rings[i];
+    {
+      // Double reflection: reflect (b1, t) in the bisector plane of x_i → x_{i+1}, then in
+      // the plane that maps the reflected tangent onto the new one.
+      const Vec3 x = g.point;
+      const Vec3 v1 = x - prev_x;
+      const double c1 = v1.squaredNorm();
+      Vec3 rL = b1, tL = rings[i - 1].tangent;
+      if (c1 > 0.0) {
+        rL = b1 - (2.0 / c1) * v1.dot(b1) * v1;
+        tL = tL - (2.0 / c1) * v1.dot(tL) * v1;
+      }
+      const Vec3 v2 = g.tangent - tL;
+      const double c2 = v2.squaredNorm();
+      Vec3 bn = c2 > 0.0 ? Vec3(rL - (2.0 / c2) * v2.dot(rL) * v2) : rL;
+      bn -= bn.dot(g.tangent) * g.tangent;  // remove rounding drift
+      const double len = bn.norm();
+      bn = len > 0.0 ? Vec3(bn / len) : any_perpendicular(g.tangent);
+      max_turn = std::max(max_turn, frame_turn(rings[i - 1].tangent, b1, g.tangent, bn));
+      b1 = bn;
+      prev_x = x;
+    }
+    g.normal = b1;
+  }
+  return rings;
+}
+
+}  // namespace
+
+int circumferential_resolution(double radius, double tolerance) {
+  if (!(radius > 0.0) || !(tolerance > 0.0) || !std::isfinite(radius) || !std::isfinite(tolerance))
+    throw std::invalid_argument("circumferential_resolution: radius and tolerance must be positive and finite");
+  if (tolerance >= radius) return kMinCircumferential;
+  const double half_angle = std::acos(1.0 - tolerance / radius);  // sagitta R(1 − cos(π/n)) ≤ tol
+  const double need = std::ceil(M_PI / half_angle);
+  if (need > kMaxCircumferential)
+    throw std::invalid_argument("chord tolerance " + std::to_string(tolerance) + " is too small for radius " +
+                                std::to_string(radius));
+  return std::max(kMinCircumferential, static_cast<int>(need));
+}
+
+namespace {
+
+/// Triangle mesh of rings at the sections (n vertices each) with fan end caps.
+SweepResult mesh_sections(const std::vector<SweepSection>& rings, const SweepOptions& opt, double max_turn) {
+  double rmax = 0.0;
+  for (const SweepSection& g : rings) rmax = std::max(rmax, g.radius);
+  const int n = circumferential_resolution(rmax, kCircumferentialShare * opt.chord_tolerance);
+  SweepResult out;
+  out.circumferential = n;
+  out.rings = static_cast<int>(rings.size());
+  out.max_frame_turn = max_turn;
+  Mesh& m = out.mesh;
+  const std::size_t nr = rings.size();
+  m.vertices.reserve(nr * n + (opt.end_caps ? 2 : 0));
+  std::vector<double> cs(n), sn(n);
+  for (int j = 0; j < n; ++j) {
+    cs[j] = std::cos(2.0 * M_PI * j / n);
+    sn[j] = std::sin(2.0 * M_PI * j / n);
+  }
+  for (const SweepSection& g : rings) {
+    const Vec3 e1 = g.radius * g.normal, e2 = g.radius * g.tangent.cross(g.normal);
+    for (int j = 0; j < n; ++j) m.vertices.emplace_back(g.centre + cs[j] * e1 + sn[j] * e2);  // eq. 9
+  }
+
+  // --- triangles: quads between rings, fans for the caps (outward, counter-clockwise) -----
+  using Tri = std::array<std::uint32_t, 3>;
+  m.triangles.reserve(2 * (nr - 1) * n + (opt.end_caps ? 2 * n : 0));
+  auto& t = m.triangles;
+  for (std::size_t i = 0; i + 1 < nr; ++i) {
+    const auto a0 = static_cast<std::uint32_t>(i * n), b0 = static_cast<std::uint32_t>((i + 1) * n);
+    for (int j = 0; j < n; ++j) {
+      const std::uint32_t j1 = static_cast<std::uint32_t>(j + 1 == n ? 0 : j + 1);
+      const std::uint32_t jj = static_cast<std::uint32_t>(j);
+      t.push_back(Tri{a0 + jj, a0 + j1, b0 + j1});
+      t.push_back(Tri{a0 + jj, b0 + j1, b0 + jj});
+    }
+  }
+  if (opt.end_caps) {
+    const auto c0 = static_cast<std::uint32_t>(nr * n), c1 = c0 + 1;
+    m.vertices.push_back(rings.front().centre);
+    m.vertices.push_back(rings.back().centre);
+    const auto last = static_cast<std::uint32_t>((nr - 1) * n);
+    for (int j = 0; j < n; ++j) {
+      const std::uint32_t j1 = static_cast<std::uint32_t>(j + 1 == n ? 0 : j + 1);
+      const std::uint32_t jj = static_cast<std::uint32_t>(j);
+      t.push_back(Tri{c0, j1, jj});
+      t.push_back(Tri{c1, last + jj, last + j1});
+    }
+  }
+  return out;
+}
+
+
+std::vector<SweepSection> tube_section_list(const Centerline& c, double radius, const SweepOptions& opt,
+                                            double& max_turn) {
+  if (!(radius > 0.0) || !std::isfinite(radius))
+    throw std::invalid_argument("sweep_tube: radius must be positive and finite");
+  return sections(
+      c, [radius](double) { return std::pair<double, double>(radius, 0.0); }, false, opt, "sweep_tube", max_turn);
+}
+
+std::vector<SweepSection> canal_section_list(const Centerline& c, const std::function<double(double)>& radius_of_s,
+                                             const SweepOptions& opt, double& max_turn) {
+  if (!radius_of_s) throw std::invalid_argument("sweep_canal: no radius function");
+  const double L = c.empty() ? 0.0 : c.length();
+  // Central difference for r'(s); one-sided at the ends.
+  const double h = 6e-6 * std::max(L, 1e-300);
+  auto law = [&](double s) {
+    const double r = radius_of_s(s);
+    const double a = std::max(0.0, s - h), b = std::min(L, s + h);
+    const double rs = b > a ? (radius_of_s(b) - radius_of_s(a)) / (b - a) : 0.0;
+    return std::pair<double, double>(r, rs);
+  };
+  return sections(c, law, true, opt, "sweep_canal", max_turn);
+}
+
+}  // namespace
+
+SweepResult sweep_tube(const Centerline& c, double radius, const SweepOptions& opt) {
+  double turn = 0.0;
+  const auto sec = tube_section_list(c, radius, opt, turn);
+  return mesh_sections(sec, opt, turn);
+}
+
+SweepResult sweep_canal(const Centerline& c, const std::function<double(double)>& radius_of_s,
+                        const SweepOptions& opt) {
+  double turn = 0.0;
+  const auto sec = canal_section_list(c, radius_of_s, opt, turn);
+  return mesh_sections(sec, opt, turn);
+}
+
+std::vector<SweepSection> tube_sections(const Centerline& c, double radius, const SweepOptions& opt) {
+  double turn = 0.0;
+  return tube_section_list(c, radius, opt, turn);
+}
+
+std::vector<SweepSection> canal_sections(const Centerline& c, const std::function<double(double)>& radius_of_s,
+                                         const SweepOptions& opt) {
+  double turn = 0.0;
+  return canal_section_list(c, radius_of_s, opt, turn);
+}
+
+SweepResult sweep_junction(const Vec3& centre, double radius, const SweepOptions& opt) {
+  if (!is_finite(centre)) throw std::invalid_argument("sweep_junction: centre is not finite");
+  if (!(radius > 0.0) || !std::isfinite(radius))
+    throw std::invalid_argument("sweep_junction: radius must be positive and finite");
+  if (!(opt.chord_tolerance > 0.0) || !std::isfinite(opt.chord_tolerance))
+    throw std::invalid_argument("sweep_junction: chord_tolerance must be positive and finite");
+  // UV sphere with n longitudes and n/2 latitude bands, vertices on a sphere of radius
+  // Rv = r / cos ρ, ρ ≥ the angular circumradius of every triangle (half a longitude step
+  // plus half a latitude step): every facet plane is at least r from the centre, so the
+  // mesh contains the ball; Rv − r ≤ tol fixes the resolution.
+  int n = 4;
+  for (;; n += 2) {
+    const double rho = 0.5 * (2.0 * M_PI / n + M_PI / (n / 2));
+    if (radius * (1.0 / std::cos(rho) - 1.0) <= opt.chord_tolerance) break;
+    if (n > kMaxCircumferential)
+      throw std::invalid_argument("sweep_junction: chord tolerance too small for the radius");
+  }
+  const int bands = n / 2;
+  const double rho = 0.5 * (2.0 * M_PI / n + M_PI / bands);
+  const double Rv = radius / std::cos(rho);
+  SweepResult out;
+  out.circumferential = n;
+  out.rings = bands - 1;
+  Mesh& m = out.mesh;
+  using Tri = std::array<std::uint32_t, 3>;
+  m.vertices.push_back(centre + Vec3(0, 0, -Rv));  // south pole
+  for (int b = 1; b < bands; ++b) {
+    const double th = -0.5 * M_PI + M_PI * b / bands;
+    for (int j = 0; j < n; ++j) {
+      const double ph = 2.0 * M_PI * j / n;
+      m.vertices.push_back(centre + Rv * Vec3(std::cos(th) * std::cos(ph), std::cos(th) * std::sin(ph), std::sin(th)));
+    }
+  }
+  m.vertices.push_back(centre + Vec3(0, 0, Rv));  // north pole
+  const auto north = static_cast<std::uint32_t>(m.vertices.size() - 1);
+  auto ring = [n](int b, int j) { return static_cast<std::uint32_t>(1 + (b - 1) * n + (j % n)); };
+  for (int j = 0; j < n; ++j) m.triangles.push_back(Tri{0, ring(1, j + 1), ring(1, j)});
+  for (int b = 1; b + 1 < bands; ++b)
+    for (int j = 0; j < n; ++j) {
+      m.triangles.push_back(Tri{ring(b, j), ring(b, j + 1), ring(b + 1, j + 1)});
+      m.triangles.push_back(Tri{ring(b, j), ring(b + 1, j + 1), ring(b + 1, j)});
+    }
+  for (int j = 0; j < n; ++j) m.triangles.push_back(Tri{north, ring(bands - 1, j), ring(bands - 1, j + 1)});
+  return out;
+}
+
+}  // namespace loom

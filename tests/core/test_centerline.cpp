@@ -1,0 +1,480 @@
+// Centerline (core/centerline.hpp): interpolation, evaluation, arc length, curvature and
+// bend radius against closed forms, brute force and OpenCASCADE's independent B-spline code.
+#include "core/centerline.hpp"
+
+#include <GCPnts_AbscissaPoint.hxx>
+#include <GeomAPI_Interpolate.hxx>
+#include <GeomAdaptor_Curve.hxx>
+#include <GeomLProp_CLProps.hxx>
+#include <Geom_BSplineCurve.hxx>
+#include <TColStd_HArray1OfReal.hxx>
+#include <TColgp_HArray1OfPnt.hxx>
+
+#include <gtest/gtest.h>
+#include <rapidcheck/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+
+using loom::Centerline;
+using loom::InterpolationOptions;
+using loom::KnotMethod;
+using loom::Vec3;
+
+namespace {
+
+std::vector<Vec3> random_walk(std::mt19937& rng, int n, double step) {
+  std::uniform_real_distribution<double> d(-1.0, 1.0);
+  std::vector<Vec3> p{Vec3(d(rng), d(rng), d(rng))};
+  for (int i = 1; i < n; ++i) {
+    Vec3 dir(d(rng) + 1.2, d(rng), d(rng));  // mostly forward: a cable-like route
+    p.push_back(p.back() + step * dir.normalized());
+  }
+  return p;
+}
+
+double scale_of(const std::vector<Vec3>& p) {
+  loom::AABB b;
+  for (const Vec3& q : p) b.extend(q);
+  return b.diagonal();
+}
+
+/// The same curve as an OpenCASCADE Geom_BSplineCurve (knots with multiplicities).
+Handle(Geom_BSplineCurve) to_occt(const Centerline& c) {
+  std::vector<double> k;
+  std::vector<int> m;
+  for (double u : c.knots()) {
+    if (!k.empty() && u == k.back())
+      ++m.back();
+    else {
+      k.push_back(u);
+      m.push_back(1);
+    }
+  }
+  TColgp_Array1OfPnt poles(1, static_cast<int>(c.control_points().size()));
+  for (int i = 0; i < poles.Length(); ++i) {
+    const Vec3& p = c.control_points()[i];
+    poles.SetValue(i + 1, gp_Pnt(p.x(), p.y(), p.z()));
+  }
+  TColStd_Array1OfReal knots(1, static_cast<int>(k.size()));
+  TColStd_Array1OfInteger mults(1, static_cast<int>(k.size()));
+  for (std::size_t i = 0; i < k.size(); ++i) {
+    knots.SetValue(static_cast<int>(i) + 1, k[i]);
+    mults.SetValue(static_cast<int>(i) + 1, m[i]);
+  }
+  return new Geom_BSplineCurve(poles, knots, mults, c.degree());
+}
+
+Vec3 v3(const gp_Pnt& p) { return Vec3(p.X(), p.Y(), p.Z()); }
+Vec3 v3(const gp_Vec& p) { return Vec3(p.X(), p.Y(), p.Z()); }
+
+/// Geometric distance from q to the helix (R cos t, R sin t, c t), by Newton from a start.
+double helix_distance(const Vec3& q, double R, double c, double t0) {
+  double t = t0;
+  for (int it = 0; it < 50; ++it) {
+    const Vec3 h(R * std::cos(t), R * std::sin(t), c * t);
+    const Vec3 d1(-R * std::sin(t), R * std::cos(t), c);
+    const Vec3 d2(-R * std::cos(t), -R * std::sin(t), 0);
+    const double f = (h - q).dot(d1), fp = d1.squaredNorm() + (h - q).dot(d2);
+    const double dt = f / fp;
+    t -= dt;
+    if (std::abs(dt) < 1e-15) break;
+  }
+  return (Vec3(R * std::cos(t), R * std::sin(t), c * t) - q).norm();
+}
+
+}  // namespace
+
+// --- interpolation --------------------------------------------------------------------
+
+TEST(Centerline, PassesThroughEveryKeyPoint) {
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 20; ++trial) {
+    const auto pts = random_walk(rng, 3 + trial, 0.1 + 0.05 * trial);
+    const double scale = scale_of(pts);
+    for (KnotMethod km : {KnotMethod::ChordLength, KnotMethod::HartleyJudd}) {
+      for (int ends = 0; ends < 2; ++ends) {
+        InterpolationOptions o;
+        o.knots = km;
+        if (ends) {
+          o.start_tangent = Vec3(1, 0.2, -0.1);
+          o.end_tangent = Vec3(0.3, 1, 0);
+        }
+        const Centerline c = Centerline::interpolate(pts, o);
+        ASSERT_EQ(c.key_parameters().size(), pts.size());
+        for (std::size_t i = 0; i < pts.size(); ++i)
+          EXPECT_LE((c.position(c.key_parameters()[i]) - pts[i]).norm(), 1e-9 * scale)
+              << "trial " << trial << " point " << i;
+        if (ends) {
+          EXPECT_NEAR(c.derivative(c.u_min(), 1).normalized().dot(o.start_tangent->normalized()), 1.0, 1e-12);
+          EXPECT_NEAR(c.derivative(c.u_max(), 1).normalized().dot(o.end_tangent->normalized()), 1.0, 1e-12);
+        } else {  // natural: C'' = 0 at both ends
+          EXPECT_LE(c.derivative(c.u_min(), 2).norm(), 1e-9 * c.derivative(c.u_min(), 1).norm() / scale * 100);
+          EXPECT_LE(c.derivative(c.u_max(), 2).norm(), 1e-9 * c.derivative(c.u_max(), 1).norm() / scale * 100);
+        }
+      }
+    }
+  }
+}
+
+TEST(Centerline, HartleyJuddAndChordLengthParametersDiffer) {
+  // Unequal chords: the two methods must give different (but both increasing) parameters.
+  const std::vector<Vec3> pts{{0, 0, 0}, {1, 0, 0}, {1.2, 0.3, 0}, {4, 1, 0}, {4.5, 3, 1}};
+  InterpolationOptions a, b;
+  b.knots = KnotMethod::HartleyJudd;
+  const Centerline ca = Centerline::interpolate(pts, a), cb = Centerline::interpolate(pts, b);
+  double diff = 0.0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    diff = std::max(diff, std::abs(ca.key_parameters()[i] - cb.key_parameters()[i]));
+    if (i > 0) {
+      EXPECT_GT(cb.key_parameters()[i], cb.key_parameters()[i - 1]);
+    }
+  }
+  EXPECT_GT(diff, 1e-3);
+  // Chord length: parameter steps equal the chords.
+  for (std::size_t i = 1; i < pts.size(); ++i)
+    EXPECT_NEAR(ca.key_parameters()[i] - ca.key_parameters()[i - 1], (pts[i] - pts[i - 1]).norm(), 1e-12);
+}
+
+TEST(Centerline, AgreesWithOpenCascadeInterpolation) {
+  // Same points, parameters and end derivatives → the same complete cubic spline.
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 10; ++trial) {
+    const auto pts = random_walk(rng, 4 + 3 * trial, 0.5);
+    for (KnotMethod km : {KnotMethod::ChordLength, KnotMethod::HartleyJudd}) {
+      InterpolationOptions o;
+      o.knots = km;
+      o.start_tangent = Vec3(1, 1, 0);
+      o.end_tangent = Vec3(0, 1, 1);
+      const Centerline c = Centerline::interpolate(pts, o);
+      Handle(TColgp_HArray1OfPnt) P = new TColgp_HArray1OfPnt(1, static_cast<int>(pts.size()));
+      Handle(TColStd_HArray1OfReal) U = new TColStd_HArray1OfReal(1, static_cast<int>(pts.size()));
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        P->SetValue(static_cast<int>(i) + 1, gp_Pnt(pts[i].x(), pts[i].y(), pts[i].z()));
+        U->SetValue(static_cast<int>(i) + 1, c.key_parameters()[i]);
+      }
+      GeomAPI_Interpolate gi(P, U, Standard_False, 1e-12);
+      const Vec3 t0 = c.derivative(c.u_min(), 1), t1 = c.derivative(c.u_max(), 1);
+      gi.Load(gp_Vec(t0.x(), t0.y(), t0.z()), gp_Vec(t1.x(), t1.y(), t1.z()), Standard_False);
+      gi.Perform();
+      ASSERT_TRUE(gi.IsDone());
+      const Handle(Geom_BSplineCurve) oc = gi.Curve();
+      const double scale = scale_of(pts);
+      double worst = 0.0;
+      for (int k = 0; k <= 2000; ++k) {
+        const double u = c.u_min() + (c.u_max() - c.u_min()) * k / 2000.0;
+        worst = std::max(worst, (c.position(u) - v3(oc->Value(u))).norm());
+        gp_Pnt p;
+        gp_Vec d1, d2;
+        oc->D2(u, p, d1, d2);
+        EXPECT_LE((c.derivative(u, 1) - v3(d1)).norm(), 1e-8 * (1 + v3(d1).norm()));
+        EXPECT_LE((c.derivative(u, 2) - v3(d2)).norm(), 1e-6 * (1 + v3(d2).norm()));
+      }
+      EXPECT_LE(worst, 1e-10 * scale) << "trial " << trial;
+    }
+  }
+}
+
+TEST(Centerline, ConvergesAsFourthPowerOnHelixAndCircle) {
+  // Points sampled from a helix and a circle with exact end tangents: the geometric error
+  // must fall ~16× per halving of the spacing (O(h⁴)).
+  const double R = 3.0, pitch = 0.4;
+  std::vector<double> err_helix, err_circle;
+  for (int n : {8, 16, 32, 64}) {
+    const double T = 2.0 * M_PI;
+    std::vector<Vec3> h, ci;
+    for (int i = 0; i <= n; ++i) {
+      const double t = T * i / n;
+      h.emplace_back(R * std::cos(t), R * std::sin(t), pitch * t);
+      ci.emplace_back(R * std::cos(0.75 * t), R * std::sin(0.75 * t), 0.0);
+    }
+    InterpolationOptions oh, oc;
+    oh.start_tangent = Vec3(0, R, pitch);
+    oh.end_tangent = Vec3(-R * std::sin(T), R * std::cos(T), pitch);
+    oc.start_tangent = Vec3(0, 1, 0);
+    oc.end_tangent = Vec3(-std::sin(0.75 * T), std::cos(0.75 * T), 0);
+    const Centerline chx = Centerline::interpolate(h, oh), ccl = Centerline::interpolate(ci, oc);
+    double eh = 0, ec = 0;
+    for (int k = 0; k <= 40 * n; ++k) {
+      const double uh = chx.u_min() + (chx.u_max() - chx.u_min()) * k / (40.0 * n);
+      const Vec3 q = chx.position(uh);
+      const double t0 = T * k / (40.0 * n);
+      eh = std::max(eh, helix_distance(q, R, pitch, t0));
+      const double uc = ccl.u_min() + (ccl.u_max() - ccl.u_min()) * k / (40.0 * n);
+      ec = std::max(ec, std::abs(ccl.position(uc).norm() - R));
+    }
+    err_helix.push_back(eh);
+    err_circle.push_back(ec);
+  }
+  for (std::size_t i = 1; i < err_helix.size(); ++i) {
+    const double oh = std::log2(err_helix[i - 1] / err_helix[i]);
+    const double oc = std::log2(err_circle[i - 1] / err_circle[i]);
+    EXPECT_GT(oh, 3.6) << "helix order at refinement " << i << " errors " << err_helix[i - 1] << " → " << err_helix[i];
+    EXPECT_GT(oc, 3.6) << "circle order at refinement " << i << " errors " << err_circle[i - 1] << " → " << err_circle[i];
+    EXPECT_LT(oh, 4.6);
+    EXPECT_LT(oc, 4.6);
+  }
+}
+
+// --- arc length, curvature, bend radius ---------------------------------------------------
+
+TEST(Centerline, ArcLengthMatchesOpenCascadeAndInverts) {
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 8; ++trial) {
+    const auto pts = random_walk(rng, 5 + trial, 1.0);
+    const Centerline c = Centerline::interpolate(pts);
+    GeomAdaptor_Curve ga(to_occt(c));
+    const double Locc = GCPnts_AbscissaPoint::Length(ga, c.u_min(), c.u_max(), 1e-13);
+    EXPECT_NEAR(c.length(), Locc, 1e-9 * Locc);
+    for (int k = 1; k < 20; ++k) {
+      const double u = c.u_min() + (c.u_max() - c.u_min()) * k / 20.0;
+      const double s = c.arc_length_at(u);
+      EXPECT_NEAR(s, GCPnts_AbscissaPoint::Length(ga, c.u_min(), u, 1e-13), 1e-9 * Locc);
+      EXPECT_NEAR(c.parameter_at_length(s), u, 1e-9 * (c.u_max() - c.u_min()));
+    }
+    EXPECT_EQ(c.parameter_at_length(-1.0), c.u_min());
+    EXPECT_EQ(c.parameter_at_length(2.0 * c.length()), c.u_max());
+  }
+}
+
+TEST(Centerline, SamplesAtEqualArcSpacing) {
+  std::mt19937 rng(8);
+  const auto pts = random_walk(rng, 9, 2.0);
+  const Centerline c = Centerline::interpolate(pts);
+  const double spacing = 0.37;
+  const auto smp = c.sample_by_arc_length(spacing);
+  ASSERT_GE(smp.size(), 2u);
+  const double step = c.length() / static_cast<double>(smp.size() - 1);
+  EXPECT_LE(step, spacing);
+  EXPECT_GT(step, spacing * 0.9);  // not needlessly dense
+  EXPECT_LE((smp.front().second - pts.front()).norm(), 1e-12);
+  EXPECT_LE((smp.back().second - pts.back()).norm(), 1e-9);
+  for (std::size_t i = 0; i < smp.size(); ++i) {
+    EXPECT_NEAR(smp[i].first, step * i, 1e-9 * c.length());
+    // The point is where the (independent) parameter_at_length puts it.
+    EXPECT_LE((smp[i].second - c.position(c.parameter_at_length(smp[i].first))).norm(), 1e-9 * c.length());
+  }
+  EXPECT_THROW(c.sample_by_arc_length(0.0), std::invalid_argument);
+  EXPECT_THROW(c.sample_by_arc_length(std::nan("")), std::invalid_argument);
+}
+
+TEST(Centerline, CurvatureMatchesOpenCascade) {
+  std::mt19937 rng(21);
+  const auto pts = random_walk(rng, 12, 1.0);
+  const Centerline c = Centerline::interpolate(pts, {KnotMethod::HartleyJudd, Vec3(1, 0, 0), std::nullopt});
+  const Handle(Geom_BSplineCurve) oc = to_occt(c);
+  for (int k = 0; k <= 500; ++k) {
+    const double u = c.u_min() + (c.u_max() - c.u_min()) * k / 500.0;
+    GeomLProp_CLProps props(oc, u, 2, 1e-12);
+    const double ko = props.Curvature();
+    EXPECT_NEAR(c.curvature(u), ko, 1e-9 * (1.0 + ko));
+  }
+}
+
+TEST(Centerline, MinBendRadiusAgreesWithBruteForce) {
+  std::mt19937 rng(42);
+  for (int trial = 0; trial < 10; ++trial) {
+    const auto pts = random_walk(rng, 6 + trial, 1.0);
+    const Centerline c = Centerline::interpolate(pts);
+    const loom::BendExtremum b = c.min_bend_radius();
+    double brute = std::numeric_limits<double>::infinity(), at = 0;
+    const int N = 200000;
+    for (int k = 0; k <= N; ++k) {
+      const double u = c.u_min() + (c.u_max() - c.u_min()) * k / N;
+      const double kap = c.curvature(u);
+      if (kap > 0 && 1.0 / kap < brute) {
+        brute = 1.0 / kap;
+        at = u;
+      }
+    }
+    // Brute force, refined by a fine grid around its best sample and around b.u (narrow
+    // curvature peaks fall between coarse samples).
+    const double h = (c.u_max() - c.u_min()) / N;
+    for (double centre : {at, b.u})
+      for (int k = -20000; k <= 20000; ++k) {
+        const double u = std::clamp(centre + 2.0 * h * k / 20000.0, c.u_min(), c.u_max());
+        const double kap = c.curvature(u);
+        if (kap > 0) brute = std::min(brute, 1.0 / kap);
+      }
+    EXPECT_LE(b.radius, brute * (1 + 1e-9)) << "trial " << trial;
+    EXPECT_GE(b.radius, brute * (1 - 1e-9)) << "trial " << trial;
+    EXPECT_NEAR(1.0 / c.curvature(b.u), b.radius, 1e-9 * b.radius);
+    EXPECT_NEAR(b.s, c.arc_length_at(b.u), 1e-9 * c.length());
+  }
+}
+
+TEST(Centerline, CircleThroughExactPointsHasItsRadius) {
+  // Many points on a circle of radius 5 → κ ≈ 1/5 everywhere away from the ends.
+  std::vector<Vec3> p;
+  for (int i = 0; i <= 200; ++i) p.emplace_back(5 * std::cos(0.01 * i), 5 * std::sin(0.01 * i), 0);
+  const Centerline c = Centerline::interpolate(p, {KnotMethod::ChordLength, Vec3(0, 1, 0),
+                                                   Vec3(-std::sin(2.0), std::cos(2.0), 0)});
+  EXPECT_NEAR(c.min_bend_radius().radius, 5.0, 5e-4);  // curvature converges as O(h²)
+  EXPECT_NEAR(c.length(), 10.0, 1e-8);
+}
+
+// --- degenerate input -------------------------------------------------------------------
+
+TEST(Centerline, TwoPointsGiveAStraightSegment) {
+  const Centerline c = Centerline::interpolate({Vec3(1, 2, 3), Vec3(4, 6, 3)});
+  EXPECT_NEAR(c.length(), 5.0, 1e-12);
+  EXPECT_EQ(c.curvature(0.5 * (c.u_min() + c.u_max())), 0.0);
+  EXPECT_TRUE(std::isinf(c.min_bend_radius().radius));
+  EXPECT_LE((c.position(c.parameter_at_length(2.5)) - Vec3(2.5, 4, 3)).norm(), 1e-12);
+  // With end tangents it bends, finitely.
+  const Centerline t = Centerline::interpolate({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {KnotMethod::ChordLength,
+                                                                               Vec3(0, 1, 0), Vec3(0, -1, 0)});
+  EXPECT_TRUE(std::isfinite(t.min_bend_radius().radius));
+  EXPECT_GT(t.length(), 1.0);
+}
+
+TEST(Centerline, RepeatedPointsAreMerged) {
+  const std::vector<Vec3> a{{0, 0, 0}, {1, 0, 0}, {2, 1, 0}, {3, 1, 1}};
+  const std::vector<Vec3> b{{0, 0, 0}, {0, 0, 0}, {1, 0, 0}, {2, 1, 0}, {2, 1, 0}, {2, 1, 0}, {3, 1, 1}};
+  const Centerline ca = Centerline::interpolate(a), cb = Centerline::interpolate(b);
+  ASSERT_EQ(cb.key_parameters().size(), b.size());
+  EXPECT_EQ(cb.key_parameters()[0], cb.key_parameters()[1]);
+  EXPECT_EQ(cb.key_parameters()[3], cb.key_parameters()[5]);
+  for (int k = 0; k <= 100; ++k) {
+    const double u = ca.u_min() + (ca.u_max() - ca.u_min()) * k / 100.0;
+    EXPECT_LE((ca.position(u) - cb.position(u)).norm(), 1e-12);
+  }
+  EXPECT_THROW(Centerline::interpolate({Vec3(1, 1, 1), Vec3(1, 1, 1), Vec3(1, 1, 1)}), std::invalid_argument);
+  EXPECT_THROW(Centerline::interpolate({Vec3(1, 1, 1)}), std::invalid_argument);
+  EXPECT_THROW(Centerline::interpolate({}), std::invalid_argument);
+}
+
+TEST(Centerline, CollinearPointsGiveAStraightLine) {
+  const Centerline c = Centerline::interpolate({Vec3(0, 0, 0), Vec3(1, 1, 1), Vec3(3, 3, 3), Vec3(3.5, 3.5, 3.5)});
+  EXPECT_TRUE(std::isinf(c.min_bend_radius().radius));
+  EXPECT_NEAR(c.length(), 3.5 * std::sqrt(3.0), 1e-12);
+  for (int k = 0; k <= 50; ++k) {
+    const Vec3 p = c.position(c.u_min() + (c.u_max() - c.u_min()) * k / 50.0);
+    EXPECT_NEAR(p.x(), p.y(), 1e-12);
+    EXPECT_NEAR(p.y(), p.z(), 1e-12);
+  }
+}
+
+TEST(Centerline, ReversalIsAFoldWithZeroBendRadius) {
+  // A 180° reversal: defined, finite, and reported as a fold (bend radius 0).
+  const Centerline c = Centerline::interpolate({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0), Vec3(1, 0, 0)});
+  const loom::BendExtremum b = c.min_bend_radius();
+  EXPECT_EQ(b.radius, 0.0);
+  EXPECT_NEAR(c.position(b.u).y(), 0.0, 1e-12);
+  for (int k = 0; k <= 200; ++k) {
+    const double u = c.u_min() + (c.u_max() - c.u_min()) * k / 200.0;
+    EXPECT_TRUE(loom::is_finite(c.position(u)));
+    EXPECT_TRUE(std::isfinite(c.curvature(u)));
+  }
+  // A slightly offset reversal is a finite tight bend.
+  const Centerline d = Centerline::interpolate({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 0.01, 0), Vec3(0, 0.01, 0)});
+  EXPECT_GT(d.min_bend_radius().radius, 0.0);
+  EXPECT_LT(d.min_bend_radius().radius, 0.5);
+}
+
+TEST(Centerline, ClosedLoopClosesAndStaysFinite) {
+  std::vector<Vec3> p;
+  for (int i = 0; i < 8; ++i) p.emplace_back(std::cos(i * M_PI / 4), std::sin(i * M_PI / 4), 0.1 * (i % 2));
+  p.push_back(p.front());
+  const Centerline c = Centerline::interpolate(p, {KnotMethod::HartleyJudd, Vec3(0, 1, 0), Vec3(0, 1, 0)});
+  EXPECT_LE((c.position(c.u_min()) - c.position(c.u_max())).norm(), 1e-12);
+  EXPECT_NEAR(c.derivative(c.u_min(), 1).normalized().dot(c.derivative(c.u_max(), 1).normalized()), 1.0, 1e-12);
+  EXPECT_GT(c.min_bend_radius().radius, 0.1);
+  EXPECT_TRUE(std::isfinite(c.length()));
+}
+
+TEST(Centerline, NonFiniteInputIsRejectedWithAReason) {
+  const double nan = std::nan(""), inf = std::numeric_limits<double>::infinity();
+  try {
+    Centerline::interpolate({Vec3(0, 0, 0), Vec3(1, nan, 0), Vec3(2, 0, 0)});
+    FAIL() << "NaN accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("key point 1 is not finite"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(Centerline::interpolate({Vec3(0, 0, 0), Vec3(inf, 0, 0)}), std::invalid_argument);
+  EXPECT_THROW(Centerline::polyline({Vec3(0, 0, 0), Vec3(nan, 0, 0)}), std::invalid_argument);
+  EXPECT_THROW(Centerline::interpolate({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {KnotMethod::ChordLength, Vec3(nan, 0, 0),
+                                                                        std::nullopt}),
+               std::invalid_argument);
+  EXPECT_THROW(Centerline::interpolate({Vec3(0, 0, 0), Vec3(1, 0, 0)}, {KnotMethod::ChordLength, Vec3(0, 0, 0),
+                                                                        std::nullopt}),
+               std::invalid_argument);
+  // Raw-data constructor checks.
+  const std::vector<Vec3> cp{{0, 0, 0}, {1, 0, 0}, {2, 1, 0}, {3, 1, 0}};
+  EXPECT_NO_THROW(Centerline(3, {0, 0, 0, 0, 1, 1, 1, 1}, cp));
+  EXPECT_THROW(Centerline(3, {0, 0, 0, 1, 1, 1, 1}, cp), std::invalid_argument);
+  EXPECT_THROW(Centerline(3, {0, 0, 0, 0, 1, 0.5, 1, 1}, cp), std::invalid_argument);
+  EXPECT_THROW(Centerline(3, {0, 0, 0, 0, 0, 0, 0, 0}, cp), std::invalid_argument);
+  EXPECT_THROW(Centerline(3, {0, 0, 0, 0, 1, 1, 1, 1}, {cp[0], cp[1], Vec3(nan, 0, 0), cp[3]}),
+               std::invalid_argument);
+}
+
+TEST(Centerline, PolylineIsExactAndKinksHaveZeroRadius) {
+  const Centerline c = Centerline::polyline({Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(2, 3, 0), Vec3(2, 3, 0)});
+  EXPECT_EQ(c.degree(), 1);
+  EXPECT_NEAR(c.length(), 5.0, 1e-12);
+  EXPECT_LE((c.position(c.parameter_at_length(3.0)) - Vec3(2, 1, 0)).norm(), 1e-12);
+  const loom::BendExtremum b = c.min_bend_radius();
+  EXPECT_EQ(b.radius, 0.0);
+  EXPECT_NEAR(b.s, 2.0, 1e-12);
+  const Centerline straight = Centerline::polyline({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0)});
+  EXPECT_TRUE(std::isinf(straight.min_bend_radius().radius));
+}
+
+TEST(Centerline, BasisFunctionsFormAPartitionOfUnity) {
+  const std::vector<double> U{0, 0, 0, 0, 0.3, 0.5, 0.5, 0.9, 1, 1, 1, 1};
+  double d[3 * 4];
+  for (int k = 0; k <= 100; ++k) {
+    const double u = k / 100.0;
+    loom::bspline_basis(U, 3, u, 2, d);
+    EXPECT_NEAR(d[0] + d[1] + d[2] + d[3], 1.0, 1e-14);
+    EXPECT_NEAR(d[4] + d[5] + d[6] + d[7], 0.0, 1e-11);
+    EXPECT_NEAR(d[8] + d[9] + d[10] + d[11], 0.0, 1e-9);
+  }
+}
+
+// --- properties -----------------------------------------------------------------------
+
+RC_GTEST_PROP(CenterlineProperty, InterpolatesFiniteAndLongerThanItsPolygon, ()) {
+  const int n = *rc::gen::inRange(2, 25);
+  const auto coords = *rc::gen::container<std::vector<int>>(3 * n, rc::gen::inRange(-1000, 1000));
+  const bool hj = *rc::gen::arbitrary<bool>();
+  const bool tangents = *rc::gen::arbitrary<bool>();
+  std::vector<Vec3> p;
+  for (int i = 0; i < n; ++i) p.emplace_back(coords[3 * i] * 0.01, coords[3 * i + 1] * 0.01, coords[3 * i + 2] * 0.01);
+  // Duplicate a random point now and then (zero chords).
+  if (n > 2 && *rc::gen::arbitrary<bool>()) p.insert(p.begin() + n / 2, p[n / 2]);
+  std::vector<Vec3> distinct;
+  for (const Vec3& q : p)
+    if (distinct.empty() || (q - distinct.back()).norm() > 1e-9) distinct.push_back(q);
+  RC_PRE(distinct.size() >= 2u);
+  InterpolationOptions o;
+  o.knots = hj ? KnotMethod::HartleyJudd : KnotMethod::ChordLength;
+  if (tangents) {
+    o.start_tangent = Vec3(1, 0, 0);
+    o.end_tangent = Vec3(0, 0, 1);
+  }
+  const Centerline c = Centerline::interpolate(p, o);
+  const double scale = scale_of(p);
+  double poly = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    RC_ASSERT((c.position(c.key_parameters()[i]) - p[i]).norm() <= 1e-9 * scale);
+    if (i > 0) poly += (p[i] - p[i - 1]).norm();
+  }
+  RC_ASSERT(c.length() >= poly * (1 - 1e-12));
+  double prev = 0.0;
+  for (int k = 0; k <= 64; ++k) {
+    const double u = c.u_min() + (c.u_max() - c.u_min()) * k / 64.0;
+    RC_ASSERT(loom::is_finite(c.position(u)));
+    RC_ASSERT(loom::is_finite(c.derivative(u, 3)));
+    RC_ASSERT(std::isfinite(c.curvature(u)));
+    const double s = c.arc_length_at(u);
+    RC_ASSERT(s >= prev - 1e-12 * c.length());
+    prev = s;
+  }
+  const loom::BendExtremum b = c.min_bend_radius();
+  RC_ASSERT(!std::isnan(b.radius));
+  RC_ASSERT(b.radius >= 0.0);
+}

@@ -1,0 +1,293 @@
+// EmbreeIndex and BruteForceIndex against each other and against closed forms: random
+// scenes with fixed seeds, inside tests against the winding-number oracle (points near
+// edges and vertices), an aircraft-sized offset scene, degenerate meshes, real data, and
+// rapidcheck properties of the interface contract.
+#include "index/brute_force_index.hpp"
+#include "index/embree_index.hpp"
+#include "index/triangle_distance.hpp"
+#include "index_conformance.hpp"
+#include "index_test_meshes.hpp"
+
+#include "core/error.hpp"
+
+#include <gtest/gtest.h>
+#include <rapidcheck/gtest.h>
+
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <random>
+
+using namespace loom;
+using namespace loom::testmesh;
+
+namespace {
+
+/// Embree distances are computed in double on the exact triangles: far better than the
+/// issue's 1e-5 relative bound, which is what we assert.
+constexpr double kEmbreeRel = 1e-5;
+
+std::vector<Part> mixed_scene(const Vec3& offset) {
+  std::mt19937_64 rng(42);
+  std::vector<Part> parts;
+  parts.push_back(make_part("sphere", uv_sphere(offset + Vec3(0, 0, 0), 10, 24, 12), true));
+  parts.push_back(make_part("box", box(offset + Vec3(15, -5, -5), offset + Vec3(30, 5, 8)), true));
+  parts.push_back(make_part("torus", torus(offset + Vec3(-25, 10, 0), 10, 3, 32, 12), true));
+  parts.push_back(make_part("soup", random_soup(rng, 300, offset + Vec3(-40, -40, -20), offset + Vec3(40, 40, 20), 4), false));
+  return parts;
+}
+
+AABB scene_box(const std::vector<Part>& parts) {
+  AABB b;
+  for (const auto& p : parts) b.extend(p.mesh.bounds());
+  return b;
+}
+
+}  // namespace
+
+TEST(TestMeshes, GeneratorsAreClosedAndOutward) {
+  for (Mesh m : {uv_sphere(Vec3::Zero(), 1, 16, 8), box(Vec3::Zero(), Vec3::Ones()), torus(Vec3::Zero(), 3, 1, 16, 8)}) {
+    weld_identical_vertices(m);
+    EXPECT_TRUE(analyse_topology(m).closed);
+    EXPECT_GT(m.signed_volume(), 0.0);
+  }
+}
+
+TEST(EmbreeIndex, MatchesBruteForceOnRandomScene) {
+  const auto parts = mixed_scene(Vec3::Zero());
+  const EmbreeIndex e(parts);
+  const BruteForceIndex b(parts);
+  EXPECT_EQ(e.part_count(), 4);
+  EXPECT_EQ(e.triangle_count(), b.part_count() > 0 ? e.triangle_count() : 0u);
+  std::mt19937_64 rng(5);
+  const AABB box = scene_box(parts);
+  const auto pts = random_points(rng, box, 10, 400);
+  expect_distances_match(e, b, pts, kEmbreeRel, 1e-3);
+  expect_rays_match(e, b, pts, kEmbreeRel, 1e-3);
+  // Batch forms agree with the single queries, on 1 and 2 threads.
+  for (int threads : {1, 2}) {
+    const auto hits = e.closest_batch(pts, 5.0, threads);
+    const auto ins = e.inside_batch(pts, threads);
+    const auto within = e.any_within_batch(pts, 2.0, threads);
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const ClosestHit h = e.closest(pts[i], 5.0);
+      ASSERT_EQ(hits[i].found(), h.found());
+      if (h.found()) {
+        EXPECT_EQ(hits[i].distance, h.distance);
+      }
+      EXPECT_EQ(ins[i] != 0, e.inside(pts[i]));
+      EXPECT_EQ(within[i] != 0, e.any_within(pts[i], 2.0));
+    }
+  }
+}
+
+TEST(EmbreeIndex, AircraftSizedOffsetKeepsPrecision) {
+  // 40 m away from the origin in mm: float coordinates would lose ~4e-3 mm; re-centring
+  // and double kernels keep the brute-force answer.
+  const Vec3 offset(40000.0, -25000.0, 12000.0);
+  const auto parts = mixed_scene(offset);
+  const EmbreeIndex e(parts);
+  const BruteForceIndex b(parts);
+  std::mt19937_64 rng(6);
+  const auto pts = random_points(rng, scene_box(parts), 5, 200);
+  for (const Vec3& p : pts) {
+    const ClosestHit he = e.closest(p), hb = b.closest(p);
+    ASSERT_TRUE(he.found());
+    EXPECT_NEAR(he.distance, hb.distance, 1e-9);
+  }
+  expect_distances_match(e, b, pts, kEmbreeRel, 1e-3);
+  EXPECT_LT(e.accuracy().abs_error, 1e-9);
+  EXPECT_TRUE(e.accuracy().exact);
+}
+
+TEST(EmbreeIndex, InsideAgreesWithWindingNumberNearEdgesAndVertices) {
+  const auto parts = mixed_scene(Vec3(0.5, 0.25, 0.125));
+  const EmbreeIndex e(parts);
+  const BruteForceIndex b(parts);
+  std::mt19937_64 rng(8);
+  std::vector<Vec3> pts = random_points(rng, scene_box(parts), 2, 2000);
+  // Points just off vertices and edge midpoints of the closed parts (the rays from these
+  // pass near edges and vertices), at offsets down to 1e-4 of the part size.
+  std::normal_distribution<double> n01;
+  for (int part = 0; part < 3; ++part) {
+    const Mesh& m = parts[part].mesh;
+    for (std::size_t t = 0; t < m.triangle_count(); t += 3) {
+      const auto c = m.corners(t);
+      for (const Vec3& base : {c[0], Vec3(0.5 * (c[0] + c[1]))})
+        for (double eps : {1e-2, 1e-3, 1e-4}) pts.push_back(base + eps * Vec3(n01(rng), n01(rng), n01(rng)).normalized());
+    }
+  }
+  // Points closer to a face than float rounding of the coordinates (1e-6, 1e-8 of a
+  // 40-unit scene), on both sides: the answer must follow the exact side.
+  std::vector<std::pair<Vec3, bool>> sided;
+  for (int part = 0; part < 3; ++part) {
+    const Mesh& m = parts[part].mesh;
+    for (std::size_t t = 1; t < m.triangle_count(); t += 7) {
+      const auto c = m.corners(t);
+      const Vec3 centroid = (c[0] + c[1] + c[2]) / 3.0;
+      const Vec3 n = (c[1] - c[0]).cross(c[2] - c[0]).normalized();
+      for (double eps : {1e-6, 1e-8}) {
+        sided.emplace_back(centroid + eps * n, false);
+        sided.emplace_back(centroid - eps * n, true);
+      }
+    }
+  }
+  for (const auto& [p, in] : sided) {
+    EXPECT_EQ(b.inside(p), in) << p.transpose();
+    EXPECT_EQ(e.inside(p), in) << p.transpose();
+  }
+  int inside_count = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    int pe = -1, pb = -1;
+    const bool ie = e.inside(pts[i], &pe), ib = b.inside(pts[i], &pb);
+    ASSERT_EQ(ie, ib) << "point " << i << " (" << pts[i].transpose() << ")";
+    if (ib) {
+      ++inside_count;
+      EXPECT_EQ(pe, pb);
+    }
+  }
+  EXPECT_GT(inside_count, 100);
+  // The soup is open: no inside even at its centre of mass.
+  int part = -1;
+  EXPECT_FALSE(BruteForceIndex({parts[3]}).inside(parts[3].mesh.bounds().center(), &part));
+  EXPECT_FALSE(EmbreeIndex({parts[3]}).inside(parts[3].mesh.bounds().center(), &part));
+}
+
+TEST(EmbreeIndex, RaysThroughVerticesAndEdgesOfABox) {
+  // Axis-aligned box: points on the grid of its vertex coordinates make axis rays hit
+  // edges exactly; the fixed non-axis inside rays and the majority must still be right.
+  std::vector<Part> parts{make_part("box", box(Vec3(0, 0, 0), Vec3(2, 2, 2)), true)};
+  const EmbreeIndex e(parts);
+  const BruteForceIndex b(parts);
+  for (double x : {-1.0, 0.5, 1.0, 1.5, 3.0})
+    for (double y : {-1.0, 0.5, 1.0, 1.5, 3.0})
+      for (double z : {-1.0, 0.5, 1.0, 1.5, 3.0}) {
+        const Vec3 p(x, y, z);
+        EXPECT_EQ(e.inside(p), b.inside(p)) << p.transpose();
+        EXPECT_EQ(e.inside(p), (p.array() > 0).all() && (p.array() < 2).all());
+      }
+  // Closed-form distances and rays.
+  EXPECT_NEAR(e.closest(Vec3(1, 1, 5)).distance, 3.0, 1e-12);
+  EXPECT_NEAR(e.closest(Vec3(3, 3, 3)).distance, std::sqrt(3.0), 1e-12);
+  EXPECT_NEAR(e.closest(Vec3(1, 1, 1)).distance, 1.0, 1e-12);
+  const RayHit r = e.ray(Vec3(1, 1, 5), Vec3(0, 0, -3));
+  ASSERT_TRUE(r.found());
+  EXPECT_NEAR(r.t, 3.0, 1e-12);
+  EXPECT_NEAR(r.normal.z(), 1.0, 1e-12);
+  EXPECT_FALSE(e.ray(Vec3(1, 1, 5), Vec3(0, 0, 1)).found());
+  EXPECT_FALSE(e.ray(Vec3(1, 1, 5), Vec3(0, 0, -1), 2.5).found());
+  EXPECT_THROW(e.ray(Vec3(1, 1, 5), Vec3::Zero()), std::invalid_argument);
+  // A capsule along the top face at height 0.5 above it.
+  EXPECT_TRUE(e.segment_within(Vec3(-5, 1, 2.5), Vec3(5, 1, 2.5), 0.5));
+  EXPECT_FALSE(e.segment_within(Vec3(-5, 1, 2.5), Vec3(5, 1, 2.5), 0.499));
+  double s = -1;
+  const ClosestHit sc = e.segment_closest(Vec3(-5, 1, 2.5), Vec3(5, 1, 2.5), 10.0, &s);
+  ASSERT_TRUE(sc.found());
+  EXPECT_NEAR(sc.distance, 0.5, 1e-12);
+  EXPECT_GE(s, 0.5 - 1e-12);
+  EXPECT_LE(s, 0.7 + 1e-12);
+}
+
+TEST(EmbreeIndex, DegenerateMeshes) {
+  // Zero-area triangles, duplicate vertices, a single triangle, an empty part.
+  Mesh degenerate;
+  degenerate.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0), Vec3(1, 0, 0), Vec3(5, 5, 5)};
+  degenerate.triangles = {{0, 1, 2}, {1, 3, 1}, {4, 4, 4}};
+  Mesh single;
+  single.vertices = {Vec3(0, 0, 3), Vec3(1, 0, 3), Vec3(0, 1, 3)};
+  single.triangles = {{0, 1, 2}};
+  std::vector<Part> parts{make_part("degenerate", degenerate, false), make_part("single", single, false),
+                          make_part("empty", Mesh{}, false)};
+  const EmbreeIndex e(parts);
+  const BruteForceIndex b(parts);
+  EXPECT_NEAR(e.closest(Vec3(1, 1, 0)).distance, 1.0, 1e-12);
+  EXPECT_NEAR(e.closest(Vec3(5, 5, 6)).distance, 1.0, 1e-12);  // the point triangle
+  EXPECT_EQ(e.closest(Vec3(5, 5, 6)).part, 0);
+  EXPECT_NEAR(e.closest(Vec3(0.2, 0.2, 4)).distance, 1.0, 1e-12);
+  EXPECT_FALSE(e.closest_on_part(Vec3(0, 0, 0), 2).found());
+  EXPECT_THROW(e.closest_on_part(Vec3(0, 0, 0), 3), std::out_of_range);
+  EXPECT_FALSE(e.inside(Vec3(0.2, 0.2, 3)));
+  std::mt19937_64 rng(9);
+  const auto pts = random_points(rng, scene_box(parts), 2, 200);
+  expect_distances_match(e, b, pts, kEmbreeRel, 1e-3);
+
+  // Empty scene: nothing found, nothing inside, no hits.
+  const EmbreeIndex empty(std::vector<Part>{});
+  EXPECT_EQ(empty.part_count(), 0);
+  EXPECT_FALSE(empty.closest(Vec3::Zero()).found());
+  EXPECT_FALSE(empty.any_within(Vec3::Zero(), 1e9));
+  EXPECT_FALSE(empty.segment_within(Vec3::Zero(), Vec3::Ones(), 1e9));
+  EXPECT_FALSE(empty.segment_closest(Vec3::Zero(), Vec3::Ones()).found());
+  EXPECT_FALSE(empty.ray(Vec3::Zero(), Vec3::UnitX()).found());
+  EXPECT_FALSE(empty.inside(Vec3::Zero()));
+  EXPECT_TRUE(empty.closest_batch({Vec3::Zero()}, 1.0)[0].part == -1);
+}
+
+TEST(EmbreeIndex, ConcurrentFirstUseOfPartScenes) {
+  // closest_on_part builds each part's scene lazily (std::call_once): hammer it from
+  // several threads on a fresh index and compare with brute force.
+  const auto parts = mixed_scene(Vec3(1, 2, 3));
+  const EmbreeIndex e(parts);
+  const BruteForceIndex b(parts);
+  std::mt19937_64 rng(24);
+  const auto pts = random_points(rng, scene_box(parts), 5, 2000);
+  std::vector<double> got(pts.size(), -1.0);
+  tbb::parallel_for(std::size_t(0), pts.size(), [&](std::size_t i) {
+    const ClosestHit h = e.closest_on_part(pts[i], static_cast<int>(i % parts.size()));
+    got[i] = h.found() ? h.distance : -2.0;
+  });
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    ASSERT_NEAR(got[i], b.closest_on_part(pts[i], static_cast<int>(i % parts.size())).distance, 1e-9) << i;
+}
+
+TEST(EmbreeIndex, RejectsBadMeshes) {
+  Mesh bad;
+  bad.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0)};
+  bad.triangles = {{0, 1, 2}};
+  EXPECT_THROW(EmbreeIndex({make_part("bad", bad, false)}), InputError);
+  bad.vertices.push_back(Vec3(std::nan(""), 0, 0));
+  EXPECT_THROW(EmbreeIndex({make_part("nan", bad, false)}), InputError);
+}
+
+TEST(EmbreeIndex, RealMeshFromSharedData) {
+  Mesh m = read_obj(std::string(LOOM_SHARED_DATA) + "/fcl/env.obj");
+  ASSERT_GT(m.triangle_count(), 1000u);
+  weld_identical_vertices(m);
+  const bool closed = analyse_topology(m).closed;
+  std::vector<Part> parts{make_part("env", m, closed)};
+  const EmbreeIndex e(parts);
+  const BruteForceIndex b(parts);
+  std::mt19937_64 rng(10);
+  const AABB box = m.bounds();
+  const auto pts = random_points(rng, box, 0.05 * box.diagonal(), 150);
+  expect_distances_match(e, b, pts, kEmbreeRel, 1e-6 * box.diagonal());
+  expect_rays_match(e, b, pts, kEmbreeRel, 1e-6 * box.diagonal());
+  for (const Vec3& p : pts) EXPECT_EQ(e.inside(p), b.inside(p)) << p.transpose();
+}
+
+RC_GTEST_PROP(EmbreeIndexProps, ClosestIsConsistentWithAnyWithinAndVertices, ()) {
+  static const std::vector<Part> parts = mixed_scene(Vec3::Zero());
+  static const EmbreeIndex e(parts);
+  const Vec3 p(*rc::gen::inRange(-500, 500) / 10.0, *rc::gen::inRange(-500, 500) / 10.0,
+               *rc::gen::inRange(-300, 300) / 10.0);
+  const ClosestHit h = e.closest(p);
+  RC_ASSERT(h.found());
+  RC_ASSERT(std::isfinite(h.distance));
+  // Never farther than any vertex of any part.
+  for (const Part& part : parts)
+    for (const Vec3& v : part.mesh.vertices) RC_ASSERT(h.distance <= (v - p).norm() + 1e-12);
+  // The reported point is at the reported distance and on the reported triangle.
+  RC_ASSERT(std::abs((h.point - p).norm() - h.distance) <= 1e-9);
+  const auto c = parts[h.part].mesh.corners(static_cast<std::size_t>(h.triangle));
+  RC_ASSERT(closest_point_on_triangle(h.point, c[0], c[1], c[2]).dist2 <= 1e-18);
+  RC_ASSERT(e.any_within(p, h.distance * (1 + 1e-9) + 1e-12));
+  if (h.distance > 1e-6) RC_ASSERT(!e.any_within(p, h.distance * (1 - 1e-9)));
+  // Inside a closed part ⇒ the distance to it is measured to its surface, and p is in its box.
+  int part = -1;
+  if (e.inside(p, &part)) RC_ASSERT(parts[part].mesh.bounds().contains(p));
+  // Segment distance ≤ each endpoint's distance.
+  const Vec3 q = p + Vec3(*rc::gen::inRange(-100, 100) / 10.0, *rc::gen::inRange(-100, 100) / 10.0, 0.0);
+  const ClosestHit s = e.segment_closest(p, q);
+  RC_ASSERT(s.found());
+  RC_ASSERT(s.distance <= h.distance + 1e-12);
+}

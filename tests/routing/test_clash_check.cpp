@@ -1,0 +1,624 @@
+// Clash checks against a test-only exact oracle (dense brute-force segment–triangle and
+// segment–segment distances), on scenes with known answers, adversarial scenes where the
+// paper's discrete method misses, and random scenes (rapidcheck).
+#include "routing/clash_check.hpp"
+
+#include "core/mesh.hpp"
+#include "index/brute_force_index.hpp"
+#include "index/embree_index.hpp"
+#include "index/triangle_distance.hpp"
+
+#include <gtest/gtest.h>
+#include <rapidcheck/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <random>
+#include <sstream>
+
+namespace loom {
+namespace {
+
+// ---------------------------------------------------------------------------------------
+// Scene building.
+
+/// Closed box [lo, hi] with outward counter-clockwise triangles.
+Mesh box_mesh(const Vec3& lo, const Vec3& hi) {
+  Mesh m;
+  for (int i = 0; i < 8; ++i)
+    m.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
+  const std::uint32_t f[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                                  {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  for (const auto& t : f) m.triangles.push_back({t[0], t[1], t[2]});
+  return m;
+}
+
+Part box_part(const std::string& name, const Vec3& lo, const Vec3& hi, PartRole role = PartRole::Structure) {
+  Part p;
+  p.name = name;
+  p.mesh = box_mesh(lo, hi);
+  p.role = role;
+  p.closed = analyse_topology(p.mesh).closed;
+  return p;
+}
+
+/// Open rectangle (two triangles) with corners o, o+u, o+u+v, o+v.
+Part sheet_part(const std::string& name, const Vec3& o, const Vec3& u, const Vec3& v) {
+  Part p;
+  p.name = name;
+  p.mesh.vertices = {o, o + u, o + u + v, o + v};
+  p.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  p.closed = false;
+  return p;
+}
+
+CableInput straight_cable(const std::string& id, const Vec3& a, const Vec3& b, double r) {
+  CableInput c;
+  c.id = id;
+  c.curve = Centerline::polyline({a, b});
+  c.radius = r;
+  return c;
+}
+
+/// Clamped uniform cubic B-spline with the given control points (≥ 4): a smooth centerline
+/// that does not depend on interpolation.
+Centerline cubic_from_controls(const std::vector<Vec3>& cps) {
+  const int n = static_cast<int>(cps.size());
+  std::vector<double> knots;
+  for (int i = 0; i < 4; ++i) knots.push_back(0.0);
+  for (int i = 1; i < n - 3; ++i) knots.push_back(static_cast<double>(i));
+  for (int i = 0; i < 4; ++i) knots.push_back(static_cast<double>(n - 3));
+  return Centerline(3, knots, cps);
+}
+
+// ---------------------------------------------------------------------------------------
+// The oracle: every centerline is cut into pieces of length ≤ h (chord error ≤ h²κ/8) and
+// compared with every triangle / every piece of every other cable.
+
+struct OracleCable {
+  std::vector<Vec3> p;
+  std::vector<double> s;
+};
+
+OracleCable dense(const Centerline& c, double h) {
+  OracleCable o;
+  for (const auto& sp : c.sample_by_arc_length(h)) {
+    o.s.push_back(sp.first);
+    o.p.push_back(sp.second);
+  }
+  return o;
+}
+
+/// Winding number of a closed mesh around p.
+double winding(const Mesh& m, const Vec3& p) {
+  double w = 0.0;
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    const auto c = m.corners(t);
+    w += triangle_solid_angle(p, c[0], c[1], c[2]);
+  }
+  return w / (4.0 * M_PI);
+}
+
+/// Smallest clearance of a cable to a part (dist 0 inside a closed part).
+double oracle_structure(const OracleCable& oc, double r, const Part& part) {
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k + 1 < oc.p.size(); ++k) {
+    for (std::size_t t = 0; t < part.mesh.triangles.size(); ++t) {
+      const auto c = part.mesh.corners(t);
+      best = std::min(best, closest_segment_triangle(oc.p[k], oc.p[k + 1], c[0], c[1], c[2]).dist2);
+    }
+  }
+  double d = std::sqrt(best);
+  if (part.closed)
+    for (const Vec3& p : oc.p)
+      if (winding(part.mesh, p) > 0.5) d = 0.0;
+  return d - r;
+}
+
+/// Smallest clearance between two cables (self: pairs with |s − t| ≥ π r). Blocks of 16
+/// pieces farther apart than `cap` are skipped (the answer is then ≥ cap − radii).
+double oracle_pair(const OracleCable& a, double ra, const OracleCable& b, double rb, bool self, double cap) {
+  constexpr std::size_t B = 16;
+  auto boxes = [&](const OracleCable& o) {
+    std::vector<AABB> out;
+    for (std::size_t i = 0; i + 1 < o.p.size(); i += B) {
+      AABB box;
+      for (std::size_t k = i; k <= std::min(o.p.size() - 1, i + B); ++k) box.extend(o.p[k]);
+      out.push_back(box);
+    }
+    return out;
+  };
+  const auto ba = boxes(a), bb = boxes(b);
+  double best = cap * cap;
+  for (std::size_t x = 0; x < ba.size(); ++x)
+    for (std::size_t y = 0; y < bb.size(); ++y) {
+      const Vec3 gap = (ba[x].min - bb[y].max).cwiseMax(bb[y].min - ba[x].max).cwiseMax(Vec3::Zero());
+      if (gap.squaredNorm() > best) continue;
+      for (std::size_t i = x * B; i < std::min(a.p.size() - 1, (x + 1) * B); ++i)
+        for (std::size_t j = y * B; j < std::min(b.p.size() - 1, (y + 1) * B); ++j) {
+          const auto r = closest_segment_segment(a.p[i], a.p[i + 1], b.p[j], b.p[j + 1]);
+          if (self) {
+            const double s = a.s[i] + r.s * (a.s[i + 1] - a.s[i]);
+            const double t = b.s[j] + r.t * (b.s[j + 1] - b.s[j]);
+            if (std::abs(s - t) < M_PI * ra) continue;
+          }
+          best = std::min(best, r.dist2);
+        }
+    }
+  return std::sqrt(best) - ra - rb;
+}
+
+bool has_structure_clash(const ClashResult& r, int cable, int part) {
+  for (const auto& e : r.clashes)
+    if (e.kind == ClashKind::CableStructure && e.cable == cable && e.part == part) return true;
+  return false;
+}
+const ClashEntry* find_clash(const ClashResult& r, ClashKind k, int cable, int other_or_part) {
+  for (const auto& e : r.clashes)
+    if (e.kind == k && e.cable == cable && (k == ClashKind::CableStructure ? e.part : e.other) == other_or_part)
+      return &e;
+  return nullptr;
+}
+
+enum class IndexKind { Embree, Brute };
+
+std::unique_ptr<ObstacleIndex> make_index(IndexKind k, const std::vector<Part>& parts) {
+  if (k == IndexKind::Embree) return std::make_unique<EmbreeIndex>(parts);
+  return std::make_unique<BruteForceIndex>(parts);
+}
+
+ClashResult run(const std::vector<CableInput>& cables, const std::vector<Part>& parts, ClashMethod m,
+                double tol, IndexKind ik = IndexKind::Embree, double clearance = 0.0, bool use_index = true) {
+  auto index = make_index(ik, parts);
+  ClashRequest req;
+  req.method = m;
+  req.tolerance = tol;
+  req.routing_clearance = clearance;
+  req.use_index = use_index;
+  req.threads = 2;
+  return check_clashes(cables, parts, index.get(), req);
+}
+
+constexpr double kTol = 0.01;
+constexpr double kR = 1.0;
+
+class ClashKnown : public ::testing::TestWithParam<IndexKind> {};
+
+// A cable along x above the top face z = 10 of a box at axis height 10 + r + delta.
+std::vector<CableInput> above_box(double delta) {
+  return {straight_cable("C", {-20, 5, 10 + kR + delta}, {30, 5, 10 + kR + delta}, kR)};
+}
+
+TEST_P(ClashKnown, TouchingClearAndPenetrating) {
+  const std::vector<Part> parts{box_part("box", {0, 0, 0}, {10, 10, 10})};
+  // Clear by +2·tol: nothing.
+  auto clear = run(above_box(2 * kTol), parts, ClashMethod::Certified, kTol, GetParam());
+  EXPECT_TRUE(clear.clashes.empty());
+  ASSERT_EQ(clear.cables.size(), 1u);
+  EXPECT_NEAR(clear.cables[0].min_clearance, 2 * kTol, kTol);
+  // Penetrating by 2·tol: one clash at clearance −2·tol ± tol.
+  auto pen = run(above_box(-2 * kTol), parts, ClashMethod::Certified, kTol, GetParam());
+  ASSERT_EQ(pen.clashes.size(), 1u);
+  EXPECT_EQ(pen.clashes[0].part, 0);
+  EXPECT_NEAR(pen.clashes[0].clearance, -2 * kTol, kTol);
+  EXPECT_GE(pen.clashes[0].s, 20.0 - kTol);
+  EXPECT_LE(pen.clashes[0].s, 30.0 + kTol);
+  EXPECT_NEAR(pen.clashes[0].point.z(), 10 + kR - 2 * kTol, 1e-9);
+  // Touching: whatever is reported is within ±tol of 0.
+  auto touch = run(above_box(0.0), parts, ClashMethod::Certified, kTol, GetParam());
+  for (const auto& e : touch.clashes) EXPECT_NEAR(e.clearance, 0.0, kTol);
+  EXPECT_LE(touch.clashes.size(), 1u);
+}
+
+TEST_P(ClashKnown, InsideClosedPartWithNoSurfaceNearby) {
+  const std::vector<Part> parts{box_part("hull", {-100, -100, -100}, {100, 100, 100})};
+  const std::vector<CableInput> cables{straight_cable("C", {-20, 0, 0}, {20, 0, 0}, kR)};
+  for (ClashMethod m : {ClashMethod::Certified, ClashMethod::Discrete}) {
+    auto r = run(cables, parts, m, kTol, GetParam());
+    ASSERT_EQ(r.clashes.size(), 1u) << clash_method_name(m);
+    EXPECT_TRUE(r.clashes[0].inside);
+    EXPECT_DOUBLE_EQ(r.clashes[0].clearance, -kR);
+    EXPECT_DOUBLE_EQ(r.cables[0].min_clearance, -kR);
+  }
+}
+
+TEST_P(ClashKnown, CrossingAWallIsOneStretchAtItsDeepestPoint) {
+  // A cable passing through a 4-wide wall: one clash stretch, inside, deepest in the middle.
+  const std::vector<Part> parts{box_part("wall", {-2, -50, -50}, {2, 50, 50})};
+  const std::vector<CableInput> cables{straight_cable("C", {-30, 0, 0}, {30, 0, 0}, kR)};
+  auto r = run(cables, parts, ClashMethod::Certified, kTol, GetParam());
+  ASSERT_EQ(r.clashes.size(), 1u);
+  EXPECT_TRUE(r.clashes[0].inside);
+  EXPECT_NEAR(r.clashes[0].s, 30.0, 1.0 + kTol);
+  EXPECT_NEAR(r.clashes[0].s_begin, 30.0 - 2 - kR, 1.0);
+  EXPECT_NEAR(r.clashes[0].s_end, 30.0 + 2 + kR, 1.0);
+}
+
+TEST_P(ClashKnown, ThinRodBetweenSamplesIsMissedByDiscreteOnly) {
+  // Discrete samples at x = 0, 2r, 4r, …; a 0.2-thick rod along z at x = r (midway),
+  // its near face at y = r − 2·tol below the axis y = 0... i.e. penetrating by 2·tol.
+  const double eps = 2 * kTol;
+  const std::vector<Part> parts{box_part("rod", {kR - 0.1, kR - eps, -20}, {kR + 0.1, kR - eps + 0.2, 20})};
+  const std::vector<CableInput> cables{straight_cable("C", {0, 0, 0}, {20 * kR, 0, 0}, kR)};
+  auto cert = run(cables, parts, ClashMethod::Certified, kTol, GetParam());
+  ASSERT_EQ(cert.clashes.size(), 1u);
+  EXPECT_NEAR(cert.clashes[0].clearance, -eps, kTol);
+  EXPECT_NEAR(cert.clashes[0].s, kR, 0.1 + kTol);
+  auto disc = run(cables, parts, ClashMethod::Discrete, kTol, GetParam());
+  EXPECT_TRUE(disc.clashes.empty()) << "the paper's method misses a rod between samples";
+  auto brute = run(cables, parts, ClashMethod::Discrete, kTol, GetParam(), 0.0, false);
+  EXPECT_TRUE(brute.clashes.empty());
+}
+
+TEST_P(ClashKnown, SheetEdgeGrazingBetweenSamplesIsMissedByDiscreteOnly) {
+  // An open sheet in the plane x = r, its edge at y = r − 2·tol: grazes the tube midway.
+  const double eps = 2 * kTol;
+  const std::vector<Part> parts{sheet_part("sheet", {kR, kR - eps, -30}, {0, 40, 0}, {0, 0, 60})};
+  const std::vector<CableInput> cables{straight_cable("C", {0, 0, 0}, {20 * kR, 0, 0}, kR)};
+  auto cert = run(cables, parts, ClashMethod::Certified, kTol, GetParam());
+  ASSERT_EQ(cert.clashes.size(), 1u);
+  EXPECT_FALSE(cert.clashes[0].inside);
+  EXPECT_NEAR(cert.clashes[0].clearance, -eps, kTol);
+  EXPECT_FALSE(cert.notes.empty());  // says the sheet is open
+  auto disc = run(cables, parts, ClashMethod::Discrete, kTol, GetParam());
+  EXPECT_TRUE(disc.clashes.empty());
+}
+
+TEST_P(ClashKnown, CablesCrossingBetweenSamples) {
+  // A along x at z = 0; B along y at height 2r − 2·tol, crossing at x = r, y = 0 with B's
+  // samples at y = ±r: every sample pair is farther than 2r.
+  const double eps = 2 * kTol;
+  const std::vector<CableInput> cables{straight_cable("A", {0, 0, 0}, {10 * kR, 0, 0}, kR),
+                                       straight_cable("B", {kR, -5 * kR, 2 * kR - eps}, {kR, 5 * kR, 2 * kR - eps}, kR)};
+  const std::vector<Part> parts{box_part("far", {100, 100, 100}, {101, 101, 101})};
+  auto cert = run(cables, parts, ClashMethod::Certified, kTol, GetParam());
+  const ClashEntry* e = find_clash(cert, ClashKind::CableCable, 0, 1);
+  ASSERT_NE(e, nullptr);
+  EXPECT_EQ(cert.clashes.size(), 1u);
+  EXPECT_NEAR(e->clearance, -eps, kTol);
+  EXPECT_NEAR(e->s, kR, 1e-6);
+  EXPECT_NEAR(e->s_other, 5 * kR, 1e-6);
+  auto disc = run(cables, parts, ClashMethod::Discrete, kTol, GetParam());
+  EXPECT_EQ(find_clash(disc, ClashKind::CableCable, 0, 1), nullptr) << "discrete misses the crossing";
+  // Clear by 2·tol: nothing.
+  const std::vector<CableInput> apart{cables[0], straight_cable("B", {kR, -5 * kR, 2 * kR + eps}, {kR, 5 * kR, 2 * kR + eps}, kR)};
+  EXPECT_TRUE(run(apart, parts, ClashMethod::Certified, kTol, GetParam()).clashes.empty());
+}
+
+TEST_P(ClashKnown, BundledCablesAreExcusedOnTheirSharedSegment) {
+  CableInput a = straight_cable("A", {0, 0, 0}, {50, 0, 0}, kR);
+  CableInput b = straight_cable("B", {0, 0, 0}, {50, 0, 0}, kR);
+  const std::vector<Part> parts{box_part("far", {100, 100, 100}, {101, 101, 101})};
+  auto r = run({a, b}, parts, ClashMethod::Certified, kTol, GetParam());
+  EXPECT_NE(find_clash(r, ClashKind::CableCable, 0, 1), nullptr);
+  a.segments = {{7, 0.0, 50.0}};
+  b.segments = {{7, 0.0, 50.0}};
+  for (ClashMethod m : {ClashMethod::Certified, ClashMethod::Discrete}) {
+    const auto res = run({a, b}, parts, m, kTol, GetParam());
+    EXPECT_TRUE(res.clashes.empty()) << clash_method_name(m) << " " << clash_kind_name(res.clashes[0].kind)
+                                     << " s=" << res.clashes[0].s << " t=" << res.clashes[0].s_other;
+  }
+}
+
+TEST_P(ClashKnown, SelfLoopFoundByBothMethods) {
+  // Goes along x, comes back 1.5·r above itself: |s − t| large, distance 1.5 r < 2 r.
+  CableInput c;
+  c.id = "L";
+  c.radius = kR;
+  c.curve = Centerline::polyline({{0, 0, 0}, {20, 0, 0}, {20, 0, 1.5 * kR}, {0, 0, 1.5 * kR}});
+  const std::vector<Part> parts{box_part("far", {100, 100, 100}, {101, 101, 101})};
+  for (ClashMethod m : {ClashMethod::Certified, ClashMethod::Discrete}) {
+    auto r = run({c}, parts, m, kTol, GetParam());
+    const ClashEntry* e = find_clash(r, ClashKind::Self, 0, 0);
+    ASSERT_NE(e, nullptr) << clash_method_name(m);
+    EXPECT_NEAR(e->clearance, -0.5 * kR, m == ClashMethod::Certified ? kTol : 0.5);
+  }
+  // A straight cable never touches itself.
+  auto straight = run({straight_cable("S", {0, 0, 0}, {50, 0, 0}, kR)}, parts, ClashMethod::Certified, kTol, GetParam());
+  EXPECT_TRUE(straight.clashes.empty());
+}
+
+TEST_P(ClashKnown, ClearanceAndKeepOut) {
+  std::vector<Part> parts{box_part("box", {0, 0, 0}, {10, 10, 10})};
+  // Clearance 1.0 with 2.0 required: a clearance violation, not a clash.
+  auto v = run(above_box(1.0), parts, ClashMethod::Certified, kTol, GetParam(), 2.0);
+  EXPECT_TRUE(v.clashes.empty());
+  ASSERT_EQ(v.violations.size(), 1u);
+  EXPECT_EQ(v.violations[0].kind, ViolationKind::Clearance);
+  EXPECT_NEAR(v.violations[0].value, 1.0, kTol);
+  EXPECT_DOUBLE_EQ(v.violations[0].limit, 2.0);
+  // Part clearance adds to the routing clearance.
+  parts[0].clearance = 1.5;
+  auto v2 = run(above_box(2.5), parts, ClashMethod::Certified, kTol, GetParam(), 2.0);
+  ASSERT_EQ(v2.violations.size(), 1u);
+  EXPECT_DOUBLE_EQ(v2.violations[0].limit, 3.5);
+  // Clearance 3.0 with 2.0 required: nothing.
+  parts[0].clearance = 0.0;
+  auto ok = run(above_box(3.0), parts, ClashMethod::Certified, kTol, GetParam(), 2.0);
+  EXPECT_TRUE(ok.violations.empty());
+  EXPECT_TRUE(ok.clashes.empty());
+  // Keep-out zone entered: a cable-structure clash flagged keep_out.
+  const std::vector<Part> zone{box_part("zone", {0, 0, 0}, {10, 10, 10}, PartRole::KeepOut)};
+  auto k = run({straight_cable("C", {-10, 5, 5}, {20, 5, 5}, kR)}, zone, ClashMethod::Certified, kTol, GetParam());
+  ASSERT_EQ(k.clashes.size(), 1u);
+  EXPECT_TRUE(k.clashes[0].keep_out);
+}
+
+TEST_P(ClashKnown, TwoContactsInOneClearanceStretchAreTwoClashes) {
+  // Dips into the box top twice (−0.1) and stays within the 2.0 clearance band between.
+  const std::vector<Part> parts{box_part("box", {0, 0, 0}, {10, 10, 10})};
+  const double lo = 10 + kR - 0.1, mid = 10 + kR + 0.5;
+  CableInput c;
+  c.id = "W";
+  c.radius = kR;
+  c.curve = Centerline::polyline({{-5, 5, 20}, {1, 5, lo}, {3, 5, lo}, {4, 5, mid}, {6, 5, mid}, {7, 5, lo},
+                                  {9, 5, lo}, {15, 5, 20}});
+  auto r = run({c}, parts, ClashMethod::Certified, kTol, GetParam(), 2.0);
+  ASSERT_EQ(r.clashes.size(), 2u);
+  for (const auto& e : r.clashes) EXPECT_NEAR(e.clearance, -0.1, kTol);
+  EXPECT_LT(r.clashes[0].s_end, r.clashes[1].s_begin);
+  EXPECT_TRUE(r.violations.empty());
+}
+
+TEST_P(ClashKnown, BendRadiusViolation) {
+  // Cubic B-spline whose control polygon is a fine regular polygon on a circle of radius
+  // 20: bend radius ≈ 20 away from the clamped ends (which straighten out).
+  std::vector<Vec3> pts;
+  for (int i = 0; i <= 24; ++i) pts.emplace_back(20 * std::cos(i * M_PI / 12), 20 * std::sin(i * M_PI / 12), 0);
+  CableInput c;
+  c.id = "B";
+  c.radius = kR;
+  c.curve = cubic_from_controls(pts);
+  c.min_bend_radius = 30;
+  const std::vector<Part> parts{box_part("far", {100, 100, 100}, {101, 101, 101})};
+  auto r = run({c}, parts, ClashMethod::Certified, kTol, GetParam());
+  // Oracle: smallest circumradius of three curve points h apart in u (independent of
+  // Centerline::min_bend_radius).
+  double oracle = std::numeric_limits<double>::infinity();
+  const double h = 1e-3;
+  for (double u = c.curve.u_min() + h; u < c.curve.u_max() - h; u += 1e-3) {
+    const Vec3 a = c.curve.position(u - h), b = c.curve.position(u), d = c.curve.position(u + h);
+    const double cr = (a - b).norm() * (b - d).norm() * (d - a).norm() / (2.0 * (b - a).cross(d - a).norm());
+    oracle = std::min(oracle, cr);
+  }
+  ASSERT_EQ(r.violations.size(), 1u);
+  EXPECT_EQ(r.violations[0].kind, ViolationKind::BendRadius);
+  EXPECT_NEAR(r.violations[0].value, oracle, 0.01 * oracle);
+  EXPECT_LT(oracle, 20.0);
+  c.min_bend_radius = 10;
+  EXPECT_TRUE(run({c}, parts, ClashMethod::Certified, kTol, GetParam()).violations.empty());
+}
+
+INSTANTIATE_TEST_SUITE_P(Indices, ClashKnown, ::testing::Values(IndexKind::Embree, IndexKind::Brute),
+                         [](const auto& param_info) { return param_info.param == IndexKind::Embree ? "Embree" : "Brute"; });
+
+TEST(ClashCheck, BadInputIsRejected) {
+  const std::vector<Part> parts{box_part("box", {0, 0, 0}, {1, 1, 1})};
+  BruteForceIndex idx(parts);
+  ClashRequest req;
+  CableInput no_curve;
+  no_curve.id = "X";
+  no_curve.radius = 1;
+  EXPECT_THROW(check_clashes({no_curve}, parts, &idx, req), std::invalid_argument);
+  CableInput zero = straight_cable("Z", {0, 0, 0}, {1, 0, 0}, 0.0);
+  EXPECT_THROW(check_clashes({zero}, parts, &idx, req), std::invalid_argument);
+  EXPECT_THROW(check_clashes({}, parts, nullptr, req), std::invalid_argument);
+  // No cables: nothing to report.
+  EXPECT_TRUE(check_clashes({}, parts, &idx, req).clashes.empty());
+}
+
+TEST(ClashCheck, DiscreteWithAndWithoutIndexAgree) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> U(-20, 20);
+  std::vector<Part> parts;
+  for (int i = 0; i < 4; ++i) {
+    const Vec3 lo(U(rng), U(rng), U(rng));
+    parts.push_back(box_part("b" + std::to_string(i), lo, lo + Vec3(6, 4, 5)));
+  }
+  std::vector<CableInput> cables;
+  for (int i = 0; i < 4; ++i) {
+    CableInput c;
+    c.id = "C" + std::to_string(i);
+    c.radius = 0.8 + 0.3 * i;
+    c.curve = cubic_from_controls({{U(rng), U(rng), U(rng)}, {U(rng), U(rng), U(rng)}, {U(rng), U(rng), U(rng)},
+                                   {U(rng), U(rng), U(rng)}});
+    cables.push_back(c);
+  }
+  auto a = run(cables, parts, ClashMethod::Discrete, kTol, IndexKind::Embree, 1.0, true);
+  auto b = run(cables, parts, ClashMethod::Discrete, kTol, IndexKind::Embree, 1.0, false);
+  ASSERT_EQ(a.clashes.size(), b.clashes.size());
+  for (std::size_t i = 0; i < a.clashes.size(); ++i) {
+    EXPECT_EQ(a.clashes[i].kind, b.clashes[i].kind);
+    EXPECT_EQ(a.clashes[i].part, b.clashes[i].part);
+    EXPECT_EQ(a.clashes[i].other, b.clashes[i].other);
+    EXPECT_NEAR(a.clashes[i].clearance, b.clashes[i].clearance, 1e-9);
+  }
+  EXPECT_EQ(a.violations.size(), b.violations.size());
+}
+
+// ---------------------------------------------------------------------------------------
+// Random scenes: certified has no miss and no false clash outside ±tolerance; discrete's
+// misses are counted (and there are some over the whole run).
+
+struct MissCount {
+  int certified_missed = 0, certified_false = 0, discrete_missed = 0, truth_clashes = 0;
+};
+MissCount g_miss;
+
+/// Returns a description of every disagreement with the oracle (empty: none).
+std::string random_scene_check(std::uint32_t seed) {
+  std::string fail;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> U(0, 1);
+  // Boxes and thin rods in disjoint cells of a 3×3×1 grid of 20-unit cells (no overlaps).
+  std::vector<Part> parts;
+  for (int cx = 0; cx < 3; ++cx)
+    for (int cy = 0; cy < 3; ++cy) {
+      if (U(rng) < 0.3) continue;
+      const Vec3 cell(cx * 20.0, cy * 20.0, 0.0);
+      const Vec3 lo = cell + Vec3(2 + 6 * U(rng), 2 + 6 * U(rng), 2 + 6 * U(rng));
+      const bool rod = U(rng) < 0.5;
+      const Vec3 size = rod ? Vec3(0.2 + 0.2 * U(rng), 0.2 + 0.2 * U(rng), 8.0) : Vec3(2 + 8 * U(rng), 2 + 8 * U(rng), 2 + 8 * U(rng));
+      parts.push_back(box_part("p" + std::to_string(parts.size()), lo, (lo + size).cwiseMin(cell + Vec3(19.5, 19.5, 19.5))));
+    }
+  if (parts.empty()) parts.push_back(box_part("p0", {5, 5, 5}, {8, 8, 8}));
+  std::vector<CableInput> cables;
+  const int nc = 2 + static_cast<int>(U(rng) * 2);
+  for (int i = 0; i < nc; ++i) {
+    std::vector<Vec3> pts;
+    for (int k = 0; k < 5; ++k) pts.emplace_back(60 * U(rng), 60 * U(rng), 20 * U(rng));
+    CableInput c;
+    c.id = "C" + std::to_string(i);
+    c.radius = 0.5 + 1.5 * U(rng);
+    c.curve = cubic_from_controls(pts);
+    cables.push_back(c);
+  }
+  const double tol = 0.02;
+  auto cert = run(cables, parts, ClashMethod::Certified, tol, IndexKind::Embree);
+  auto disc = run(cables, parts, ClashMethod::Discrete, tol, IndexKind::Embree);
+  // Oracle: pieces of 0.05 on curves of bend radius ≳ 1 deviate ≤ 0.0003.
+  std::vector<OracleCable> oc;
+  for (const auto& c : cables) oc.push_back(dense(c.curve, 0.05));
+  const double oracle_err = 0.001;
+  for (std::size_t c = 0; c < cables.size(); ++c) {
+    for (std::size_t p = 0; p < parts.size(); ++p) {
+      const double truth = oracle_structure(oc[c], cables[c].radius, parts[p]);
+      const bool cert_hit = has_structure_clash(cert, static_cast<int>(c), static_cast<int>(p));
+      const bool disc_hit = has_structure_clash(disc, static_cast<int>(c), static_cast<int>(p));
+      if (truth < -tol - oracle_err) {
+        ++g_miss.truth_clashes;
+        if (!cert_hit) fail += "seed " + std::to_string(seed) + ": missed cable " + std::to_string(c) + " part " +
+                               std::to_string(p) + " truth " + std::to_string(truth) + "\n";
+        if (!disc_hit) ++g_miss.discrete_missed;
+      }
+      if (truth > tol + oracle_err && cert_hit)
+        fail += "seed " + std::to_string(seed) + ": false clash cable " + std::to_string(c) + " part " +
+                std::to_string(p) + " truth " + std::to_string(truth) + "\n";
+    }
+    for (std::size_t d = c; d < cables.size(); ++d) {
+      const bool self = c == d;
+      const double truth = oracle_pair(oc[c], cables[c].radius, oc[d], cables[d].radius, self,
+                                       cables[c].radius + cables[d].radius + 1.0);
+      const ClashKind k = self ? ClashKind::Self : ClashKind::CableCable;
+      const bool cert_hit = find_clash(cert, k, static_cast<int>(c), static_cast<int>(d)) != nullptr;
+      // Self: the chord-level |s − t| rule blurs by one chord (≤ r); only judge clear cases.
+      const double margin = self ? cables[c].radius : 0.0;
+      if ((truth < -tol - oracle_err - margin && !cert_hit) || (truth > tol + oracle_err + margin && cert_hit))
+        fail += "seed " + std::to_string(seed) + (self ? ": self " : ": pair ") + std::to_string(c) + "/" +
+                std::to_string(d) + " truth " + std::to_string(truth) + " reported " + (cert_hit ? "yes" : "no") + "\n";
+      if (!self && truth < -tol - oracle_err) {
+        ++g_miss.truth_clashes;
+        if (find_clash(disc, k, static_cast<int>(c), static_cast<int>(d)) == nullptr) ++g_miss.discrete_missed;
+      }
+    }
+  }
+  return fail;
+}
+
+RC_GTEST_PROP(ClashRandom, CertifiedMatchesOracle, ()) {
+  const auto seed = *rc::gen::inRange<std::uint32_t>(0, 1u << 30);
+  const std::string fail = random_scene_check(seed);
+  RC_ASSERT(fail == "");
+}
+
+TEST(ClashRandom, DiscreteMissesAreCounted) {
+  // Fixed seeds; the counts are printed so that the paper's failure is documented.
+  g_miss = {};
+  for (std::uint32_t seed = 1; seed <= 40; ++seed) EXPECT_EQ(random_scene_check(seed), "");
+  std::printf("random scenes: %d true clashes, discrete missed %d\n", g_miss.truth_clashes, g_miss.discrete_missed);
+  EXPECT_GT(g_miss.truth_clashes, 0);
+  EXPECT_GT(g_miss.discrete_missed, 0) << "the discrete method is expected to miss some clashes";
+}
+
+// ---------------------------------------------------------------------------------------
+// `loom audit` through the binary: exit codes and report.json on tiny scenes.
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int status = -1;
+  std::string report;  ///< report.json text ("" if not written)
+};
+
+CliRun loom_audit(const std::string& args, const std::string& tag) {
+  const fs::path out = fs::temp_directory_path() / ("loom-test-audit-" + tag + "-" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  const std::string cmd = std::string(LOOM_EXE) + " audit " + args + " --quiet --out " + out.string() + " 2>/dev/null";
+  CliRun r;
+  const int raw = std::system(cmd.c_str());
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  std::ifstream in(out / "report.json");
+  if (in) {
+    std::stringstream ss;
+    ss << in.rdbuf();
+    r.report = ss.str();
+  }
+  fs::remove_all(out);
+  return r;
+}
+
+const std::string kAuditData = std::string(LOOM_TEST_DATA) + "/audit/";
+
+TEST(AuditCli, CleanSceneExitsZeroWithAFullReport) {
+  const CliRun r = loom_audit(kAuditData + "clean.toml", "clean");
+  ASSERT_EQ(r.status, 0);
+  ASSERT_FALSE(r.report.empty());
+  EXPECT_EQ(r.report.find("null"), std::string::npos) << "no NaN/inf (written as null) in the report";
+  const auto j = nlohmann::json::parse(r.report);
+  EXPECT_EQ(j["scene"], "tiny-clean");
+  EXPECT_EQ(j["units"], "mm");
+  EXPECT_EQ(j["method"], "certified");
+  EXPECT_DOUBLE_EQ(j["tolerance"].get<double>(), 0.01);  // radius 1 / 100
+  EXPECT_TRUE(j["clashes"].empty());
+  EXPECT_TRUE(j["violations"].empty());
+  ASSERT_EQ(j["cables"].size(), 1u);
+  EXPECT_EQ(j["cables"][0]["id"], "C1");
+  EXPECT_TRUE(j["cables"][0]["routed"].get<bool>());
+  EXPECT_NEAR(j["cables"][0]["length"].get<double>(), 50.0, 1e-9);
+  for (const char* k : {"load", "index", "route", "check"}) EXPECT_TRUE(j["timing_ms"].contains(k)) << k;
+  EXPECT_GT(j["counters"]["distance_queries"].get<long>(), 0);
+}
+
+TEST(AuditCli, ClashExitsOne) {
+  for (const char* extra : {"", "--method discrete", "--no-index", "--method discrete --spacing 0.5 --threads 1"}) {
+    const CliRun r = loom_audit(kAuditData + "clash.toml " + extra, "clash");
+    ASSERT_EQ(r.status, 1) << extra;
+    const auto j = nlohmann::json::parse(r.report);
+    ASSERT_EQ(j["clashes"].size(), 1u) << extra;
+    const auto& c = j["clashes"][0];
+    EXPECT_EQ(c["kind"], "cable-structure");
+    EXPECT_EQ(c["cable"], "C1");
+    EXPECT_EQ(c["part"], "box");
+    EXPECT_DOUBLE_EQ(c["clearance"].get<double>(), -1.0);  // axis inside: dist 0, clearance −r
+    // Inside a closed part every point is equally deep (dist 0): s lies in the box.
+    EXPECT_GE(c["s"].get<double>(), 20.0 - 1.0);
+    EXPECT_LE(c["s"].get<double>(), 30.0 + 1.0);
+    EXPECT_EQ(c["point"].size(), 3u);
+  }
+}
+
+TEST(AuditCli, RoutesReplaceTheHarness) {
+  EXPECT_EQ(loom_audit(kAuditData + "clean.toml --routes " + kAuditData + "harness_clash.xml", "routes").status, 1);
+  EXPECT_EQ(loom_audit(kAuditData + "clash.toml --routes " + kAuditData + "harness_clear.xml", "routes2").status, 0);
+}
+
+TEST(AuditCli, BadInputExitsTwoAndWritesNothing) {
+  const CliRun missing = loom_audit(kAuditData + "bad.toml", "bad");
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_TRUE(missing.report.empty());
+  EXPECT_EQ(loom_audit(kAuditData + "no-such-scene.toml", "nofile").status, 2);
+  EXPECT_EQ(loom_audit(kAuditData + "clean.toml --method bogus", "method").status, 2);
+  EXPECT_EQ(loom_audit(kAuditData + "clean.toml --method certified --no-index", "noidx").status, 2);
+  EXPECT_EQ(loom_audit(kAuditData + "clean.toml --spacing -1", "spacing").status, 2);
+  EXPECT_EQ(loom_audit(kAuditData + "clean.toml --routes " + kAuditData + "missing.xml", "noroutes").status, 2);
+}
+
+}  // namespace
+}  // namespace loom
