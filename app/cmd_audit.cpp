@@ -6,6 +6,7 @@
 #include "core/error.hpp"
 #include "routing/audit.hpp"
 #include "routing/report_json.hpp"
+#include "routing/view_html.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -112,6 +113,7 @@ int run_audit_command(const AuditFlags& f) {
   const AuditReport rep = audit_scene_file(f.scene, opt);
   const std::filesystem::path report_path = std::filesystem::path(f.out) / "report.json";
   write_audit_report(rep, report_path);
+  write_view_outputs_for_files(f.out, f.scene, opt.routes, audit_report_json(rep));  // view.html, render.png (issue 9)
   if (f.json)
     std::cout << audit_report_json(rep).dump(2) << "\n";
   else if (!f.quiet)

@@ -5,6 +5,7 @@
 #include "core/error.hpp"
 #include "core/io/scene_load.hpp"
 #include "routing/route_report.hpp"
+#include "routing/view_html.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -12,6 +13,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <set>
 #include <unistd.h>
 
 namespace loom::app {
@@ -20,11 +22,11 @@ namespace {
 
 void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
   const auto& a = rep.audit;
-  std::size_t routed = 0;
-  for (const auto& c : a.cables) routed += c.routed ? 1 : 0;
+  std::set<std::string> unrouted;
+  for (const auto& u : rep.unrouted) unrouted.insert(u.cable);
   std::printf("route %s: %zu/%zu cables routed (%s, seed %u), clearance %.4g %s\n", a.scene.c_str(),
-              routed - std::min(routed, rep.unrouted.size()), a.cables.size(), rep.planner.c_str(), rep.seed,
-              rep.clearance, a.units.c_str());
+              a.cables.size() - unrouted.size(), a.cables.size(), rep.planner.c_str(), rep.seed, rep.clearance,
+              a.units.c_str());
   std::printf("  time: load %.0f ms, simplify %.0f ms, index %.0f ms, plan %.0f ms, spline %.0f ms, audit %.0f ms, "
               "repair %.0f ms, total %.0f ms\n",
               rep.timing.load, rep.timing.simplify, rep.timing.index, rep.timing.plan, rep.timing.spline,
@@ -37,8 +39,11 @@ void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
   std::size_t shown = 0;
   for (const auto& c : a.result.clashes) {
     if (++shown > 10) break;
-    std::printf("  clash %s %s at s=%.1f: clearance %.3f\n", clash_kind_name(c.kind),
-                a.check_ids[c.cable].c_str(), c.s, c.clearance);
+    const std::string with = c.kind == ClashKind::CableStructure ? a.part_names[c.part]
+                             : c.kind == ClashKind::CableCable  ? a.check_ids[c.other]
+                                                                : std::string("itself");
+    std::printf("  clash %s %s with %s at s=%.1f: clearance %.3f\n", clash_kind_name(c.kind),
+                a.check_ids[c.cable].c_str(), with.c_str(), c.s, c.clearance);
   }
   for (const auto& v : a.result.violations) {
     if (++shown > 20) break;
@@ -60,7 +65,7 @@ int run_route(const std::string& scene_path, const RouteCommandOptions& o) {
   ro.time_limit = o.time_limit;
   ro.seed = o.seed;
   ro.threads = o.threads;
-  ro.simplify = !o.no_simplify;
+  ro.simplify = o.simplify;
   const bool tty = !o.quiet && ::isatty(STDERR_FILENO);
   if (tty)
     ro.progress = [](const std::string& stage, double f) {
@@ -74,6 +79,7 @@ int run_route(const std::string& scene_path, const RouteCommandOptions& o) {
   // Tube resolution: a tenth of the smallest cable radius is finer than any viewer needs.
   const double chord = 0.1 * 0.5 * scene.harness.smallest_diameter();
   write_route_outputs(rep, o.out, chord > 0 ? chord : 0.01);
+  write_view_outputs(o.out, scene, rep.routed, route_report_json(rep));  // view.html, render.png (issue 9)
   (void)t0;
   if (o.json) std::cout << route_report_json(rep).dump(2) << "\n";
   else if (!o.quiet) print_summary(rep, o.out);
@@ -90,7 +96,7 @@ void add_route_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--time-limit", o->time_limit, "Planning seconds per segment (default: scene [routing])");
   cmd->add_option("--seed", o->seed, "Random seed (default: scene [routing])");
   cmd->add_option("--threads", o->threads, "Audit threads (default: all cores)");
-  cmd->add_flag("--no-simplify", o->no_simplify, "Plan among the exact parts instead of α-simplified ones");
+  cmd->add_flag("--simplify", o->simplify, "Plan among α-simplified parts instead of the exact ones (α-SIM, DESIGN §6)");
   cmd->add_flag("--json", o->json, "Print the report as JSON");
   cmd->add_flag("--quiet", o->quiet, "Print nothing (exit status only)");
   cmd->callback([scene, o, &exit_code]() { exit_code = run_route(*scene, *o); });

@@ -12,6 +12,8 @@ class App;
 namespace loom::app {
 
 void add_info_command(CLI::App& app, int& exit_code);
+/// `loom simplify`: α-SIM per part → DIR/<part>.stl + DIR/simplify.json (issue 4).
+void add_simplify_command(CLI::App& app, int& exit_code);
 /// `loom scan`: centerline, tube and deviation report of a scanned cable (DESIGN §4).
 void add_scan_command(CLI::App& app, int& exit_code);
 /// `loom audit`: clash, bend and clearance audit of a harness (DESIGN §4).
@@ -26,7 +28,7 @@ struct RouteCommandOptions {
   double time_limit = -1.0;  ///< < 0: the scene's
   long seed = -1;            ///< < 0: the scene's
   int threads = 0;
-  bool no_simplify = false;
+  bool simplify = false;     ///< plan among α-simplified parts
   bool json = false;
   bool quiet = false;
 };
@@ -35,6 +37,8 @@ void add_route_command(CLI::App& app, int& exit_code);
 int run_route(const std::string& scene, const RouteCommandOptions& options);
 
 void add_demo_command(CLI::App& app, int& exit_code);
+/// `loom render`: a ray-cast PNG of a scene, its cables and a report's clashes (issue 9).
+void add_render_command(CLI::App& app, int& exit_code);
 /// Path of the bundled demo scene ($LOOM_EXAMPLES_DIR overrides the built-in path).
 std::string demo_scene_path();
 

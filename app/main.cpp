@@ -19,10 +19,12 @@ int main(int argc, char** argv) {
   app.require_subcommand(1, 1);
   int exit_code = 0;
   loom::app::add_info_command(app, exit_code);
+  loom::app::add_simplify_command(app, exit_code);
   loom::app::add_scan_command(app, exit_code);
   loom::app::add_audit_command(app, exit_code);
   loom::app::add_route_command(app, exit_code);
   loom::app::add_demo_command(app, exit_code);
+  loom::app::add_render_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {

@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -142,9 +143,13 @@ double now_ms() {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+/// Process CPU time (all threads), ms: the work done, robust to other load on the machine.
+double cpu_ms() { return 1000.0 * static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
+
 struct Timed {
   ClashResult res;
-  double ms = 0.0;
+  double ms = 0.0;      ///< wall clock, best run
+  double cpu = 0.0;     ///< process CPU time of that run
 };
 
 /// Best of `reps` runs.
@@ -152,11 +157,12 @@ Timed timed_check(const BenchScene& sc, const ObstacleIndex* idx, ClashRequest r
   Timed t;
   t.ms = 1e300;
   for (int i = 0; i < reps; ++i) {
-    const double t0 = now_ms();
+    const double t0 = now_ms(), c0 = cpu_ms();
     ClashResult r = check_clashes(sc.cables, sc.parts, idx, req);
-    const double dt = now_ms() - t0;
+    const double dt = now_ms() - t0, dc = cpu_ms() - c0;
     if (dt < t.ms) {
       t.ms = dt;
+      t.cpu = dc;
       t.res = std::move(r);
     }
   }
@@ -191,11 +197,38 @@ int main(int argc, char** argv) {
   const bool quick = argc > 1 && std::string(argv[1]) == "--quick";
   const std::string dir = std::string(LOOM_SOURCE_DIR) + "/bench/results/";
   std::filesystem::create_directories(dir);
-  const int base_parts = quick ? 40 : 200, base_cables = quick ? 20 : 100, tris = 5000;
+  const int base_parts = quick ? 40 : 200, base_cables = quick ? 20 : 100, tris = 7500;
+
+  const bool breakdown_only = argc > 1 && std::string(argv[1]) == "--breakdown";
+  {
+    // Where the certified time goes (each check kind alone), paper-scale scene.
+    const BenchScene sc = make_scene(base_parts, tris, base_cables, 1.0, 42);
+    EmbreeIndex idx(sc.parts);
+    std::ofstream csv(dir + "audit_breakdown.csv");
+    csv << "part,ms,cpu_ms,distance_queries,pair_tests,samples\n";
+    for (int part = 0; part < 5; ++part) {
+      ClashRequest req;
+      req.routing_clearance = 3.0;
+      req.threads = 2;
+      req.check_structure = part == 0 || part == 4;
+      req.check_cable_cable = part == 1 || part == 4;
+      req.check_self = part == 2 || part == 4;
+      req.check_bend = part == 3 || part == 4;
+      const Timed t = timed_check(sc, &idx, req);
+      const char* names[] = {"structure", "cable-cable", "self", "bend", "all"};
+      csv << names[part] << "," << t.ms << "," << t.cpu << "," << t.res.counters.distance_queries << "," << t.res.counters.pair_tests
+          << "," << t.res.counters.samples << "\n";
+      std::printf("%-12s %8.1f ms (cpu %.1f)  %lld queries  %lld pair tests  %lld samples\n", names[part], t.ms, t.cpu,
+                  static_cast<long long>(t.res.counters.distance_queries),
+                  static_cast<long long>(t.res.counters.pair_tests), static_cast<long long>(t.res.counters.samples));
+    }
+    if (breakdown_only) return 0;
+  }
 
   // ---- 1. paper scale and 10× -------------------------------------------------------
   std::ofstream main_csv(dir + "audit.csv");
   main_csv << "scene,parts,triangles,cables,index_ms,certified_1t_ms,certified_2t_ms,speedup_2t,"
+              "certified_1t_cpu_ms,certified_2t_cpu_ms,"
               "discrete_indexed_ms,brute_discrete_ms_extrapolated,ratio_vs_brute,clashes,violations,"
               "distance_queries\n";
   for (int mult : {1, 10}) {
@@ -243,12 +276,13 @@ int main(int argc, char** argv) {
       const double n = static_cast<double>(sc.cables.size());
       brute_ms += bc.ms * (n * (n - 1)) / (kc * (kc - 1.0));
     }
-    std::printf("scene x%d: %zu parts, %zu tris, %zu cables: index %.0f ms, certified 1t %.1f ms, 2t %.1f ms "
+    std::printf("scene x%d: %zu parts, %zu tris, %zu cables: index %.0f ms, certified 1t %.1f ms (cpu %.1f), 2t %.1f ms "
                 "(%.2fx), discrete %.1f ms, brute ~%.0f ms (%.0fx), %zu clashes, %zu violations\n",
-                mult, sc.parts.size(), sc.triangles, sc.cables.size(), index_ms, c1.ms, c2.ms, c1.ms / c2.ms, d2.ms,
+                mult, sc.parts.size(), sc.triangles, sc.cables.size(), index_ms, c1.ms, c1.cpu, c2.ms, c1.ms / c2.ms, d2.ms,
                 brute_ms, brute_ms / c2.ms, c2.res.clashes.size(), c2.res.violations.size());
     main_csv << "x" << mult << "," << sc.parts.size() << "," << sc.triangles << "," << sc.cables.size() << ","
-             << index_ms << "," << c1.ms << "," << c2.ms << "," << c1.ms / c2.ms << "," << d2.ms << "," << brute_ms
+             << index_ms << "," << c1.ms << "," << c2.ms << "," << c1.ms / c2.ms << "," << c1.cpu << "," << c2.cpu
+             << "," << d2.ms << "," << brute_ms
              << "," << brute_ms / c2.ms << "," << c2.res.clashes.size() << "," << c2.res.violations.size() << ","
              << c2.res.counters.distance_queries << "\n";
   }
@@ -257,7 +291,7 @@ int main(int argc, char** argv) {
   // ---- 2. time vs cables (fixed parts) and vs triangles (fixed cables) -----------------
   {
     std::ofstream csv(dir + "audit_scaling.csv");
-    csv << "series,cables,triangles,certified_ms\n";
+    csv << "series,cables,triangles,certified_ms,certified_cpu_ms\n";
     const BenchScene big = make_scene(base_parts, tris, quick ? 80 : 400, 1.0, 7);
     EmbreeIndex idx(big.parts);
     for (int n : {25, 50, 100, 200, 400}) {
@@ -269,7 +303,7 @@ int main(int argc, char** argv) {
       req.routing_clearance = 3.0;
       req.threads = 2;
       const Timed t = timed_check(sub, &idx, req);
-      csv << "cables," << n << "," << big.triangles << "," << t.ms << "\n";
+      csv << "cables," << n << "," << big.triangles << "," << t.ms << "," << t.cpu << "\n";
       std::printf("cables %d: %.1f ms\n", n, t.ms);
     }
     for (int tp : {500, 1500, 5000, 15000, 50000}) {
@@ -280,7 +314,7 @@ int main(int argc, char** argv) {
       req.routing_clearance = 3.0;
       req.threads = 2;
       const Timed t = timed_check(sc, &ix, req);
-      csv << "triangles," << sc.cables.size() << "," << sc.triangles << "," << t.ms << "\n";
+      csv << "triangles," << sc.cables.size() << "," << sc.triangles << "," << t.ms << "," << t.cpu << "\n";
       std::printf("triangles %zu: %.1f ms\n", sc.triangles, t.ms);
     }
   }
@@ -288,7 +322,7 @@ int main(int argc, char** argv) {
   // ---- 3. speed vs accuracy: spacing (discrete) and tolerance (certified) ---------------
   {
     std::ofstream csv(dir + "audit_accuracy.csv");
-    csv << "method,parameter,time_ms,clashes,missed\n";
+    csv << "method,parameter,time_ms,cpu_ms,clashes,missed\n";
     const BenchScene sc = make_scene(base_parts, tris, base_cables, 1.0, 42);
     EmbreeIndex idx(sc.parts);
     ClashRequest req;
@@ -300,7 +334,7 @@ int main(int argc, char** argv) {
     for (double tol : {0.1, 0.03, 0.01, 0.003, 0.001}) {
       req.tolerance = tol;
       const Timed t = timed_check(sc, &idx, req);
-      csv << "certified," << tol << "," << t.ms << "," << t.res.clashes.size() << ","
+      csv << "certified," << tol << "," << t.ms << "," << t.cpu << "," << t.res.clashes.size() << ","
           << missed(truth_keys, clash_keys(t.res)) << "\n";
     }
     for (double sp : {16.0, 8.0, 4.0, 2.0, 1.0, 0.5, 0.25}) {
@@ -309,28 +343,28 @@ int main(int argc, char** argv) {
       d.spacing = sp;
       const Timed t = timed_check(sc, &idx, d, 1);
       const int m = missed(truth_keys, clash_keys(t.res));
-      csv << "discrete," << sp << "," << t.ms << "," << t.res.clashes.size() << "," << m << "\n";
+      csv << "discrete," << sp << "," << t.ms << "," << t.cpu << "," << t.res.clashes.size() << "," << m << "\n";
       std::printf("discrete spacing %.2f: %.1f ms, missed %d of %zu\n", sp, t.ms, m, truth_keys.size());
     }
     ClashRequest d = req;
     d.method = ClashMethod::Discrete;
     d.spacing = 0.0;  // the paper's rule, 2r per cable
     const Timed t = timed_check(sc, &idx, d, 1);
-    csv << "discrete-2r,0," << t.ms << "," << t.res.clashes.size() << "," << missed(truth_keys, clash_keys(t.res))
+    csv << "discrete-2r,0," << t.ms << "," << t.cpu << "," << t.res.clashes.size() << "," << missed(truth_keys, clash_keys(t.res))
         << "\n";
   }
 
   gnuplot("set datafile separator ','\nset terminal pngcairo size 1400,450\nset output '" + dir +
           "audit.png'\nset multiplot layout 1,3\n"
-          "set title 'certified audit time vs cables (200 parts)'\nset xlabel 'cables'\nset ylabel 'ms'\nset key off\n"
-          "plot '" + dir + "audit_scaling.csv' using (strcol(1) eq 'cables' ? $2 : 1/0):4 with linespoints pt 7\n"
+          "set title 'certified audit time vs cables (200 parts)'\nset xlabel 'cables'\nset ylabel 'CPU ms (both threads)'\nset key off\n"
+          "plot '" + dir + "audit_scaling.csv' using (strcol(1) eq 'cables' ? $2 : 1/0):5 with linespoints pt 7\n"
           "set title 'certified audit time vs triangles (100 cables)'\nset xlabel 'triangles'\nset logscale x\n"
-          "plot '" + dir + "audit_scaling.csv' using (strcol(1) eq 'triangles' ? $3 : 1/0):4 with linespoints pt 7\n"
-          "unset logscale x\nset title 'speed vs accuracy'\nset xlabel 'time (ms)'\nset ylabel 'missed clashes'\n"
+          "plot '" + dir + "audit_scaling.csv' using (strcol(1) eq 'triangles' ? $3 : 1/0):5 with linespoints pt 7\n"
+          "unset logscale x\nset title 'speed vs accuracy'\nset xlabel 'CPU time (ms)'\nset ylabel 'missed clashes'\n"
           "set logscale x\nset key top right\n"
-          "plot '" + dir + "audit_accuracy.csv' using (strcol(1) eq 'discrete' ? $3 : 1/0):5:(sprintf('%g', $2)) "
-          "with labels offset 0,1 notitle, '' using (strcol(1) eq 'discrete' ? $3 : 1/0):5 with linespoints pt 7 "
-          "title 'discrete (label: spacing mm)', '' using (strcol(1) eq 'certified' ? $3 : 1/0):5 with linespoints "
+          "plot '" + dir + "audit_accuracy.csv' using (strcol(1) eq 'discrete' ? $4 : 1/0):6:(sprintf('%g', $2)) "
+          "with labels offset 0,1 notitle, '' using (strcol(1) eq 'discrete' ? $4 : 1/0):6 with linespoints pt 7 "
+          "title 'discrete (label: spacing mm)', '' using (strcol(1) eq 'certified' ? $4 : 1/0):6 with linespoints "
           "pt 5 title 'certified (tolerance 0.1 .. 0.001)'\nunset multiplot\n");
   return 0;
 }

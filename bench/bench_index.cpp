@@ -164,11 +164,14 @@ void build_scaling() {
   }
   write_csv("index_build.csv", csv.str());
   run_gnuplot("index_build",
-              "set terminal pngcairo size 800,500\nset output 'index_build.png'\nset datafile separator ','\n"
+              "set terminal pngcairo size 900,500\nset output 'index_build.png'\nset datafile separator ','\n"
               "set logscale x\nset xlabel 'triangles'\nset ylabel 'M triangles / s'\nset y2label 'bytes / triangle'\n"
-              "set ytics nomirror\nset y2tics\nset key top left\nset title 'Embree BVH build rate and memory'\n"
-              "plot 'index_build.csv' every ::1 using 2:4 with linespoints title 'build rate (M tris/s)', "
-              "'' every ::1 using 2:5 axes x1y2 with linespoints title 'memory (B/tri)'\n");
+              "set ytics nomirror\nset y2tics\nset y2range [0:*]\nset yrange [0:*]\nset key top right\n"
+              "set title 'Embree BVH build (generated scenes; x = motor.stl)'\n"
+              "plot 'index_build.csv' every ::1::4 using 2:4 with linespoints title 'M tris/s (wall, shared machine)', "
+              "'' every ::1::4 using 2:6 with linespoints title 'M tris per CPU-second', "
+              "'' every ::1::4 using 2:7 axes x1y2 with linespoints title 'memory B/tri (right)', "
+              "'' every ::5::5 using 2:6 with points pt 2 ps 2 title 'motor.stl (per CPU-s)'\n");
 }
 
 void query_throughput() {
@@ -331,8 +334,8 @@ void voxel_tradeoff() {
   write_csv("index_voxel.csv", csv.str());
   run_gnuplot("index_voxel",
               "set terminal pngcairo size 900,500\nset output 'index_voxel.png'\nset datafile separator ','\n"
-              "set logscale x\nset xlabel 'voxel edge (mm)'\nset ylabel 'distance error (mm)'\n"
-              "set y2label 'lookup time (ns)'\nset ytics nomirror\nset y2tics\nset key top left\n"
+              "set logscale x\nset xrange [1:16]\nset xlabel 'voxel edge (mm)'\nset ylabel 'distance error (mm)'\n"
+              "set y2label 'query time per CPU (ns, log)'\nset logscale y2\nset ytics nomirror\nset y2tics\nset key top left\n"
               "set title 'Voxel distance map: voxel size vs error and lookup time (100k triangles)'\n"
               "plot 'index_voxel.csv' every ::1 using 1:8 with linespoints title 'max |error|', "
               "'' every ::1 using 1:9 with linespoints title 'mean |error|', "

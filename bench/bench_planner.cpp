@@ -2,8 +2,8 @@
 // set of cables through a fixed-seed cluttered scene of boxes (EmbreeIndex) and compare each
 // route's length with the best length found for that cable in the same process (all runs plus
 // long baseline runs of BIT* and Informed RRT* at kBaselineBudget). Writes
-// bench/results/planner.csv (every run), planner_summary.csv (per planner and budget) and
-// planner.png (gnuplot).
+// bench/results/planner.csv (every run), planner_summary.csv (per planner and budget),
+// planner_<name>.dat + planner.gp (chart data and script) and planner.png (gnuplot).
 //
 // Usage: bench_planner [--quick]   (--quick: fewer budgets and cables, for a smoke run)
 
@@ -163,7 +163,7 @@ int main(int argc, char** argv) {
   std::ofstream sum(dir + "planner_summary.csv");
   sum << "planner,budget_s,cables,solved,failures,mean_length_ratio,mean_time_ms\n";
   for (const auto& p : planners) {
-    std::ofstream f(dir + "planner_" + p + ".dat.tmp");
+    std::ofstream f(dir + "planner_" + p + ".dat");
     for (double b : budgets) {
       const Agg& a = agg[{p, b}];
       const double mean_ratio = a.solved > 0 ? a.ratio_sum / a.solved : 0.0;
@@ -183,16 +183,15 @@ int main(int argc, char** argv) {
     << "set logscale x\nset xlabel 'time budget (s)'\nset key top right\nset grid\n"
     << "set ylabel 'mean length / best known length (solved cables)'\nplot ";
   for (std::size_t i = 0; i < planners.size(); ++i)
-    g << (i ? ", " : "") << "'" << dir << "planner_" << planners[i] << ".dat.tmp' using 1:2 with linespoints title '"
+    g << (i ? ", " : "") << "'" << dir << "planner_" << planners[i] << ".dat' using 1:2 with linespoints title '"
       << planners[i] << "'";
   g << "\nset ylabel 'failures (of " << n_queries << ")'\nset yrange [0:" << n_queries << "]\nplot ";
   for (std::size_t i = 0; i < planners.size(); ++i)
-    g << (i ? ", " : "") << "'" << dir << "planner_" << planners[i] << ".dat.tmp' using 1:3 with linespoints title '"
+    g << (i ? ", " : "") << "'" << dir << "planner_" << planners[i] << ".dat' using 1:3 with linespoints title '"
       << planners[i] << "'";
   g << "\nunset multiplot\n";
   g.close();
   const int rc = std::system(("gnuplot '" + gp + "'").c_str());
-  for (const auto& p : planners) std::remove((dir + "planner_" + p + ".dat.tmp").c_str());
   std::cout << "wrote " << dir << "planner.csv, planner_summary.csv, planner.png (gnuplot rc " << rc << ")\n";
   return rc == 0 ? 0 : 1;
 }

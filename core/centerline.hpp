@@ -44,6 +44,9 @@ class Centerline {
 
   /// Interpolating cubic through every key point (≥ 2 points, finite). Consecutive
   /// duplicates are merged; throws std::invalid_argument with the reason otherwise.
+  /// Parameters run over [0, total chord length] (scene units, so |C'| ≈ 1); a given end
+  /// tangent is scaled to that speed. Natural ends have C'' = 0. The tridiagonal system for
+  /// the control points is solved with Eigen (dense LU when small, SparseLU otherwise).
   static Centerline interpolate(const std::vector<Vec3>& points, const InterpolationOptions& opt = {});
   /// As above with explicit parameters, one per key point (opt.knots is ignored; consecutive
   /// duplicates take their first point's parameter), increasing across distinct points.
@@ -62,6 +65,7 @@ class Centerline {
   /// moved them). Throws std::invalid_argument if one is outside [u_min, u_max] or they decrease.
   void set_key_parameters(std::vector<double> u);
 
+  /// First / last parameter of the curve's domain.
   double u_min() const;
   double u_max() const;
   /// C(u).
@@ -79,7 +83,9 @@ class Centerline {
   double parameter_at_length(double s) const;
   /// Points at equal arc spacing ≤ `spacing`, first and last included; with their s.
   std::vector<std::pair<double, Vec3>> sample_by_arc_length(double spacing) const;
-  /// Smallest bend radius and where it occurs (dense search + local refinement).
+  /// Smallest bend radius and where it occurs (dense search + local refinement); 0 at a
+  /// kink (tangent jump at a knot, e.g. polyline corners) or a fold (C' = 0 with the
+  /// tangent reversing); infinity for a straight curve.
   BendExtremum min_bend_radius() const;
 
   /// Writes C⁽ᵏ⁾(u) for k = 0..nder (nder ≤ 3) into out[0..nder]; u is clamped to the

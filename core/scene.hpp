@@ -21,7 +21,7 @@ struct Setting {
 /// [routing] of the scene file.
 struct RoutingSettings {
   Setting clearance;       ///< required gap between cable surface and structure
-  std::string planner = "rrtconnect";
+  std::string planner = "informedrrtstar";
   Setting time_limit;      ///< seconds per cable or bundle
   unsigned seed = 1;
 };

@@ -10,8 +10,6 @@
 #include <cstdint>
 #include <limits>
 #include <map>
-#include <cstdio>
-#include <cstdlib>
 
 namespace loom {
 
@@ -72,8 +70,6 @@ struct BucketGrid {
     for (std::size_t i = 1; i < count.size(); ++i) count[i] += count[i - 1];
     start = count;
     items.resize(count.back());
-    if (std::getenv("LOOM_ALPHA_DEBUG"))
-      std::fprintf(stderr, "grid %d x %d, %zu boxes, %u items\n", nx, ny, boxes.size(), count.back());
     for (std::uint32_t k = 0; k < boxes.size(); ++k) {
       const auto& b = boxes[k];
       for (int y = cy(b[0].y()); y <= cy(b[1].y()); ++y)
@@ -195,7 +191,8 @@ struct AlphaShape2D::Impl {
   }
 };
 
-AlphaShape2D::AlphaShape2D(const std::vector<Vec2>& points, double alpha) : impl_(std::make_unique<Impl>()) {
+AlphaShape2D::AlphaShape2D(const std::vector<Vec2>& points, double alpha, double short_edge)
+    : impl_(std::make_unique<Impl>()) {
   impl_->alpha = alpha;
   std::vector<CPoint> pts;
   pts.reserve(points.size());
@@ -211,7 +208,10 @@ AlphaShape2D::AlphaShape2D(const std::vector<Vec2>& points, double alpha) : impl
     const auto& p2 = f->vertex(2)->point();
     impl_->coords.push_back({to_vec(p0), to_vec(p1), to_vec(p2)});
     const double r2 = CGAL::squared_radius(p0, p1, p2);
-    impl_->kept.push_back(r2 < a2 ? 1 : 0);
+    const auto& c = impl_->coords.back();
+    const double longest2 =
+        std::max({(c[1] - c[0]).squaredNorm(), (c[2] - c[1]).squaredNorm(), (c[0] - c[2]).squaredNorm()});
+    impl_->kept.push_back(r2 < a2 || longest2 <= short_edge * short_edge ? 1 : 0);
   }
   impl_->refresh();
 }
@@ -458,7 +458,9 @@ std::size_t merge_collinear(std::vector<Vec2>& ring, double angle_tol_rad, doubl
   out.push_back(r[0]);
   while (a + 1 < r.size()) {
     std::size_t j = a + 1;
-    while (j + 1 < r.size() && fits(a, j + 1)) ++j;
+    // Runs are capped at kMaxRun vertices so that the check stays linear in the ring size.
+    constexpr std::size_t kMaxRun = 256;
+    while (j + 1 < r.size() && j + 1 - a <= kMaxRun && fits(a, j + 1)) ++j;
     if (j + 1 < r.size()) out.push_back(r[j]);
     a = j;
   }

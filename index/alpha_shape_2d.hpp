@@ -28,8 +28,10 @@ struct PolygonWithHoles2 {
 class AlphaShape2D {
  public:
   /// Triangulates `points` (duplicates allowed) and keeps every triangle whose
-  /// circumradius is < alpha (alpha ≥ 0; +inf keeps the convex hull).
-  AlphaShape2D(const std::vector<Vec2>& points, double alpha);
+  /// circumradius is < alpha (alpha ≥ 0; +inf keeps the convex hull), and also every
+  /// triangle whose longest edge is ≤ short_edge (0: none): flat slivers between nearly
+  /// collinear samples have a huge circumradius but span no gap wider than the sampling.
+  AlphaShape2D(const std::vector<Vec2>& points, double alpha, double short_edge = 0.0);
   ~AlphaShape2D();
   AlphaShape2D(AlphaShape2D&&) noexcept;
   AlphaShape2D& operator=(AlphaShape2D&&) noexcept;

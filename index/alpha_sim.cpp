@@ -59,6 +59,7 @@ const char* alpha_sim_status_name(AlphaSimStatus s) {
     case AlphaSimStatus::Blocked: return "blocked";
     case AlphaSimStatus::Failed: return "failed";
     case AlphaSimStatus::EmptyInput: return "empty_input";
+    case AlphaSimStatus::TooFine: return "too_fine";
   }
   return "?";
 }
@@ -250,10 +251,17 @@ struct MeshQuery {
   SM sm;
   std::unique_ptr<Tree> tree;
   explicit MeshQuery(const Mesh& m) {
-    std::vector<SM::Vertex_index> vi;
-    vi.reserve(m.vertices.size());
-    for (const auto& v : m.vertices) vi.push_back(sm.add_vertex(K3::Point_3(v.x(), v.y(), v.z())));
-    for (const auto& f : m.triangles) sm.add_face(vi[f[0]], vi[f[1]], vi[f[2]]);
+    // A triangle soup (own corners per face): prism intersections can touch along an
+    // edge (non-manifold), which a half-edge structure rejects; the AABB tree and the
+    // ray-parity inside test need only the triangles.
+    for (const auto& f : m.triangles) {
+      SM::Vertex_index c[3];
+      for (int k = 0; k < 3; ++k) {
+        const Vec3& v = m.vertices[f[k]];
+        c[k] = sm.add_vertex(K3::Point_3(v.x(), v.y(), v.z()));
+      }
+      sm.add_face(c[0], c[1], c[2]);
+    }
     tree = std::make_unique<Tree>(faces(sm).first, faces(sm).second, sm);
     tree->build();
     tree->accelerate_distance_queries();
@@ -454,6 +462,24 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
     }
   }
 
+  // The cloud size is known before sampling: refuse what would not fit in memory.
+  {
+    double estimate = 0.0;
+    for (std::size_t t = 0; t < part.mesh.triangles.size(); ++t) {
+      const auto c = part.mesh.corners(t);
+      const double longest = std::max({(c[1] - c[0]).norm(), (c[2] - c[1]).norm(), (c[0] - c[2]).norm()});
+      const double n = std::ceil(longest / r.l_max);
+      estimate += 0.5 * n * n + 1.5 * n;
+    }
+    if (estimate > static_cast<double>(opt.max_cloud_points)) {
+      keep_original(out, part, AlphaSimStatus::TooFine,
+                    "sampling at L_max = " + full_precision(r.l_max) + " needs about " +
+                        std::to_string(static_cast<long long>(estimate)) + " points > " +
+                        std::to_string(opt.max_cloud_points) + ": original kept (raise dim_pre)");
+      return finish();
+    }
+  }
+
   // 1. Sample (L_max), 2–3. project and build α-shapes per plane (in parallel).
   const Cloud cloud = sample_cloud(part.mesh, r.l_max);
   r.sample_points = cloud.points.size();
@@ -486,7 +512,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
               [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
     pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
     rep.points = pts.size();
-    auto shape = std::make_shared<AlphaShape2D>(pts, r.alpha);
+    auto shape = std::make_shared<AlphaShape2D>(pts, r.alpha, std::min(opt.short_edge_factor * r.l_max, r.alpha));
     rep.delaunay_triangles = shape->delaunay_triangle_count();
     rep.alpha_area = shape->area();
     rep.hull_area = shape->hull_area();
@@ -638,11 +664,15 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
   r.mesh_ms = ms_since(t_mesh);
   weld_identical_vertices(out.mesh);
   const MeshTopology otopo = analyse_topology(out.mesh);
-  orient_outward(out.mesh, otopo);
-  r.closed_after = otopo.closed;
+  // Watertight: no boundary and no misoriented edge. Edges shared by four triangles are
+  // allowed: two pieces of the intersection may touch along an edge.
+  const bool watertight = otopo.boundary_edges == 0 && otopo.misoriented_edges == 0;
+  if (watertight && out.mesh.signed_volume() < 0.0)
+    for (auto& f : out.mesh.triangles) std::swap(f[1], f[2]);
+  r.closed_after = watertight;
   r.triangles_after = out.mesh.triangle_count();
-  r.volume_after = otopo.closed ? std::abs(out.mesh.signed_volume()) : 0.0;
-  if (!otopo.closed || out.mesh.empty()) {
+  r.volume_after = watertight ? std::abs(out.mesh.signed_volume()) : 0.0;
+  if (!watertight || out.mesh.empty()) {
     keep_original(out, part, AlphaSimStatus::Failed,
                   "the OpenCASCADE result mesh is not closed (" + std::to_string(otopo.boundary_edges) +
                       " boundary, " + std::to_string(otopo.nonmanifold_edges) + " non-manifold, " +

@@ -24,6 +24,10 @@ struct AlphaSimOptions {
   double dim_pre = 0.0;          ///< features smaller than this vanish (scene units, > 0)
   double sampling_factor = 0.5;  ///< L_max = sampling_factor·dim_pre (paper §3.2: 0.5)
   double alpha_factor = 0.95;    ///< α = alpha_factor·dim_pre (paper §3.2: 0.95)
+  /// Delaunay triangles whose longest edge is ≤ min(short_edge_factor·L_max, α) are kept whatever
+  /// their circumradius: flat slivers between nearly collinear samples of a silhouette
+  /// (otherwise they erode the projection; 0 = the paper's definition only).
+  double short_edge_factor = 1.0;
   bool coordinate_planes = true;  ///< project onto XY, XZ, YZ
   std::vector<Vec3> extra_planes;  ///< normals of user projection planes (need not be unit)
   /// Scene size used for tolerances (bbox diagonal); ≤ 0: the part's own diagonal.
@@ -45,6 +49,8 @@ struct AlphaSimOptions {
   /// (at least the vertices, edge midpoints, centroids and two random points per triangle).
   double containment_density = 4.0;
   std::size_t containment_max_samples = 400000;
+  /// Largest 3D cloud sampled for one part (memory bound, ~100 bytes per point and plane).
+  std::size_t max_cloud_points = 4000000;
   bool build_mesh = true;       ///< OpenCASCADE prisms ∩ → triangle mesh (else implicit only)
   bool measure = true;          ///< containment of the mesh + Hausdorff distance
   std::filesystem::path step_dir;  ///< if set, writes <step_dir>/<part>.step (OpenCASCADE)
@@ -70,8 +76,9 @@ enum class AlphaSimStatus {
   Blocked,     ///< a feature hidden in every projection: space a cable could use was filled; original kept
   Failed,      ///< the mesh could not be built or did not contain the original: original kept
   EmptyInput,  ///< the part has no triangles
+  TooFine,     ///< dim_pre so small that the cloud would exceed max_cloud_points: original kept
 };
-/// "ok" | "hull_fallback" | "thin" | "blocked" | "failed" | "empty_input".
+/// "ok" | "hull_fallback" | "thin" | "blocked" | "failed" | "empty_input" | "too_fine".
 const char* alpha_sim_status_name(AlphaSimStatus s);
 
 /// Which fallback was used.

@@ -11,6 +11,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -149,10 +150,7 @@ VoxelMap::VoxelMap(const std::vector<Part>& parts, const VoxelOptions& opt, std:
   max_distance_ = opt.max_distance > 0.0 ? opt.max_distance : kDefaultMaxDistanceVoxels * res_;
   part_count_ = static_cast<int>(parts.size());
   AABB box;
-  for (const Part& p : parts) {
-    box.extend(p.mesh.bounds());
-    part_closed_.push_back(p.closed ? 1 : 0);
-  }
+  for (const Part& p : parts) box.extend(p.mesh.bounds());
   init_grid(box, parts.empty() ? std::string() : parts.front().source_file);
   if (!exact_) exact_ = std::make_shared<EmbreeIndex>(parts);
   const auto t0 = Clock::now();
@@ -375,7 +373,6 @@ std::unique_ptr<VoxelMap> VoxelMap::load_bt(const std::string& path, const Voxel
   vm->max_cells_ = opt.max_cells;
   vm->from_file_ = true;
   vm->part_count_ = 1;
-  vm->part_closed_ = {0};
   AABB box;
   for (auto it = tree->begin_leafs(); it != tree->end_leafs(); ++it) {
     if (!tree->isNodeOccupied(*it)) continue;

@@ -129,7 +129,6 @@ class VoxelMap : public ObstacleIndex {
   std::vector<float> dist_;          ///< per cell: distance (scene units), +inf beyond max_distance
   std::vector<std::int32_t> part_;   ///< per cell: nearest part (-1 unknown)
   std::vector<std::uint8_t> flags_;  ///< per cell: 0 free, 1 surface, 2 interior of a closed part
-  std::vector<char> part_closed_;
   std::unique_ptr<octomap::OcTree> tree_;
   std::shared_ptr<const ObstacleIndex> exact_;
   VoxelBuildStats stats_;

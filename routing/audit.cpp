@@ -77,9 +77,14 @@ std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCa
         if (!pos) continue;
         double rad = 0.0;
         for (int inc : topo.incident_segments(n)) rad = std::max(rad, topo.segment_diameter(inc));
+        // At a branch point cables run bundled along the breakout before they separate
+        // (the router leaves it straight for breakout_length); allow contact over twice
+        // that, the run-out of two tubes diverging at their minimum bend radius.
+        if (h.find_branch(n) >= 0) rad = std::max(rad, 2.0 * breakout_length(topo, n));
         in.junctions.push_back({n, *pos, rad});
       }
     }
+    for (auto& piece : cable_pieces(topo, static_cast<int>(c))) in.bend_pieces.emplace_back(piece.s0, std::move(piece.curve));
     ac.routed = true;
     ac.check_index = static_cast<int>(out.size());
     cables.push_back(ac);

@@ -91,14 +91,27 @@ double breakout_length(const HarnessTopology& topo, const std::string& node) {
   return len;
 }
 
-std::optional<Centerline> cable_centerline(const HarnessTopology& topo, int cable) {
+std::vector<CablePiece> cable_pieces(const HarnessTopology& topo, int cable) {
   const Harness& h = topo.harness();
-  std::optional<Centerline> out;
+  std::vector<CablePiece> out;
+  double s0 = 0.0;
   for (const SegmentUse& u : topo.cable_chain(cable)) {
     auto c = segment_centerline(h, u.segment);
-    if (!c) return std::nullopt;
-    Centerline piece = as_cubic(u.reversed ? reversed(*c) : *c);
-    out = out ? join(*out, piece) : piece;
+    if (!c) return {};
+    CablePiece p{u.segment, s0, u.reversed ? reversed(*c) : *c};
+    s0 += p.curve.length();
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+std::optional<Centerline> cable_centerline(const HarnessTopology& topo, int cable) {
+  std::optional<Centerline> out;
+  const auto pieces = cable_pieces(topo, cable);
+  if (pieces.empty()) return std::nullopt;
+  for (const CablePiece& p : pieces) {
+    Centerline cubic = as_cubic(p.curve);
+    out = out ? join(*out, cubic) : cubic;
   }
   return out;
 }

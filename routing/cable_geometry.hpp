@@ -17,6 +17,18 @@ namespace loom {
 /// no position (an unplaced branch point) — the segment is not routed yet.
 std::optional<Centerline> segment_centerline(const Harness& h, int segment);
 
+/// One segment of a cable's route, oriented in the cable's direction of travel.
+struct CablePiece {
+  int segment = -1;     ///< index into Harness::segments
+  double s0 = 0.0;      ///< arc length from the cable's first port where the piece starts
+  Centerline curve;     ///< the segment's curve, traversed as the cable runs
+};
+
+/// The segment curves of a cable's chain, in order, each reversed where the cable runs
+/// to → from. Empty if any segment of the chain is not routed. Bends are judged within a
+/// piece: where two pieces meet at a branch point the wires splay inside the breakout.
+std::vector<CablePiece> cable_pieces(const HarnessTopology& topo, int cable);
+
 /// A cable's full centerline from its first to its second port: the segment curves of its
 /// chain joined in order (reversed where the cable runs to → from) into one curve.
 /// nullopt if any segment of the chain is not routed.

@@ -33,9 +33,10 @@ constexpr double kDefaultMaxStepRadii = 50.0;
 constexpr double kChordShareOfTolerance = 0.5;
 /// Stretches of the sphere trace shorter than this many cable radii that cannot be proven
 /// clear are handed to the exact chord measurement.
-constexpr double kLeafRadii = 1.0;
-/// Longest chord, in cable radii (keeps the self rule |s − t| ≥ πr sharp).
-constexpr double kMaxChordRadii = 1.0;
+constexpr double kLeafRadii = 2.0;
+/// Longest chord, in cable radii (keeps the self rule |s − t| ≥ πr sharp: the paper's
+/// sample spacing 2r).
+constexpr double kMaxChordRadii = 2.0;
 /// Chords per block in the cable–cable narrow phase.
 constexpr std::size_t kBlock = 8;
 /// Arc-length slack (relative to the cable length) when deciding that two chord or sample
@@ -437,8 +438,9 @@ class StructureTracer {
         PartObservation o;
         o.part = inside_part_;
         ++count_.distance_queries;
-        const ClosestHit hb = ctx_.index->closest_on_part(b, inside_part_);
-        o.key = -r_ - (hb.found() ? hb.distance : 0.0);
+        // Depth only ranks points of the stretch (all have clearance −r): bounded search.
+        const ClosestHit hb = ctx_.index->closest_on_part(b, inside_part_, thr_);
+        o.key = -r_ - (hb.found() ? hb.distance : thr_);
         o.point = b;
         o.s = ch.s[k + 1];
         o.inside = true;
@@ -447,8 +449,17 @@ class StructureTracer {
         obs.push_back(o);
       }
       if (primary >= 0 && cand.size() > 1) {
-        for (int q : cand)
-          if (q != primary && q != inside_part_) secondary(a, b, ch.s[k], ch.s[k + 1], q, obs);
+        AABB cb;
+        cb.extend(a);
+        cb.extend(b);
+        for (int q : cand) {
+          if (q == primary || q == inside_part_) continue;
+          const AABB& pb = ctx_.info[q].box;
+          const double reach = r_ + ctx_.info[q].required + margin_;
+          if (!((cb.min.array() - reach <= pb.max.array()).all() && (pb.min.array() <= cb.max.array() + reach).all()))
+            continue;  // the part's box is beyond the band of this chord
+          secondary(a, b, ch.s[k], ch.s[k + 1], q, obs);
+        }
       }
       tracker_.step(obs, ch.s[k], ch.s[k + 1]);
     }
@@ -639,6 +650,11 @@ void narrow_phase(Context& ctx, const SpanBox& A, const SpanChords& CA, const Sp
           const double sa0 = CA.ch.s[ka], sa1 = CA.ch.s[ka + 1];
           const double tb0 = CB.ch.s[kb], tb1 = CB.ch.s[kb + 1];
           if (self && std::max(std::abs(tb1 - sa0), std::abs(sa1 - tb0)) < self_gap) continue;
+          // Midpoint bound: chords whose midpoints are farther apart than their half
+          // lengths plus the radii cannot touch.
+          const Vec3 ma = 0.5 * (CA.ch.p[ka] + CA.ch.p[ka + 1]), mb = 0.5 * (CB.ch.p[kb] + CB.ch.p[kb + 1]);
+          const double reach = r_sum + 0.5 * ((CA.ch.p[ka + 1] - CA.ch.p[ka]).norm() + (CB.ch.p[kb + 1] - CB.ch.p[kb]).norm());
+          if ((ma - mb).squaredNorm() >= reach * reach) continue;
           ++tests;
           const SegmentSegmentResult r =
               closest_segment_segment(CA.ch.p[ka], CA.ch.p[ka + 1], CB.ch.p[kb], CB.ch.p[kb + 1]);
@@ -947,7 +963,19 @@ void discrete_cable_pairs(Context& ctx, const std::vector<DiscreteSamples>& ds, 
 
 void check_bend(const Context& ctx, std::size_t c, CableCheckSummary& sum, std::vector<Violation>& out) {
   const CableInput& in = ctx.cables[c];
-  const BendExtremum b = in.curve.min_bend_radius();
+  BendExtremum b = in.bend_pieces.empty() ? in.curve.min_bend_radius() : BendExtremum{};
+  Vec3 where = in.bend_pieces.empty() ? in.curve.position(b.u) : Vec3::Zero();
+  if (!in.bend_pieces.empty()) {
+    b.radius = std::numeric_limits<double>::infinity();
+    for (const auto& [s0, piece] : in.bend_pieces) {
+      const BendExtremum pb = piece.min_bend_radius();
+      if (pb.radius < b.radius) {
+        b = pb;
+        b.s += s0;
+        where = piece.position(pb.u);
+      }
+    }
+  }
   sum.min_bend_radius = b.radius;
   sum.min_bend_s = b.s;
   if (ctx.req.check_bend && in.min_bend_radius > 0.0 && b.radius < in.min_bend_radius) {
@@ -957,7 +985,7 @@ void check_bend(const Context& ctx, std::size_t c, CableCheckSummary& sum, std::
     v.value = b.radius;
     v.limit = in.min_bend_radius;
     v.s = b.s;
-    v.point = in.curve.position(b.u);
+    v.point = where;
     out.push_back(v);
   }
 }

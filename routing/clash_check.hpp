@@ -66,6 +66,10 @@ struct CableInput {
   double min_bend_radius = 0.0;  ///< smallest allowed 1/κ (0 = unchecked)
   std::vector<CableSegmentRange> segments;  ///< the harness segments it runs through, in order
   std::vector<CableJunction> junctions;     ///< nodes on its route (for junction excuses)
+  /// Pieces over which bends are judged: (arc length where the piece starts, its curve).
+  /// Empty: the whole `curve`. Where two harness segments meet at a branch point the wires
+  /// splay inside the breakout, so the direction change there is not a bend of one cable.
+  std::vector<std::pair<double, Centerline>> bend_pieces;
 };
 
 /// Everything the checker needs to know. Tolerances are named, documented and derived
@@ -109,8 +113,8 @@ struct ClashEntry {
   Vec3 point = Vec3::Zero();  ///< deepest point: on the centerline (structure), midway between axes (cables)
   double s = 0.0;          ///< arc length of the deepest point on `cable`
   double s_other = 0.0;    ///< arc length on `other` (cable-cable, self)
-  double s_begin = 0.0;    ///< start of the stretch on `cable`
-  double s_end = 0.0;      ///< end of the stretch on `cable`
+  double s_begin = 0.0;    ///< start of the stretch on `cable` (to one chord, ≤ 2r)
+  double s_end = 0.0;      ///< end of the stretch on `cable` (to one chord, ≤ 2r)
   bool keep_out = false;   ///< the part is a keep-out zone
   bool inside = false;     ///< the centerline runs inside the (closed) part here
 };

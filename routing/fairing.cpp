@@ -103,6 +103,9 @@ double bending_energy(const Centerline& c) {
   const std::vector<double>& bp = c.breakpoints();
   double e = 0.0;
   Vec3 d[3];
+  // κ below 1e-12 / L (bend radius ≫ the curve) is rounding on a straight run: κ² ≤ that².
+  const double L = std::max(c.length(), 1e-300);
+  const double v2_min_scale = 1.0 / (L * L);
   for (std::size_t k = 0; k + 1 < bp.size(); ++k) {
     for (int part = 0; part < kEnergySubdivisions; ++part) {
       const double a = bp[k] + (bp[k + 1] - bp[k]) * part / kEnergySubdivisions;
@@ -115,6 +118,7 @@ double bending_energy(const Centerline& c) {
         // κ²|C'| = |C'×C''|²/|C'|⁵ (same evaluation, no second lookup).
         const double cr = d[1].cross(d[2]).squaredNorm();
         if (cr <= kStraightSine2 * v * v * d[2].squaredNorm()) continue;  // C'' ∥ C': straight
+        if (cr <= kStraightSine2 * v2_min_scale * v * v * v * v * v * v) continue;  // κ·L negligible
         const double v2 = v * v;
         e += kGLw[q] * h * cr / (v2 * v2 * v);
       }

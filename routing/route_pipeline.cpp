@@ -27,6 +27,8 @@ constexpr int kWeiszfeldIterations = 100;
 /// radius growing by the required clearance each time.
 constexpr int kClearDirections = 26;
 constexpr int kClearShells = 40;
+/// The straight stubs at both ends of a segment take at most this share of its length.
+constexpr double kStubShare = 0.4;
 
 std::optional<Vec3> node_pos(const Harness& h, const std::string& id) {
   if (int p = h.find_port(id); p >= 0) return h.ports[p].position;
@@ -308,8 +310,17 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
     auto stub_for = [&](const EndFrame& e) {
       return e.is_port ? port_stub : free_stub(plan_index, e.position, e.exit, breakout[e.node], required);
     };
-    const Vec3 a_stub = ea.position + stub_for(ea) * ea.exit;
-    const Vec3 b_stub = eb.position + stub_for(eb) * eb.exit;
+    // Stubs of the two ends together take at most kStubShare of the distance between the
+    // ends; longer ones would cross and force the route into a hairpin.
+    double la = stub_for(ea), lb = stub_for(eb);
+    const double span = (b - a).norm();
+    if (la + lb > kStubShare * span) {
+      const double f = kStubShare * span / (la + lb);
+      la *= f;
+      lb *= f;
+    }
+    const Vec3 a_stub = ea.position + la * ea.exit;
+    const Vec3 b_stub = eb.position + lb * eb.exit;
     PlanRequest req;
     req.radius = radius;
     req.clearance = rep.clearance + part_extra;
@@ -326,9 +337,20 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
     PlanResult blocked;
     for (const EndFrame* e : {&ea, &eb}) {
       if (!e->is_port || !blocked.message.empty()) continue;
-      const Vec3 stub_end = e->position + port_stub * e->exit;
+      int inside_part = -1;
+      if (plan_index.inside(e->position, &inside_part)) {
+        blocked.reason = e == &ea ? NoPathReason::StartInObstacle : NoPathReason::GoalInObstacle;
+        blocked.blocked_at = e->position;
+        blocked.blocking_part = inside_part;
+        blocked.message = "port " + e->node + " at (" + full_precision(e->position.x()) + ", " +
+                          full_precision(e->position.y()) + ", " + full_precision(e->position.z()) +
+                          ") is inside part '" + planning_parts[inside_part].name + "'";
+        continue;
+      }
+      const Vec3 stub_end = e == &ea ? a_stub : b_stub;
       // The connector the port sits on may touch the first `required` of the stub.
-      const Vec3 from = plan_index.any_within(e->position, required) ? Vec3(e->position + std::min(required, port_stub) * e->exit)
+      const double len = (stub_end - e->position).norm();
+      const Vec3 from = plan_index.any_within(e->position, required) ? Vec3(e->position + std::min(required, len) * e->exit)
                                                                      : e->position;
       if (plan_index.segment_within(from, stub_end, required)) {
         double t = 0.0;
@@ -336,7 +358,7 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
         blocked.reason = e == &ea ? NoPathReason::StartPortBlocked : NoPathReason::GoalPortBlocked;
         blocked.blocked_at = hit.found() ? hit.point : stub_end;
         blocked.blocking_part = hit.part;
-        blocked.message = "port " + e->node + " faces a wall: its straight exit of length " + full_precision(port_stub) +
+        blocked.message = "port " + e->node + " faces a wall: its straight exit of length " + full_precision(len) +
                           " comes within " + full_precision(hit.distance) + " of part '" +
                           (hit.part >= 0 ? planning_parts[hit.part].name : std::string("?")) + "' (needs " +
                           full_precision(required) + ")";
@@ -365,6 +387,9 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
       }
     }
     rep.timing.plan += ms_since(t0);
+    if (!plan.solved() && plan.blocking_part >= 0 && plan.blocking_part < static_cast<int>(planning_parts.size()) &&
+        plan.message.find("'" + planning_parts[plan.blocking_part].name + "'") == std::string::npos)
+      plan.message += " (part '" + planning_parts[plan.blocking_part].name + "')";
     info.plan = plan;
     if (!plan.solved()) {
       failed_segments.insert(seg.from + " -> " + seg.to);
@@ -394,17 +419,45 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
     double min_bend = 0.0;
     for (int c : topo.segment_cables(s)) min_bend = std::max(min_bend, h.cables[c].physical.min_bend_radius);
     std::string status = "not checked";
-    if (min_bend > 0.0 && rep.clearance > 0.0) {
-      BendRepairOptions bo;
-      bo.min_bend_radius = min_bend;
-      bo.max_deviation = 0.5 * rep.clearance;
-      bo.interpolation = g.interp;
-      const BendRepairResult br = repair_bend_radius(g.points, bo);
-      g.curve = br.curve;
-      status = br.status == BendRepairStatus::Failed ? "failed: " + br.reason
-               : br.status == BendRepairStatus::AlreadySatisfied ? "satisfied"
-               : br.status == BendRepairStatus::Faired ? "faired"
-                                                       : "points inserted";
+    if (min_bend > 0.0) {
+      // Round corners as far as the planning obstacles allow: try the budgets from generous
+      // (a corner rounded to the full bend radius moves up to ~0.4 R) to tight, and keep the
+      // first repaired curve whose samples stay clear of the (simplified) parts; the exact
+      // audit that follows is the judge.
+      const double radius = 0.5 * topo.segment_diameter(s);
+      const double need = radius + 0.5 * rep.clearance;
+      const double step = std::max(radius, 0.25 * rep.clearance);
+      BendRepairResult chosen;
+      bool have = false;
+      for (double dev : {0.5 * min_bend, 0.25 * min_bend, rep.clearance, 0.5 * rep.clearance}) {
+        if (!(dev > 0.0)) continue;
+        BendRepairOptions bo;
+        bo.min_bend_radius = min_bend;
+        bo.max_deviation = dev;
+        bo.interpolation = g.interp;
+        BendRepairResult br = repair_bend_radius(g.points, bo);
+        bool clear = true;
+        for (const auto& [sa, p] : br.curve.sample_by_arc_length(step)) {
+          (void)sa;
+          if (plan_index.any_within(p, need) && (p - g.points.front()).norm() > need &&
+              (p - g.points.back()).norm() > need) {
+            clear = false;
+            break;
+          }
+        }
+        if (clear && br.status != BendRepairStatus::Failed) {
+          chosen = std::move(br);
+          have = true;
+          break;
+        }
+        if (!have) chosen = std::move(br);
+      }
+      g.curve = chosen.curve;
+      g.points = chosen.points.empty() ? g.points : chosen.points;
+      status = chosen.status == BendRepairStatus::Failed ? "failed: " + chosen.reason
+               : chosen.status == BendRepairStatus::AlreadySatisfied ? "satisfied"
+               : chosen.status == BendRepairStatus::Faired ? "faired"
+                                                           : "points inserted";
     } else {
       g.curve = Centerline::interpolate(g.points, g.interp);
     }
@@ -430,6 +483,15 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
     routed_scene.routing = scene.routing;
     routed_scene.has_harness = true;
     routed_scene.harness = h;
+    // Cables that could not be routed have no curve to audit (their segments would read
+    // as straight lines between the nodes); they are reported as unrouted instead.
+    auto& cables = routed_scene.harness.cables;
+    cables.erase(std::remove_if(cables.begin(), cables.end(),
+                                [&](const Cable& c) {
+                                  return std::any_of(rep.unrouted.begin(), rep.unrouted.end(),
+                                                     [&](const UnroutedCable& u) { return u.cable == c.id; });
+                                }),
+                 cables.end());
     // Parts are shared by value here; the audit indexes them itself.
     routed_scene.parts = scene.parts;
     return run_audit(routed_scene, ao);

@@ -21,7 +21,11 @@ struct RouteOptions {
   double time_limit = -1.0;  ///< seconds per segment; < 0: scene.routing.time_limit
   long seed = -1;            ///< < 0: scene.routing.seed
   int threads = 0;           ///< audit threads (≤ 0: all cores)
-  bool simplify = true;      ///< plan among α-simplified obstacles (false: the exact parts)
+  /// Plan among α-simplified obstacles (false: the exact parts). Off by default: on the
+  /// bundled wing section α-SIM costs minutes (bench/results/alpha_sim*) while Embree on
+  /// the exact 147k triangles plans in well under a second; turn it on for scenes whose
+  /// detail (threads, rivets) slows the planner more than simplifying costs.
+  bool simplify = false;
   int max_repair_rounds = 4; ///< audit → densify → re-spline rounds per segment
   /// Called with (stage, fraction done) from the calling thread; may be empty.
   std::function<void(const std::string&, double)> progress;

@@ -59,6 +59,14 @@ json route_report_json(const RouteReport& rep) {
       c["message"] = it->second->message;
     }
   }
+  // Unrouted cables were left out of the audit: list them with the reason.
+  for (const auto& u : rep.unrouted) {
+    bool listed = false;
+    for (const auto& c : j["cables"]) listed = listed || c["id"] == u.cable;
+    if (!listed)
+      j["cables"].push_back({{"id", u.cable}, {"routed", false}, {"reason", u.reason}, {"blocked_segment", u.segment},
+                             {"message", u.message}, {"planner", rep.planner}, {"time_ms", plan_ms[u.cable]}});
+  }
   json segs = json::array();
   for (const auto& info : rep.segments) {
     const Segment& s = rep.routed.segments[info.segment];

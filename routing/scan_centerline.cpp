@@ -7,8 +7,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -47,6 +45,11 @@ constexpr double kSeedCell = 1.0, kMergeRadius = 0.4;
 constexpr double kOutlierDistance = 1.25;
 /// A block whose fitted centre moved farther than this from its start (× d) is rejected.
 constexpr double kMaxCentreShift = 1.0;
+/// Points used for neighbourhood statistics (diameter estimate, contraction).
+constexpr std::size_t kNeighbourhoodPoints = 8192;
+/// Block fits iterate on at most this many points, then polish on all of them.
+constexpr std::size_t kFitSubsample = 384;
+constexpr int kPolishIterations = 2;
 /// A segment of the ordering curve longer than this (× d) bridges a gap in the scan.
 constexpr double kBridgeLength = 2.5;
 /// Fraction of a block's inliers ignored at each end when locating the cable's ends.
@@ -137,15 +140,20 @@ class BlockFitter {
     trial_t_.resize(n);
   }
 
-  FitOut run(const Vec3& c0, const Vec3& a0) {
-    FitOut f;
-    f.c = c0;
-    f.a = a0.normalized();
-    f.r = cfg_.radius;
+  /// Fits from a start (centre, direction; bend and radius too when `warm`). A warm start
+  /// goes straight to Tukey weights (the start is already close).
+  FitOut run(FitOut f, bool warm = false) {
+    f.a.normalize();
+    if (!warm) {
+      f.b.setZero();
+      f.r = cfg_.radius;
+    }
+    if (!cfg_.free_radius) f.r = cfg_.radius;
+    if (!cfg_.curved) f.b.setZero();
     const int np = 4 + (cfg_.curved ? 2 : 0) + (cfg_.free_radius ? 1 : 0);
     const int ib = 4, ir = cfg_.curved ? 6 : 4;
     evaluate(f, res_, nrm_, t_);
-    int accepted = 0;
+    int accepted = warm ? kHuberIterations : 0;
     update_weights(accepted);
     double cost = cost_of(f, res_);
     double lambda = 1e-4;
@@ -472,16 +480,23 @@ struct UnionFind {
 
 /// Contracts the cloud onto its axis and orders the contracted nodes by the longest path of
 /// their minimum spanning tree. Returns false (with a reason) if nothing tube-like is found.
-bool build_chain(const std::vector<Vec3>& pts, const KdTree& tree, double d, Chain& chain, std::string& why) {
+bool build_chain(const std::vector<Vec3>& pts, const std::vector<Vec3>& sub, const KdTree& tree, double d, Chain& chain,
+                 std::string& why) {
   // Seeds: one point per grid cell of size d.
   const double cell = kSeedCell * d;
-  std::unordered_map<std::int64_t, std::uint32_t> first;
+  std::unordered_map<std::int64_t, std::pair<std::uint32_t, std::uint32_t>> first;  // cell → (first point, count)
   first.reserve(pts.size() / 8 + 16);
-  for (std::uint32_t i = 0; i < pts.size(); ++i) first.emplace(cell_key(pts[i], cell), i);
-  std::vector<std::uint32_t> seeds;
-  seeds.reserve(first.size());
-  for (const auto& kv : first) seeds.push_back(kv.second);
-  std::sort(seeds.begin(), seeds.end());  // deterministic order
+  for (std::uint32_t i = 0; i < pts.size(); ++i) {
+    auto [it, fresh] = first.emplace(cell_key(pts[i], cell), std::make_pair(i, 0u));
+    (void)fresh;
+    ++it->second.second;
+  }
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> seed_cells;
+  seed_cells.reserve(first.size());
+  for (const auto& kv : first) seed_cells.push_back(kv.second);
+  std::sort(seed_cells.begin(), seed_cells.end());  // deterministic order
+  std::vector<std::uint32_t> seeds(seed_cells.size());
+  for (std::size_t k = 0; k < seeds.size(); ++k) seeds[k] = seed_cells[k].first;
   // Mean shift onto the axis.
   std::vector<Vec3> node(seeds.size());
   std::vector<std::size_t> support(seeds.size(), 0);
@@ -491,7 +506,7 @@ bool build_chain(const std::vector<Vec3>& pts, const KdTree& tree, double d, Cha
       Vec3 x = pts[seeds[k]];
       std::size_t n = 0;
       for (int it = 0; it < 8; ++it) {
-        SumResultSet rs{rad2, pts};
+        SumResultSet rs{rad2, sub};
         tree.radiusSearchCustomCallback(x.data(), rs, nanoflann::SearchParams(32, 0.0f, false));
         n = rs.n;
         if (n == 0) break;
@@ -504,9 +519,23 @@ bool build_chain(const std::vector<Vec3>& pts, const KdTree& tree, double d, Cha
       support[k] = n;
     }
   });
-  // Drop specks (outliers): support far below the typical.
-  std::vector<double> sup(support.begin(), support.end());
-  const double sup_med = median(sup);
+  // Drop specks (outliers): support far below the typical. "Typical" is the median over
+  // points, not over seeds: scattered outliers occupy one cell each and can outnumber the
+  // cable's cells, but not its points.
+  double sup_med = 0.0;
+  {
+    std::vector<std::size_t> order(seeds.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return support[x] < support[y]; });
+    std::size_t acc = 0;
+    for (std::size_t k : order) {
+      acc += seed_cells[k].second;
+      if (2 * acc >= pts.size()) {
+        sup_med = static_cast<double>(support[k]);
+        break;
+      }
+    }
+  }
   // Merge nodes that converged to the same place (greedy, hash grid of the merge radius).
   const double mr = kMergeRadius * d;
   std::unordered_map<std::int64_t, std::vector<int>> grid;
@@ -740,14 +769,26 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
                                                 std::to_string(2 * kMinBlockPoints) + " are needed");
 
   auto t0 = Clock::now();
-  CloudAdaptor ad{pts};
+  // Neighbourhood statistics (diameter estimate, contraction onto the axis) only need a
+  // bounded, evenly strided subset of the cloud.
+  std::vector<Vec3> sub_storage;
+  const std::vector<Vec3>* sub_ptr = &pts;
+  if (pts.size() > kNeighbourhoodPoints) {
+    const double stride = static_cast<double>(pts.size()) / static_cast<double>(kNeighbourhoodPoints);
+    sub_storage.reserve(kNeighbourhoodPoints);
+    for (std::size_t k = 0; k < kNeighbourhoodPoints; ++k)
+      sub_storage.push_back(pts[static_cast<std::size_t>(static_cast<double>(k) * stride)]);
+    sub_ptr = &sub_storage;
+  }
+  const std::vector<Vec3>& sub = *sub_ptr;
+  CloudAdaptor ad{sub};
   KdTree tree(3, ad, nanoflann::KDTreeSingleIndexAdaptorParams(16));
   double d;
   if (opt.diameter) {
     d = *opt.diameter;
   } else {
     const auto tdia = Clock::now();
-    auto est = coarse_diameter(pts, tree, opt.seed);
+    auto est = coarse_diameter(sub, tree, opt.seed);
     res.timing.diameter_ms = ms_since(tdia);
     if (!est) return finish(ScanStatus::NotATube, "cannot estimate a diameter: no neighbourhood has a circular cross-section");
     d = *est;
@@ -763,7 +804,7 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
   int axis_k = 0;
   if (opt.method == ScanMethod::Graph) {
     std::string why;
-    if (!build_chain(pts, tree, d, chain, why)) return finish(ScanStatus::NotATube, why);
+    if (!build_chain(pts, sub, tree, d, chain, why)) return finish(ScanStatus::NotATube, why);
     std::vector<double> dist;
     project_on_chain(pts, chain, d, s, dist);
     for (std::size_t i = 0; i < pts.size(); ++i) use[i] = dist[i] <= kOutlierDistance * d;
@@ -870,9 +911,33 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
         cfg.radius = radius;
         cfg.prior = priors[b];
         cfg.prior_weight = opt.smoothness;
-        BlockFitter fitter(sorted.data() + start[b], cnt, cfg);
         const bool warm = init && (*init)[b].ok;
-        fits[b] = fitter.run(warm ? (*init)[b].c : c0[b], warm ? (*init)[b].a : a0[b]);
+        FitOut f0;
+        if (warm) {
+          f0 = (*init)[b];
+        } else {
+          f0.c = c0[b];
+          f0.a = a0[b];
+        }
+        const Vec3* bp = sorted.data() + start[b];
+        if (cnt > kFitSubsample) {
+          // Converge on an evenly strided subset, then polish on every point of the block.
+          std::vector<Vec3> few;
+          few.reserve(kFitSubsample + 1);
+          const double stride = static_cast<double>(cnt) / static_cast<double>(kFitSubsample);
+          for (std::size_t k = 0; k < kFitSubsample; ++k) few.push_back(bp[static_cast<std::size_t>(static_cast<double>(k) * stride)]);
+          BlockFitter coarse(few.data(), few.size(), cfg);
+          const FitOut fc = coarse.run(f0, warm);
+          if (fc.ok) {
+            f0 = fc;
+            cfg.max_iter = kPolishIterations;
+          }
+          BlockFitter full(bp, cnt, cfg);
+          fits[b] = full.run(f0, fc.ok || warm);
+        } else {
+          BlockFitter fitter(bp, cnt, cfg);
+          fits[b] = fitter.run(f0, warm);
+        }
         if (fits[b].ok && (fits[b].c - c0[b]).norm() > kMaxCentreShift * d) fits[b].ok = false;
       }
     });
@@ -891,7 +956,7 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
     res.diameter = d;
   }
   std::vector<std::optional<Vec3>> priors(m);
-  if (opt.smoothness > 0.0) {
+  if (!graph && opt.smoothness > 0.0) {  // the paper's E_ext; the graph method's curved blocks need none
     for (std::size_t b = 0; b < m; ++b) {
       if (!fits[b].ok) continue;
       Vec3 acc = Vec3::Zero();
@@ -902,7 +967,7 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
     }
   }
   const std::vector<FitOut> pass1 = fits;
-  run_pass(false, 0.5 * d, priors, &pass1);
+  if (!graph || res.diameter_estimated) run_pass(false, 0.5 * d, priors, &pass1);
   res.timing.fitting_ms = ms_since(t0);
 
   // Key points in order along the cable.
@@ -936,10 +1001,6 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
       if (std::abs(te) > 0.25 * L) res.key_points.push_back(f.at(te));
     }
     run_open = true;
-    if (std::getenv("LOOM_SCAN_DEBUG"))
-      std::fprintf(stderr, "blk %zu s=[%.2f,%.2f] n=%zu inl=%zu c=(%.3f %.3f %.3f) a=(%.3f %.3f %.3f) |b|=%.4f r=%.3f t=[%.2f %.2f] c0=(%.3f %.3f %.3f) first=%d last=%d\n",
-                   b, spans[b].s0, spans[b].s1, start[b + 1] - start[b], f.inliers, f.c.x(), f.c.y(), f.c.z(), f.a.x(), f.a.y(), f.a.z(),
-                   f.b.norm(), f.r, f.t_min, f.t_max, c0[b].x(), c0[b].y(), c0[b].z(), int(spans[b].run_first), int(spans[b].run_last));
     blk.center = key;
     blk.direction = dir;
     blk.radius = pass1[b].ok ? pass1[b].r : f.r;

@@ -31,6 +31,9 @@ constexpr std::size_t kMaxRings = 1u << 22;
 constexpr double kMaxSpanFraction = 0.25;
 /// Attempts to shrink one step until the curvature inside it is consistent with its length.
 constexpr int kStepShrinkIterations = 4;
+/// Smallest step as a fraction of the parameter range (a cusp's unbounded curvature must
+/// not stall the march; the ring limit below reports absurd tolerances instead).
+constexpr double kMinStepRel = 1e-9;
 /// |C'| below this fraction of the average speed: the tangent is taken from C'' instead.
 constexpr double kStationaryRelSpeed = 1e-12;
 
@@ -139,7 +142,7 @@ std::vector<SweepSection> sections(const Centerline& c, const RadiusFn& radius_a
                          (h * h);
       if (rpp > 0.0) ds = std::min(ds, std::sqrt(8.0 * tol_axial / rpp));
     }
-    double du = std::min(ds / speed0, kMaxSpanFraction * span_w);
+    double du = std::max(std::min(ds / speed0, kMaxSpanFraction * span_w), kMinStepRel * (u1 - u0));
     Vec3 dm[3], de[3];
     for (int it = 0;; ++it) {
       du = std::min(du, u1 - u);
@@ -149,7 +152,7 @@ std::vector<SweepSection> sections(const Centerline& c, const RadiusFn& radius_a
       const double kmax = std::max({k0, curvature_of(dm, min_speed), curvature_of(de, min_speed)});
       const double allowed = axial_step(kmax, r0, tol_axial) / vmax;
       if (du <= allowed * 1.0000001 || it >= kStepShrinkIterations) break;
-      du = allowed;
+      du = std::max(allowed, kMinStepRel * (u1 - u0));
     }
     // Simpson on |C'| (the three derivatives we have) advances s for the radius law.
     const double un = (u1 - (u + du) <= 1e-12 * (u1 - u0)) ? u1 : u + du;

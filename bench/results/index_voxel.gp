@@ -2,9 +2,11 @@ set terminal pngcairo size 900,500
 set output 'index_voxel.png'
 set datafile separator ','
 set logscale x
+set xrange [1:16]
 set xlabel 'voxel edge (mm)'
 set ylabel 'distance error (mm)'
-set y2label 'lookup time (ns)'
+set y2label 'query time per CPU (ns, log)'
+set logscale y2
 set ytics nomirror
 set y2tics
 set key top left

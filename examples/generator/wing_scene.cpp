@@ -74,7 +74,7 @@ std::string wing_scene_toml() {
   tip.translate[2] = kDepth;
   part(o, "connector-tip", "connector-bracket.step", tip);
   o << "\n[harness]\nfile = \"harness.xml\"\n"
-    << "\n[routing]\nclearance  = " << fl(kSceneClearance) << "\nplanner    = \"rrtconnect\"\ntime_limit = 1.0\nseed       = 1\n"
+    << "\n[routing]\nclearance  = " << fl(kSceneClearance) << "\nplanner    = \"informedrrtstar\"\ntime_limit = 0.5\nseed       = 1\n"
     << "\n[simplify]\ndim_pre = " << fl(kSceneDimPre) << "\n";
   return o.str();
 }

@@ -114,3 +114,24 @@ TEST(SceneIndices, KeyRangeCoarsening) {
   EXPECT_TRUE(log_mentions(si, "32768"));
   EXPECT_GT(si.voxel->resolution(), 40000.0 / 32768.0);
 }
+
+RC_GTEST_PROP(SceneIndicesProps, ReportedAndCertifiedDistancesAgree, ()) {
+  // Embree (reported) cross-checked by FCL (certification) on the same scene.
+  static const Scene s = small_scene(2.0, 1.0);
+  static const SceneIndices si = [] {
+    SceneIndicesOptions o;
+    o.build_voxel = false;
+    return SceneIndices::build(s, o);
+  }();
+  const auto coord = [](int lo, int hi) { return *rc::gen::inRange(lo, hi) / 10.0; };
+  const Vec3 p(coord(-200, 400), coord(-150, 150), coord(-150, 150));
+  const Vec3 q = p + Vec3(coord(-50, 50), coord(-50, 50), coord(-50, 50));
+  const ClosestHit e = si.for_use(QueryUse::Reported).closest(p);
+  const ClosestHit f = si.for_use(QueryUse::Certification).closest(p);
+  RC_ASSERT(e.found() && f.found());
+  RC_ASSERT(std::abs(e.distance - f.distance) <= 1e-9 * std::max(1.0, f.distance));
+  const ClosestHit es = si.for_use(QueryUse::Reported).segment_closest(p, q);
+  const ClosestHit fs = si.for_use(QueryUse::Certification).segment_closest(p, q);
+  RC_ASSERT(std::abs(es.distance - fs.distance) <= 1e-9 * std::max(1.0, fs.distance));
+  RC_ASSERT(si.for_use(QueryUse::Reported).inside(p) == si.for_use(QueryUse::Certification).inside(p));
+}

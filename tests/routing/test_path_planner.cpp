@@ -1,12 +1,13 @@
 // Tests of the OMPL planning core (issue 7): closed-form box scenes built as meshes, planned
-// against BruteForceIndex (exact triangles) and checked against an independent oracle — the
-// closed-form distance to solid axis-aligned boxes, sampled densely along every key-point
-// segment (distance is 1-Lipschitz, so samples at spacing h with d ≥ required − h/2·0 and
-// the exact planner check must agree to rounding).
+// against BruteForceIndex / EmbreeIndex (exact triangles) and checked against an independent
+// oracle — the closed-form distance to solid axis-aligned boxes, sampled densely (spacing
+// required/50) along every key-point segment. The planner's capsule checks are exact, so the
+// sampled distance must never fall below radius + clearance (up to rounding).
 
 #include "core/mesh.hpp"
 #include "core/part.hpp"
 #include "index/brute_force_index.hpp"
+#include "index/embree_index.hpp"
 #include "routing/path_planner.hpp"
 #include "routing/tube_validity.hpp"
 
@@ -239,6 +240,9 @@ TEST(PathPlanner, EveryPlannerNameSolvesAnEasyScene) {
   const BruteForceIndex index(s.parts());
   const auto names = planner_names();
   ASSERT_GE(names.size(), 6u);
+  EXPECT_NO_THROW(planner_is_optimizing(PlanSettings{}.planner));  // the default is a valid name
+  EXPECT_TRUE(planner_is_optimizing("bitstar"));
+  EXPECT_FALSE(planner_is_optimizing("rrtconnect"));
   for (const char* required_name : {"rrtstar", "bitstar", "prmstar", "lazyprmstar", "rrtconnect", "informedrrtstar"})
     EXPECT_NE(std::find(names.begin(), names.end(), required_name), names.end()) << required_name;
   for (const auto& name : names) {
@@ -265,6 +269,19 @@ TEST(PathPlanner, GoesAroundABlock) {
     expect_valid_route(s, req, r);
     EXPECT_GT(r.key_points.size(), 4u);  // must bend around the block
   }
+}
+
+TEST(PathPlanner, WorksOnTheEmbreeIndex) {
+  // The production index: same contract, same oracle.
+  const Scene s = wall_with_hole(6.0);
+  const EmbreeIndex index(s.parts());
+  PlanRequest req = base_request("bitstar");
+  req.start = {Vec3(20, 40, 60), Vec3::UnitX()};
+  req.goal = {Vec3(80, 60, 40), -Vec3::UnitX()};
+  req.time_limit = 2.0;
+  const PlanResult r = plan_path(index, req);
+  expect_valid_route(s, req, r);
+  EXPECT_GT(r.motion_checks, 0u);
 }
 
 TEST(PathPlanner, RoutesThroughAHoleWiderThanTheTube) {
@@ -468,6 +485,24 @@ TEST(PathPlanner, DerivedStubLength) {
   EXPECT_DOUBLE_EQ(r.stub_length, 12.0);
 }
 
+TEST(PathPlanner, OptimisingPlannersStopOnConvergence) {
+  // The cost threshold (1% above the straight-line bound) or the convergence window (no 1%
+  // gain in 5% of the budget) ends the run long before a 20 s budget on an easy scene.
+  // Easy scene: the threshold; block scene (bound unreachable): the convergence window.
+  for (const Scene& s : {easy_scene(), block_scene()}) {
+    const BruteForceIndex index(s.parts());
+    for (const char* name : {"informedrrtstar", "bitstar"}) {
+      SCOPED_TRACE(name);
+      PlanRequest req = base_request(name);
+      req.time_limit = 20.0;
+      req.convergence_window = 0.05;
+      const PlanResult r = plan_path(index, req);
+      expect_valid_route(s, req, r);
+      EXPECT_LT(r.plan_ms, 0.75 * req.time_limit * 1000.0);
+    }
+  }
+}
+
 // --- determinism ------------------------------------------------------------------------
 
 TEST(PathPlanner, SameSeedSameKeyPoints) {
@@ -514,7 +549,7 @@ TEST(PathPlanner, PartPreferenceChoosesTheSide) {
     req.objective.preference_weight = 5.0;
     req.objective.clearance_band = 10.0;
     req.objective.part_preference = {PartPreference::Neutral, pref};
-    req.max_iterations = 1500;
+    req.max_iterations = 800;
     req.time_limit = 20.0;
     const PlanResult r = plan_path(index, req);
     expect_valid_route(s, req, r);
@@ -530,7 +565,7 @@ TEST(PathPlanner, ClearanceTermKeepsTheRouteAway) {
   const Scene s = block_scene();
   const BruteForceIndex index(s.parts());
   PlanRequest req = base_request("rrtstar");
-  req.max_iterations = 1500;
+  req.max_iterations = 800;
   req.time_limit = 20.0;
   req.objective.clearance_weight = 0.0;
   const PlanResult tight = plan_path(index, req);

@@ -1,0 +1,77 @@
+// `loom render SCENE [--routes FILE] [--report FILE] [--out FILE] [--render-size WxH] [--quiet]`:
+// a PNG of the scene, its cables and (with --report) the report's clashes, ray-cast on the CPU.
+#include "app/commands.hpp"
+
+#include "core/error.hpp"
+#include "core/io/harness_xml.hpp"
+#include "core/io/scene_load.hpp"
+#include "core/units.hpp"
+#include "routing/render.hpp"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <string>
+
+namespace loom::app {
+
+namespace {
+
+struct RenderFlags {
+  std::string scene;
+  std::string routes;
+  std::string report;
+  std::string out = "render.png";
+  std::string size = "1200x800";
+  bool quiet = false;
+};
+
+int run_render(const RenderFlags& f) {
+  RenderOptions opt;
+  parse_render_size(f.size, "--render-size", opt);
+  Scene scene = load_scene(f.scene);
+  if (!f.routes.empty()) {
+    Harness routed = read_harness_xml(f.routes);
+    if (routed.units != scene.units)
+      throw InputError({f.routes, 0, "harness"}, std::string("unit mismatch: the routes are in ") +
+                                                     unit_name(routed.units) + " but the scene is in " +
+                                                     unit_name(scene.units));
+    scene.harness = std::move(routed);
+  }
+  nlohmann::json report = nlohmann::json::object();
+  if (!f.report.empty()) {
+    std::ifstream in(f.report);
+    if (!in) throw InputError({f.report, 0, ""}, "cannot open the report");
+    try {
+      report = nlohmann::json::parse(in);
+    } catch (const nlohmann::json::parse_error& e) {
+      throw InputError({f.report, 0, ""}, std::string("not JSON: ") + e.what());
+    }
+  }
+  RenderStats st;
+  const Image img = render_scene(scene, scene.harness, report, opt, &st);
+  write_png(f.out, img);
+  if (!f.quiet)
+    std::printf("render %s: %dx%d, %zu rays, %zu tube triangles, %zu markers, %.0f ms -> %s\n", f.scene.c_str(),
+                img.width, img.height, st.rays, st.tube_triangles, st.markers, st.ms, f.out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+void add_render_command(CLI::App& app, int& exit_code) {
+  auto* cmd = app.add_subcommand("render", "Ray-cast a PNG of the scene, its cables and a report's clashes");
+  auto f = std::make_shared<RenderFlags>();
+  cmd->add_option("SCENE", f->scene, "Scene file (TOML)")->required();
+  cmd->add_option("--routes", f->routes, "Routed harness XML replacing the scene's harness");
+  cmd->add_option("--report", f->report, "report.json whose clashes and violations are marked");
+  cmd->add_option("--out", f->out, "Output PNG")->capture_default_str();
+  cmd->add_option("--render-size", f->size, "Image size WIDTHxHEIGHT")->capture_default_str();
+  cmd->add_flag("--quiet", f->quiet, "Print nothing");
+  cmd->callback([f, &exit_code]() { exit_code = run_render(*f); });
+}
+
+}  // namespace loom::app

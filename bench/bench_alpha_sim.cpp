@@ -1,0 +1,196 @@
+// α-SIM benchmark (issue 4). Scenario program, fixed seeds, baselines in the same run:
+//  1. the bundled wing-section scene and the real meshes at dim_pre = the scene's value
+//     (smallest cable diameter) / a fixed fraction of each part's size: triangle ratio,
+//     Hausdorff distance, containment, time;
+//  2. clearance (closest-point) query speed on the simplified vs the original geometry,
+//     both through EmbreeIndex;
+//  3. throughput (input triangles/s) with 1 and 2 TBB threads;
+//  4. sweep of dim_pre on occt/motor.stl: triangles, Hausdorff, time, query speed.
+// Writes bench/results/alpha_sim_parts.csv, alpha_sim_sweep.csv, alpha_sim.png.
+#include "core/io/mesh_read.hpp"
+#include "core/io/scene_load.hpp"
+#include "index/alpha_sim.hpp"
+#include "index/embree_index.hpp"
+
+#include <tbb/global_control.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+using namespace loom;
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/// Closest-point queries per second on `parts` through EmbreeIndex (random points in box).
+double query_rate(const std::vector<Part>& parts, const AABB& box, double radius, int n, std::uint64_t seed) {
+  EmbreeIndex idx(parts);
+  std::mt19937_64 rng(seed);
+  std::vector<Vec3> pts(static_cast<std::size_t>(n));
+  for (auto& p : pts)
+    for (int k = 0; k < 3; ++k)
+      p[k] = std::uniform_real_distribution<double>(box.min[k], box.max[k])(rng);
+  const auto t0 = Clock::now();
+  const auto hits = idx.closest_batch(pts, radius, 1);
+  const double s = seconds_since(t0);
+  volatile double sink = 0;
+  for (const auto& h : hits) sink = sink + (h.found() ? h.distance : 0.0);
+  return n / s;
+}
+
+Part load_part(const std::string& rel) {
+  Part p;
+  p.name = rel;
+  p.mesh = read_mesh_file(fs::path(LOOM_SHARED_DATA) / rel);
+  p.closed = analyse_topology(p.mesh).closed;
+  return p;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const fs::path out_dir = argc > 1 ? fs::path(argv[1]) : fs::path(LOOM_SOURCE_DIR) / "bench" / "results";
+  fs::create_directories(out_dir);
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  const int n_queries = 20000;
+
+  // ---- 1 + 2: per part, at the scene's dim_pre (wing) or 2% of the part diagonal (real meshes).
+  std::ofstream parts_csv(out_dir / "alpha_sim_parts.csv");
+  parts_csv << "set,part,dim_pre,triangles_before,triangles_after,ratio,hausdorff,containment,status,fallback,time_ms,"
+               "query_rate_original,query_rate_simplified,query_speedup\n";
+  struct Set {
+    std::string name;
+    std::vector<Part> parts;
+    double dim_pre;
+  };
+  std::vector<Set> sets;
+  // LOOM_BENCH_QUICK=1 skips the wing-section scene (its 14 STEP parts take minutes).
+  const bool quick = std::getenv("LOOM_BENCH_QUICK") != nullptr;
+  if (!quick) try {
+    const Scene wing = load_scene(fs::path(LOOM_SOURCE_DIR) / "examples" / "wing-section" / "scene.toml");
+    sets.push_back({"wing-section", wing.parts, wing.simplify.dim_pre.value});
+    std::printf("wing-section: %zu parts, %zu triangles, dim_pre %g (%s)\n", wing.parts.size(), wing.triangle_count(),
+                wing.simplify.dim_pre.value, wing.simplify.dim_pre.source.c_str());
+  } catch (const std::exception& e) {
+    std::printf("wing-section scene not loaded: %s\n", e.what());
+  }
+  for (const char* rel : {"occt/motor.stl", "trimesh/featuretype.STL", "fcl/env.obj", "occt/shape.stl",
+                          "trimesh/bunny.ply", "trimesh/tube.obj"}) {
+    Part p = load_part(rel);
+    const double dim = 0.02 * p.mesh.bounds().diagonal();
+    sets.push_back({rel, {p}, dim});
+  }
+  std::size_t total_in = 0;
+  for (const auto& set : sets) {
+    AlphaSimOptions opt;
+    opt.dim_pre = set.dim_pre;
+    std::vector<AlphaSimResult> res;
+    const auto simple = simplify_parts(set.parts, opt, &res);
+    AABB box;
+    for (const auto& p : set.parts) box.extend(p.mesh.bounds());
+    const double radius = 0.05 * box.diagonal();
+    const double q_orig = query_rate(set.parts, box, radius, n_queries, 11);
+    const double q_simp = query_rate(simple, box, radius, n_queries, 11);
+    std::size_t before = 0, after = 0;
+    double haus = 0, time_ms = 0, cont = 1;
+    for (std::size_t i = 0; i < res.size(); ++i) {
+      const auto& r = res[i];
+      before += r.triangles_before;
+      after += r.triangles_after;
+      haus = std::max(haus, r.hausdorff);
+      time_ms += r.time_ms;
+      cont = std::min(cont, r.containment);
+      parts_csv << set.name << "," << r.name << "," << set.dim_pre << "," << r.triangles_before << ","
+                << r.triangles_after << "," << double(r.triangles_after) / std::max<std::size_t>(1, r.triangles_before)
+                << "," << r.hausdorff << "," << r.containment << "," << alpha_sim_status_name(r.status) << ","
+                << alpha_sim_fallback_name(r.fallback) << "," << r.time_ms << "," << q_orig << "," << q_simp << ","
+                << q_simp / q_orig << "\n";
+    }
+    total_in += before;
+    std::printf("%-24s dim_pre %-8.4g tris %7zu -> %6zu (%5.1f%%) hausdorff %-9.4g containment %.6f  %7.0f ms  "
+                "queries/s %.3g -> %.3g (x%.2f)\n",
+                set.name.c_str(), set.dim_pre, before, after, 100.0 * after / std::max<std::size_t>(1, before), haus,
+                cont, time_ms, q_orig, q_simp, q_simp / q_orig);
+  }
+
+  // ---- 3: throughput on all real-mesh parts together, 1 vs 2 threads.
+  std::vector<Part> all;
+  std::size_t all_tris = 0;
+  for (std::size_t s = 0; s < sets.size(); ++s)
+    for (const auto& p : sets[s].parts) {
+      all.push_back(p);
+      all_tris += p.mesh.triangle_count();
+    }
+  std::ofstream tp_csv(out_dir / "alpha_sim_throughput.csv");
+  tp_csv << "threads,triangles,seconds,triangles_per_second,measure\n";
+  for (int measure = 0; measure <= 1; ++measure)
+    for (int threads : {1, 2}) {
+      tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+      const auto t0 = Clock::now();
+      for (std::size_t s = 0; s < sets.size(); ++s) {
+        AlphaSimOptions o;
+        o.dim_pre = sets[s].dim_pre;
+        o.measure = measure != 0;
+        std::vector<AlphaSimResult> res;
+        simplify_parts(sets[s].parts, o, &res);
+      }
+      const double sec = seconds_since(t0);
+      tp_csv << threads << "," << all_tris << "," << sec << "," << all_tris / sec << "," << measure << "\n";
+      std::printf("throughput (%s): %d thread(s): %zu triangles in %.2f s = %.3g triangles/s\n",
+                  measure ? "with verification" : "without mesh verification", threads, all_tris, sec, all_tris / sec);
+    }
+
+  // ---- 4: dim_pre sweep on the motor.
+  Part motor = load_part("occt/motor.stl");
+  const AABB mbox = motor.mesh.bounds();
+  const double diag = mbox.diagonal();
+  const double q_orig = query_rate({motor}, mbox, 0.05 * diag, n_queries, 5);
+  std::ofstream sweep_csv(out_dir / "alpha_sim_sweep.csv");
+  sweep_csv << "dim_pre,dim_pre_rel,triangles_after,triangle_ratio,hausdorff,hausdorff_rel,time_ms,query_rate,"
+               "query_speedup,status\n";
+  for (double rel : {0.005, 0.01, 0.02, 0.04, 0.08, 0.16}) {
+    AlphaSimOptions o;
+    o.dim_pre = rel * diag;
+    const auto sp = simplify_part(motor, o);
+    Part simple = motor;
+    simple.mesh = sp.mesh;
+    const double q = query_rate({simple}, mbox, 0.05 * diag, n_queries, 5);
+    const auto& r = sp.result;
+    sweep_csv << o.dim_pre << "," << rel << "," << r.triangles_after << ","
+              << double(r.triangles_after) / r.triangles_before << "," << r.hausdorff << "," << r.hausdorff / diag
+              << "," << r.time_ms << "," << q << "," << q / q_orig << "," << alpha_sim_status_name(r.status) << "\n";
+    std::printf("motor dim_pre %.4g (%.3f diag): tris %zu (%.1f%%) hausdorff %.4g  %.0f ms  speedup x%.2f  %s\n",
+                o.dim_pre, rel, r.triangles_after, 100.0 * r.triangles_after / r.triangles_before, r.hausdorff,
+                r.time_ms, q / q_orig, alpha_sim_status_name(r.status));
+  }
+  sweep_csv.close();
+
+  // Chart.
+  const fs::path gp = out_dir / "alpha_sim.gp";
+  std::ofstream g(gp);
+  g << "set terminal pngcairo size 1200,800\n"
+    << "set output '" << (out_dir / "alpha_sim.png").string() << "'\n"
+    << "set datafile separator ','\nset key autotitle columnhead\nset multiplot layout 2,2 title "
+       "'alpha-SIM on occt/motor.stl (13,502 triangles): level of detail dim_pre'\n"
+    << "set logscale x\nset xlabel 'dim_pre / bbox diagonal'\nset grid\n"
+    << "set ylabel 'triangles after / before (%)'\nplot '" << (out_dir / "alpha_sim_sweep.csv").string()
+    << "' using 2:($4*100) with linespoints title 'triangle ratio'\n"
+    << "set ylabel 'Hausdorff / diagonal'\nplot '' using 2:6 with linespoints title 'one-sided Hausdorff'\n"
+    << "set ylabel 'time (ms)'\nplot '' using 2:7 with linespoints title 'simplification time'\n"
+    << "set ylabel 'closest-point queries: simplified / original'\nplot '' using 2:9 with linespoints title "
+       "'query speed-up (Embree)'\nunset multiplot\n";
+  g.close();
+  const std::string cmd = "gnuplot '" + gp.string() + "'";
+  if (std::system(cmd.c_str()) != 0) std::printf("gnuplot failed\n");
+  std::printf("wrote %s\n", out_dir.string().c_str());
+  return 0;
+}
