@@ -17,6 +17,12 @@ int Harness::find_branch(const std::string& id) const {
   return -1;
 }
 
+std::optional<Vec3> Harness::node_position(const std::string& id) const {
+  if (int p = find_port(id); p >= 0) return ports[p].position;
+  if (int b = find_branch(id); b >= 0) return branches[b].position;
+  return std::nullopt;
+}
+
 int Harness::find_cable(const std::string& id) const {
   for (std::size_t i = 0; i < cables.size(); ++i)
     if (cables[i].id == id) return static_cast<int>(i);

@@ -86,6 +86,9 @@ struct Harness {
   int find_port(const std::string& id) const;
   /// Index of a branch point by id, or -1.
   int find_branch(const std::string& id) const;
+  /// Position of a node (port or branch point) by id; nullopt for an unknown id or an
+  /// unplaced branch point.
+  std::optional<Vec3> node_position(const std::string& id) const;
   /// Index of a cable by id, or -1.
   int find_cable(const std::string& id) const;
   /// Smallest cable diameter (0 if there are no cables).

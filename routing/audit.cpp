@@ -27,12 +27,6 @@ std::pair<std::string, std::string> use_nodes(const Harness& h, const SegmentUse
   return u.reversed ? std::make_pair(s.to, s.from) : std::make_pair(s.from, s.to);
 }
 
-std::optional<Vec3> node_pos(const Harness& h, const std::string& id) {
-  if (int p = h.find_port(id); p >= 0) return h.ports[static_cast<std::size_t>(p)].position;
-  if (int b = h.find_branch(id); b >= 0) return h.branches[static_cast<std::size_t>(b)].position;
-  return std::nullopt;
-}
-
 }  // namespace
 
 std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCable>& cables) {
@@ -73,7 +67,7 @@ std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCa
       for (const std::string& n : {nodes.first, nodes.second}) {
         if (std::any_of(in.junctions.begin(), in.junctions.end(), [&](const CableJunction& j) { return j.node == n; }))
           continue;
-        const auto pos = node_pos(h, n);
+        const auto pos = h.node_position(n);
         if (!pos) continue;
         double rad = 0.0;
         for (int inc : topo.incident_segments(n)) rad = std::max(rad, topo.segment_diameter(inc));

@@ -7,12 +7,6 @@ namespace loom {
 
 namespace {
 
-std::optional<Vec3> node_position(const Harness& h, const std::string& id) {
-  if (int p = h.find_port(id); p >= 0) return h.ports[p].position;
-  if (int b = h.find_branch(id); b >= 0) return h.branches[b].position;
-  return std::nullopt;
-}
-
 /// The curve traversed backwards: u ↦ (a + b) − u.
 Centerline reversed(const Centerline& c) {
   const auto& k = c.knots();
@@ -66,7 +60,7 @@ Centerline join(const Centerline& a, const Centerline& b) {
 std::optional<Centerline> segment_centerline(const Harness& h, int segment) {
   const Segment& s = h.segments.at(static_cast<std::size_t>(segment));
   if (s.bspline) return Centerline(s.bspline->degree, s.bspline->knots, s.bspline->control_points);
-  const auto a = node_position(h, s.from), b = node_position(h, s.to);
+  const auto a = h.node_position(s.from), b = h.node_position(s.to);
   if (!a || !b) return std::nullopt;
   std::vector<Vec3> pts{*a};
   pts.insert(pts.end(), s.path.begin(), s.path.end());

@@ -30,12 +30,6 @@ constexpr int kClearShells = 40;
 /// The straight stubs at both ends of a segment take at most this share of its length.
 constexpr double kStubShare = 0.4;
 
-std::optional<Vec3> node_pos(const Harness& h, const std::string& id) {
-  if (int p = h.find_port(id); p >= 0) return h.ports[p].position;
-  if (int b = h.find_branch(id); b >= 0) return h.branches[b].position;
-  return std::nullopt;
-}
-
 /// Directions on the unit sphere: the 26 neighbours of a cube cell, normalised.
 std::vector<Vec3> shell_directions() {
   std::vector<Vec3> d;
@@ -119,12 +113,12 @@ std::vector<std::string> place_branch_points(Harness& h, const ObstacleIndex& in
     Vec3 sum = Vec3::Zero();
     int n = 0;
     for (const auto& id : nb[h.branches[b].id])
-      if (auto p = node_pos(h, id)) sum += *p, ++n;
+      if (auto p = h.node_position(id)) sum += *p, ++n;
     pos[b] = n ? Vec3(sum / n) : port_mean;
   }
   auto position_of = [&](const std::string& id) -> Vec3 {
     if (int b = h.find_branch(id); b >= 0 && !h.branches[b].position) return pos[b];
-    return *node_pos(h, id);
+    return *h.node_position(id);
   };
   // Weiszfeld: each unplaced point moves to the distance-weighted mean of its neighbours;
   // chains of unplaced points converge together (the sum of segment lengths is convex).
@@ -231,7 +225,7 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
     breakout[br.id] = breakout_length(topo, br.id);
     auto far_end = [&](int seg) {
       const Segment& sg = h.segments[seg];
-      return *node_pos(h, sg.from == br.id ? sg.to : sg.from);
+      return *h.node_position(sg.from == br.id ? sg.to : sg.from);
     };
     std::map<std::pair<int, int>, int> passes;
     for (std::size_t c = 0; c < h.cables.size(); ++c) {
@@ -269,7 +263,7 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
     const Segment& sg = h.segments[seg];
     EndFrame e;
     e.node = from_end ? sg.from : sg.to;
-    e.position = *node_pos(h, e.node);
+    e.position = *h.node_position(e.node);
     if (int p = h.find_port(e.node); p >= 0) {
       e.is_port = true;
       e.exit = h.ports[p].direction;
@@ -296,7 +290,7 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
       rep.segments.push_back(info);
       continue;
     }
-    const Vec3 a = *node_pos(h, seg.from), b = *node_pos(h, seg.to);
+    const Vec3 a = *h.node_position(seg.from), b = *h.node_position(seg.to);
     double min_bend = 0.0;
     for (int c : topo.segment_cables(s)) min_bend = std::max(min_bend, h.cables[c].physical.min_bend_radius);
     const double radius = 0.5 * topo.segment_diameter(s);

@@ -135,6 +135,11 @@ bool marker_json(const nlohmann::json& e, double q, std::string& s) {
     if (e.contains(k) && e[k].is_string()) o[k] = e[k];
   for (const char* k : {"clearance", "s", "value", "limit"})
     if (e.contains(k) && e[k].is_number()) o[k] = std::round(finite_or(e, k, 0.0) / q) * q;
+  // DESIGN §4 violations: bend-radius carries radius/min, clearance carries clearance/required.
+  for (const auto& [from, to] : {std::pair<const char*, const char*>{"radius", "value"}, {"min", "limit"},
+                                 {"required", "limit"}})
+    if (e.contains(from) && e[from].is_number()) o[to] = std::round(finite_or(e, from, 0.0) / q) * q;
+  if (e.contains("required") && o.contains("clearance")) o["value"] = o["clearance"];
   nlohmann::json p = nlohmann::json::array();
   for (const auto& c : e["point"]) p.push_back(c.is_number() ? quantize(c.get<double>(), q) : 0);
   o["p"] = p;
