@@ -110,12 +110,14 @@ int run_audit_command(const AuditFlags& f) {
       if (frac >= 1.0) std::fprintf(stderr, "\r            \r");
       std::fflush(stderr);
     };
-  const AuditReport rep = audit_scene_file(f.scene, opt);
+  Scene scene;
+  const AuditReport rep = audit_scene_file(f.scene, opt, &scene);
   const std::filesystem::path report_path = std::filesystem::path(f.out) / "report.json";
   write_audit_report(rep, report_path);
-  write_view_outputs_for_files(f.out, f.scene, opt.routes, audit_report_json(rep));  // view.html, render.png (issue 9)
+  const nlohmann::json report = audit_report_json(rep);
+  write_view_outputs(f.out, scene, scene.harness, report);  // view.html, render.png (issue 9)
   if (f.json)
-    std::cout << audit_report_json(rep).dump(2) << "\n";
+    std::cout << report.dump(2) << "\n";
   else if (!f.quiet)
     print_summary(rep, report_path);
   return rep.exit_code();

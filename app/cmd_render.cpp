@@ -3,7 +3,6 @@
 #include "app/commands.hpp"
 
 #include "core/error.hpp"
-#include "core/io/harness_xml.hpp"
 #include "core/io/scene_load.hpp"
 #include "core/units.hpp"
 #include "routing/render.hpp"
@@ -33,14 +32,7 @@ int run_render(const RenderFlags& f) {
   RenderOptions opt;
   parse_render_size(f.size, "--render-size", opt);
   Scene scene = load_scene(f.scene);
-  if (!f.routes.empty()) {
-    Harness routed = read_harness_xml(f.routes);
-    if (routed.units != scene.units)
-      throw InputError({f.routes, 0, "harness"}, std::string("unit mismatch: the routes are in ") +
-                                                     unit_name(routed.units) + " but the scene is in " +
-                                                     unit_name(scene.units));
-    scene.harness = std::move(routed);
-  }
+  if (!f.routes.empty()) apply_routes(scene, f.routes);
   nlohmann::json report = nlohmann::json::object();
   if (!f.report.empty()) {
     std::ifstream in(f.report);

@@ -9,7 +9,6 @@
 
 #include <CLI/CLI.hpp>
 
-#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -56,7 +55,6 @@ void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
 }  // namespace
 
 int run_route(const std::string& scene_path, const RouteCommandOptions& o) {
-  const auto t0 = std::chrono::steady_clock::now();
   SceneLoadReport lr;
   Scene scene = load_scene(scene_path, {}, &lr);
   if (!scene.has_harness) throw InputError({scene_path, 0, "[harness]"}, "the scene has no harness to route");
@@ -80,7 +78,6 @@ int run_route(const std::string& scene_path, const RouteCommandOptions& o) {
   const double chord = 0.1 * 0.5 * scene.harness.smallest_diameter();
   write_route_outputs(rep, o.out, chord > 0 ? chord : 0.01);
   write_view_outputs(o.out, scene, rep.routed, route_report_json(rep));  // view.html, render.png (issue 9)
-  (void)t0;
   if (o.json) std::cout << route_report_json(rep).dump(2) << "\n";
   else if (!o.quiet) print_summary(rep, o.out);
   return rep.exit_code();

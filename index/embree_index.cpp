@@ -339,6 +339,20 @@ IndexAccuracy EmbreeIndex::accuracy() const {
 }
 
 namespace {
+/// One Embree point query: `rel` is the world point minus the index centre, `radius` the
+/// search radius already padded for float rounding; the callback accumulates into q.
+void run_point_query(RTCScene scene, const Vec3& rel, double radius, QueryState& q) {
+  RTCPointQuery pq;
+  pq.x = static_cast<float>(rel.x());
+  pq.y = static_cast<float>(rel.y());
+  pq.z = static_cast<float>(rel.z());
+  pq.time = 0.0f;
+  pq.radius = to_float_up(radius);
+  RTCPointQueryContext ctx;
+  rtcInitPointQueryContext(&ctx);
+  rtcPointQuery(scene, &pq, &ctx, point_query_callback, &q);
+}
+
 ClosestHit finish_closest(QueryState& q, double max_radius) {
   ClosestHit h = q.hit;
   if (h.found()) {
@@ -351,46 +365,24 @@ ClosestHit finish_closest(QueryState& q, double max_radius) {
 
 ClosestHit EmbreeIndex::closest(const Vec3& p, double max_radius) const {
   if (triangle_count_ == 0 || !(max_radius >= 0.0)) return {};
-  FlushDenormals ftz;
-  QueryState q;
-  q.parts = &parts_;
-  q.p = p;
-  q.pad = float_pad(p, max_radius);
-  if (std::isfinite(max_radius)) q.best2 = max_radius * max_radius * (1.0 + 1e-15);
-  const Vec3 pc = p - centre_;
-  RTCPointQuery pq;
-  pq.x = static_cast<float>(pc.x());
-  pq.y = static_cast<float>(pc.y());
-  pq.z = static_cast<float>(pc.z());
-  pq.time = 0.0f;
-  pq.radius = to_float_up(max_radius + q.pad);
-  RTCPointQueryContext ctx;
-  rtcInitPointQueryContext(&ctx);
-  rtcPointQuery(impl_->scene, &pq, &ctx, point_query_callback, &q);
-  return finish_closest(q, max_radius);
+  return closest_in(impl_->scene, -1, p, max_radius);
 }
 
 ClosestHit EmbreeIndex::closest_on_part(const Vec3& p, int part, double max_radius) const {
   check_part_id(part, parts_.size());
   if (parts_[part].triangles.empty() || !(max_radius >= 0.0)) return {};
-  auto scene = static_cast<RTCScene>(part_scene(part));
+  return closest_in(part_scene(part), part, p, max_radius);
+}
+
+ClosestHit EmbreeIndex::closest_in(void* scene, int only_part, const Vec3& p, double max_radius) const {
   FlushDenormals ftz;
   QueryState q;
   q.parts = &parts_;
-  q.only_part = part;
+  q.only_part = only_part;
   q.p = p;
   q.pad = float_pad(p, max_radius);
   if (std::isfinite(max_radius)) q.best2 = max_radius * max_radius * (1.0 + 1e-15);
-  const Vec3 pc = p - centre_;
-  RTCPointQuery pq;
-  pq.x = static_cast<float>(pc.x());
-  pq.y = static_cast<float>(pc.y());
-  pq.z = static_cast<float>(pc.z());
-  pq.time = 0.0f;
-  pq.radius = to_float_up(max_radius + q.pad);
-  RTCPointQueryContext ctx;
-  rtcInitPointQueryContext(&ctx);
-  rtcPointQuery(scene, &pq, &ctx, point_query_callback, &q);
+  run_point_query(static_cast<RTCScene>(scene), p - centre_, max_radius + q.pad, q);
   return finish_closest(q, max_radius);
 }
 
@@ -402,16 +394,7 @@ bool EmbreeIndex::any_within(const Vec3& p, double r) const {
   q.mode = Mode::AnyWithin;
   q.p = p;
   q.r2 = r * r;
-  const Vec3 pc = p - centre_;
-  RTCPointQuery pq;
-  pq.x = static_cast<float>(pc.x());
-  pq.y = static_cast<float>(pc.y());
-  pq.z = static_cast<float>(pc.z());
-  pq.time = 0.0f;
-  pq.radius = to_float_up(r + float_pad(p, r));
-  RTCPointQueryContext ctx;
-  rtcInitPointQueryContext(&ctx);
-  rtcPointQuery(impl_->scene, &pq, &ctx, point_query_callback, &q);
+  run_point_query(impl_->scene, p - centre_, r + float_pad(p, r), q);
   return q.done;
 }
 
@@ -425,21 +408,12 @@ bool EmbreeIndex::segment_within(const Vec3& a, const Vec3& b, double r) const {
   q.parts = &parts_;
   q.mode = Mode::SegmentAny;
   q.r2 = r * r;
-  RTCPointQueryContext ctx;
   for (int k = 0; k < n && !q.done; ++k) {
     q.a = a + (b - a) * (static_cast<double>(k) / n);
     q.b = a + (b - a) * (static_cast<double>(k + 1) / n);
     const Vec3 mid = 0.5 * (q.a + q.b);
     const double half = 0.5 * (q.b - q.a).norm();
-    const Vec3 pc = mid - centre_;
-    RTCPointQuery pq;
-    pq.x = static_cast<float>(pc.x());
-    pq.y = static_cast<float>(pc.y());
-    pq.z = static_cast<float>(pc.z());
-    pq.time = 0.0f;
-    pq.radius = to_float_up(half + r + float_pad(mid, half + r));
-    rtcInitPointQueryContext(&ctx);
-    rtcPointQuery(impl_->scene, &pq, &ctx, point_query_callback, &q);
+    run_point_query(impl_->scene, mid - centre_, half + r + float_pad(mid, half + r), q);
   }
   return q.done;
 }
@@ -455,8 +429,7 @@ ClosestHit EmbreeIndex::segment_closest(const Vec3& a, const Vec3& b, double max
   q.parts = &parts_;
   q.mode = Mode::Segment;
   q.best2 = std::isfinite(max_radius) ? max_radius * max_radius * (1.0 + 1e-15) : q.best2;
-  RTCPointQueryContext ctx;
-  // Visit pieces from the middle outwards? Plain order: the shrinking radius carries over.
+  // Pieces in order: the shrinking radius carries over from one to the next.
   for (int k = 0; k < n; ++k) {
     q.s0 = static_cast<double>(k) / n;
     q.s1 = static_cast<double>(k + 1) / n;
@@ -467,15 +440,7 @@ ClosestHit EmbreeIndex::segment_closest(const Vec3& a, const Vec3& b, double max
     q.radius_offset = half;
     const double cur = std::isfinite(q.best2) ? std::sqrt(q.best2) : std::numeric_limits<double>::infinity();
     q.pad = float_pad(mid, half + (std::isfinite(cur) ? cur : 0.0));
-    const Vec3 pc = mid - centre_;
-    RTCPointQuery pq;
-    pq.x = static_cast<float>(pc.x());
-    pq.y = static_cast<float>(pc.y());
-    pq.z = static_cast<float>(pc.z());
-    pq.time = 0.0f;
-    pq.radius = to_float_up(half + cur + q.pad);
-    rtcInitPointQueryContext(&ctx);
-    rtcPointQuery(impl_->scene, &pq, &ctx, point_query_callback, &q);
+    run_point_query(impl_->scene, mid - centre_, half + cur + q.pad, q);
   }
   ClosestHit h = finish_closest(q, max_radius);
   if (h.found() && segment_param) *segment_param = q.best_s;

@@ -74,6 +74,8 @@ class EmbreeIndex : public ObstacleIndex {
  private:
   /// Search-radius pad (scene units) that covers float rounding for a query at p.
   double float_pad(const Vec3& p, double radius) const;
+  /// Closest point in `scene` (the whole index, or a one-part scene with only_part = its id).
+  ClosestHit closest_in(void* scene, int only_part, const Vec3& p, double max_radius) const;
   /// Lazily built scene holding only one part (for closest_on_part).
   void* part_scene(int part) const;
 

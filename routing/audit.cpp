@@ -131,23 +131,16 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
   return rep;
 }
 
-AuditReport audit_scene_file(const std::filesystem::path& scene_file, const AuditOptions& opt) {
+AuditReport audit_scene_file(const std::filesystem::path& scene_file, const AuditOptions& opt, Scene* loaded) {
   const auto t0 = std::chrono::steady_clock::now();
   SceneLoadReport load_rep;
   Scene scene = load_scene(scene_file, {}, &load_rep);
-  if (opt.routes) {
-    Harness routed = read_harness_xml(*opt.routes);
-    if (routed.units != scene.units)
-      throw InputError({opt.routes->string(), 0, "harness"},
-                       std::string("unit mismatch: the routes are in ") + unit_name(routed.units) +
-                           " but the scene is in " + unit_name(scene.units));
-    scene.harness = std::move(routed);
-    scene.has_harness = true;
-  }
+  if (opt.routes) apply_routes(scene, *opt.routes);
   const double load_ms = ms_since(t0);
   AuditReport rep = run_audit(scene, opt);
   rep.load_ms = load_ms;
   rep.notes.insert(rep.notes.begin(), load_rep.notes.begin(), load_rep.notes.end());
+  if (loaded) *loaded = std::move(scene);
   return rep;
 }
 

@@ -67,7 +67,9 @@ std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCa
 AuditReport run_audit(const Scene& scene, const AuditOptions& opt);
 
 /// Loads the scene file (timed as timing_ms.load), applies --routes, and audits it.
-/// Throws InputError (exit 2) for bad input.
-AuditReport audit_scene_file(const std::filesystem::path& scene_file, const AuditOptions& opt);
+/// Throws InputError (exit 2) for bad input. `loaded`, if given, receives the audited scene
+/// (parts and the harness actually checked), e.g. to draw it.
+AuditReport audit_scene_file(const std::filesystem::path& scene_file, const AuditOptions& opt,
+                             Scene* loaded = nullptr);
 
 }  // namespace loom

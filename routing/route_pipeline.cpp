@@ -12,6 +12,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 #include <set>
 
 namespace loom {
@@ -467,15 +468,21 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
   rep.timing.spline = ms_since(t0);
 
   // 6. Exact audit against the real parts; repair segments whose curves clash or crowd.
+  //    The exact index is built once: the planning index when planning used the exact parts.
+  t0 = Clock::now();
+  std::unique_ptr<EmbreeIndex> exact_owned;
+  if (opt.simplify && !scene.parts.empty()) exact_owned = std::make_unique<EmbreeIndex>(scene.parts);
   AuditOptions ao;
   ao.check.threads = opt.threads;
-  ao.check.routing_clearance = rep.clearance;
+  ao.index = exact_owned ? exact_owned.get() : &plan_index;
+  rep.timing.index += ms_since(t0);
   Scene routed_scene;
+  routed_scene.name = scene.name;
+  routed_scene.units = scene.units;
+  routed_scene.routing = scene.routing;
+  routed_scene.has_harness = true;
+  routed_scene.parts = scene.parts;
   auto audit_now = [&]() {
-    routed_scene.name = scene.name;
-    routed_scene.units = scene.units;
-    routed_scene.routing = scene.routing;
-    routed_scene.has_harness = true;
     routed_scene.harness = h;
     // Cables that could not be routed have no curve to audit (their segments would read
     // as straight lines between the nodes); they are reported as unrouted instead.
@@ -486,8 +493,6 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
                                                      [&](const UnroutedCable& u) { return u.cable == c.id; });
                                 }),
                  cables.end());
-    // Parts are shared by value here; the audit indexes them itself.
-    routed_scene.parts = scene.parts;
     return run_audit(routed_scene, ao);
   };
   t0 = Clock::now();
@@ -498,18 +503,15 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
     // Segments (that we routed) hit by a clash or clearance violation of any cable.
     std::set<int> bad;
     auto mark = [&](int check_index, double s_at) {
-      const std::string& id = rep.audit.check_ids[check_index];
-      const int c = h.find_cable(id);
+      const int c = h.find_cable(rep.audit.check_ids[check_index]);
       if (c < 0) return;
-      double s0 = 0.0;
-      for (const auto& use : topo.cable_chain(c)) {
-        auto curve = segment_centerline(h, use.segment);
-        const double len = curve ? curve->length() : 0.0;
-        if (s_at <= s0 + len + 1e-9) {
-          if (geom.count(use.segment)) bad.insert(use.segment);
+      const auto pieces = cable_pieces(topo, c);
+      for (std::size_t k = 0; k < pieces.size(); ++k) {
+        const bool last = k + 1 == pieces.size();
+        if (last || s_at < pieces[k + 1].s0) {
+          if (geom.count(pieces[k].segment)) bad.insert(pieces[k].segment);
           return;
         }
-        s0 += len;
       }
     };
     for (const auto& cl : rep.audit.result.clashes) {

@@ -3,8 +3,6 @@
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
 #include "core/io/atomic_file.hpp"
-#include "core/io/harness_xml.hpp"
-#include "core/io/scene_load.hpp"
 #include "core/units.hpp"
 #include "routing/cable_geometry.hpp"
 #include "routing/render.hpp"
@@ -292,42 +290,11 @@ ViewStats write_view_html(const std::filesystem::path& file, const Scene& scene,
   return st;
 }
 
-namespace {
-
-Scene load_with_routes(const std::filesystem::path& scene_toml, const std::optional<std::filesystem::path>& routes) {
-  Scene scene = load_scene(scene_toml);
-  if (routes) {
-    Harness routed = read_harness_xml(*routes);
-    if (routed.units != scene.units)
-      throw InputError({routes->string(), 0, "harness"}, std::string("unit mismatch: the routes are in ") +
-                                                           unit_name(routed.units) + " but the scene is in " +
-                                                           unit_name(scene.units));
-    scene.harness = std::move(routed);
-  }
-  return scene;
-}
-
-}  // namespace
-
 ViewStats write_view_outputs(const std::filesystem::path& dir, const Scene& scene, const Harness& harness,
                              const nlohmann::json& report) {
   const ViewStats st = write_view_html(dir / "view.html", scene, harness, report);
   write_png(dir / "render.png", render_scene(scene, harness, report));
   return st;
-}
-
-ViewStats write_view_outputs_for_files(const std::filesystem::path& dir, const std::filesystem::path& scene_toml,
-                                       const std::optional<std::filesystem::path>& routes,
-                                       const nlohmann::json& report) {
-  const Scene scene = load_with_routes(scene_toml, routes);
-  return write_view_outputs(dir, scene, scene.harness, report);
-}
-
-ViewStats write_view_html_for_files(const std::filesystem::path& file, const std::filesystem::path& scene_toml,
-                                    const std::optional<std::filesystem::path>& routes,
-                                    const nlohmann::json& report, const ViewOptions& opt) {
-  const Scene scene = load_with_routes(scene_toml, routes);
-  return write_view_html(file, scene, scene.harness, report, opt);
 }
 
 namespace {

@@ -56,19 +56,9 @@ std::string view_data_json(const Scene& scene, const Harness& harness, const nlo
 ViewStats write_view_html(const std::filesystem::path& file, const Scene& scene, const Harness& harness,
                           const nlohmann::json& report, const ViewOptions& opt = {});
 
-/// As write_view_html for `loom audit`: loads the scene file and, if given, the routed
-/// harness XML that replaces the scene's harness. Throws InputError for bad input.
-ViewStats write_view_html_for_files(const std::filesystem::path& file, const std::filesystem::path& scene_toml,
-                                    const std::optional<std::filesystem::path>& routes,
-                                    const nlohmann::json& report, const ViewOptions& opt = {});
-
 /// What `loom route` and `loom audit` write beside report.json: DIR/view.html and
 /// DIR/render.png (routing/render.hpp, default size). Returns the page's stats.
 ViewStats write_view_outputs(const std::filesystem::path& dir, const Scene& scene, const Harness& harness,
                              const nlohmann::json& report);
-/// As write_view_outputs, loading the scene file and the optional routed harness XML first.
-ViewStats write_view_outputs_for_files(const std::filesystem::path& dir, const std::filesystem::path& scene_toml,
-                                       const std::optional<std::filesystem::path>& routes,
-                                       const nlohmann::json& report);
 
 }  // namespace loom

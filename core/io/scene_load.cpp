@@ -111,6 +111,16 @@ std::filesystem::path resolve(const std::filesystem::path& base, const std::stri
 
 }  // namespace
 
+void apply_routes(Scene& scene, const std::filesystem::path& routes) {
+  Harness routed = read_harness_xml(routes);
+  if (routed.units != scene.units)
+    throw InputError({routes.string(), 0, "harness"}, std::string("unit mismatch: the routes are in ") +
+                                                         unit_name(routed.units) + " but the scene is in " +
+                                                         unit_name(scene.units));
+  scene.harness = std::move(routed);
+  scene.has_harness = true;
+}
+
 Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions& opt, SceneLoadReport* report) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::string file = toml_path.string();

@@ -27,4 +27,8 @@ struct SceneLoadReport {
 Scene load_scene(const std::filesystem::path& toml, const SceneLoadOptions& opt = {},
                  SceneLoadReport* report = nullptr);
 
+/// Replaces the scene's harness by a routed harness XML (`--routes`). Throws InputError
+/// naming the routes file for a unit mismatch or any harness error.
+void apply_routes(Scene& scene, const std::filesystem::path& routes);
+
 }  // namespace loom
