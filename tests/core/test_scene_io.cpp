@@ -182,6 +182,24 @@ TEST_F(SceneDir, DuplicatePartNames) {
              {"duplicate part name"});
 }
 
+TEST_F(SceneDir, RoutesReplaceTheHarnessAndMustShareItsUnit) {
+  Scene s = load_scene(scene("[scene]\nname='t'\nunits='mm'\n"));
+  EXPECT_FALSE(s.has_harness);
+  apply_routes(s, dir_ / "harness.xml");
+  EXPECT_TRUE(s.has_harness);
+  EXPECT_EQ(s.harness.cables.size(), 2u);
+  std::string h = kHarness;
+  h.replace(h.find("units=\"mm\""), 10, "units=\"m\"");
+  write("routes_m.xml", h);
+  try {
+    apply_routes(s, dir_ / "routes_m.xml");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("routes_m.xml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("unit mismatch"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(SceneDir, HarnessErrorsCarryTheHarnessFile) {
   std::string h = kHarness;
   h.replace(h.find("diameter=\"4\""), 12, "diameter=\"-4\"");
