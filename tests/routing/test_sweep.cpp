@@ -376,6 +376,11 @@ RC_GTEST_PROP(SweepProperty, RandomTubesAreClosedFiniteAndOnTheTube, ()) {
     RC_ASSERT((sec[i].point - c.position(sec[i].u)).norm() <= 1e-9 * (1 + c.length()));
     for (int j = 0; j < res.circumferential; ++j)
       RC_ASSERT(std::abs((res.mesh.vertices[i * res.circumferential + j] - sec[i].point).norm() - r) <= 1e-9);
-    if (i > 0) RC_ASSERT(angle(sec[i - 1].normal, sec[i].normal) <= angle(sec[i - 1].tangent, sec[i].tangent) + 1e-9);
+    if (i > 0) {
+      // Double reflection approximates the rotation-minimising frame with a local error of
+      // O(turn³) (Wang et al. 2008), so the normal may turn that much more than the tangent.
+      const double turn = angle(sec[i - 1].tangent, sec[i].tangent);
+      RC_ASSERT(angle(sec[i - 1].normal, sec[i].normal) <= turn + turn * turn * turn + 1e-9);
+    }
   }
 }
