@@ -1,16 +1,17 @@
 // `loom audit SCENE [--routes FILE] [--method certified|discrete] [--no-index] [--spacing L]
-// [--tolerance T] [--threads N] [--out DIR] [--json] [--quiet]`: clash, bend and clearance
-// audit of a harness in its scene; writes DIR/report.json (DESIGN §4).
+// [--tolerance T] [--threads N] [--out DIR] [--render-size WxH] [--json] [--quiet]`: clash,
+// bend and clearance audit of a harness in its scene; writes DIR/report.json (DESIGN §4),
+// DIR/view.html and DIR/render.png. Progress bars on stderr when it is a terminal.
 #include "app/commands.hpp"
 
 #include "core/error.hpp"
+#include "core/progress.hpp"
 #include "routing/audit.hpp"
+#include "routing/render.hpp"
 #include "routing/report_json.hpp"
 #include "routing/view_html.hpp"
 
 #include <CLI/CLI.hpp>
-
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -34,6 +35,7 @@ struct AuditFlags {
   double tolerance = 0.0;
   int threads = 0;
   std::string out = "loom-audit";
+  std::string render_size = default_render_size();
   bool json = false;
   bool quiet = false;
 };
@@ -103,19 +105,17 @@ int run_audit_command(const AuditFlags& f) {
   opt.check.tolerance = f.tolerance;
   opt.check.threads = f.threads;
   if (!f.routes.empty()) opt.routes = f.routes;
-  const bool show_progress = !f.quiet && !f.json && isatty(STDERR_FILENO);
-  if (show_progress)
-    opt.check.progress = [](double frac) {
-      std::fprintf(stderr, "\raudit: %3.0f%%", 100.0 * frac);
-      if (frac >= 1.0) std::fprintf(stderr, "\r            \r");
-      std::fflush(stderr);
-    };
+  RenderOptions render;
+  parse_render_size(f.render_size, "--render-size", render);
+  ProgressBar bar(stderr, f.quiet || f.json);
+  opt.progress = bar.fn();
+  render.progress = bar.fn();
   Scene scene;
   const AuditReport rep = audit_scene_file(f.scene, opt, &scene);
   const std::filesystem::path report_path = std::filesystem::path(f.out) / "report.json";
   write_audit_report(rep, report_path);
   const nlohmann::json report = audit_report_json(rep);
-  write_view_outputs(f.out, scene, scene.harness, report);  // view.html, render.png (issue 9)
+  write_view_outputs(f.out, scene, scene.harness, report, render);  // view.html, render.png (issue 9)
   if (f.json)
     std::cout << report.dump(2) << "\n";
   else if (!f.quiet)
@@ -138,6 +138,7 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--tolerance", f->tolerance, "Certified accuracy (default: smallest cable radius / 100)");
   cmd->add_option("--threads", f->threads, "Worker threads (default: all cores)");
   cmd->add_option("--out", f->out, "Output directory for report.json")->capture_default_str();
+  cmd->add_option("--render-size", f->render_size, "Size of render.png, WIDTHxHEIGHT")->capture_default_str();
   cmd->add_flag("--json", f->json, "Print the report as JSON instead of the summary");
   cmd->add_flag("--quiet", f->quiet, "Print nothing (exit status and report only)");
   cmd->callback([f, m, &exit_code]() {

@@ -1,5 +1,8 @@
-// `loom demo [--out DIR]`: the main job on the bundled wing-section example.
+// `loom demo [--out DIR] [--render-size WxH] [--quiet]`: the main job on the bundled
+// wing-section example.
 #include "app/commands.hpp"
+
+#include "routing/render.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -24,18 +27,23 @@ void add_demo_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("demo", "Run loom on the bundled wing-section example");
   auto out = std::make_shared<std::string>("loom-demo");
   auto quiet = std::make_shared<bool>(false);
+  auto render_size = std::make_shared<std::string>(default_render_size());
   cmd->add_option("--out", *out, "Output directory")->capture_default_str();
+  cmd->add_option("--render-size", *render_size, "Size of render.png, WIDTHxHEIGHT")->capture_default_str();
   cmd->add_flag("--quiet", *quiet, "Print nothing (exit status only)");
-  cmd->callback([out, quiet, &exit_code]() {
+  cmd->callback([out, quiet, render_size, &exit_code]() {
     // The main job on the bundled wing section: what is there, then route + exact audit.
     const std::string scene = demo_scene_path();
+    RouteCommandOptions o;
+    o.out = *out;
+    o.quiet = *quiet;
+    o.render_size = *render_size;
+    RenderOptions size_check;
+    parse_render_size(o.render_size, "--render-size", size_check);  // a bad size fails before any work
     if (!*quiet) {
       run_info(scene, false, false);
       std::printf("\n");
     }
-    RouteCommandOptions o;
-    o.out = *out;
-    o.quiet = *quiet;
     exit_code = run_route(scene, o);
   });
 }

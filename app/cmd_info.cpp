@@ -3,6 +3,7 @@
 
 #include "core/harness_topology.hpp"
 #include "core/io/scene_load.hpp"
+#include "core/progress.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -166,7 +167,10 @@ void add_info_command(CLI::App& app, int& exit_code) {
 
 int run_info(const std::string& scene_path, bool json, bool quiet) {
   SceneLoadReport rep;
-  Scene scene = load_scene(scene_path, {}, &rep);
+  ProgressBar bar(stderr, quiet || json);
+  SceneLoadOptions lo;
+  lo.progress = bar.fn();
+  Scene scene = load_scene(scene_path, lo, &rep);
   if (quiet) return 0;
   if (json) std::cout << info_json(scene, rep).dump(2) << "\n";
   else print_text(scene, rep);

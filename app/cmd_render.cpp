@@ -4,6 +4,7 @@
 
 #include "core/error.hpp"
 #include "core/io/scene_load.hpp"
+#include "core/progress.hpp"
 #include "core/units.hpp"
 #include "routing/render.hpp"
 
@@ -24,14 +25,18 @@ struct RenderFlags {
   std::string routes;
   std::string report;
   std::string out = "render.png";
-  std::string size = "1200x800";
+  std::string size = default_render_size();
   bool quiet = false;
 };
 
 int run_render(const RenderFlags& f) {
   RenderOptions opt;
   parse_render_size(f.size, "--render-size", opt);
-  Scene scene = load_scene(f.scene);
+  ProgressBar bar(stderr, f.quiet);
+  SceneLoadOptions lo;
+  lo.progress = bar.fn();
+  opt.progress = bar.fn();
+  Scene scene = load_scene(f.scene, lo);
   if (!f.routes.empty()) apply_routes(scene, f.routes);
   nlohmann::json report = nlohmann::json::object();
   if (!f.report.empty()) {
@@ -53,6 +58,11 @@ int run_render(const RenderFlags& f) {
 }
 
 }  // namespace
+
+std::string default_render_size() {
+  const RenderOptions d;
+  return std::to_string(d.width) + "x" + std::to_string(d.height);
+}
 
 void add_render_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("render", "Ray-cast a PNG of the scene, its cables and a report's clashes");

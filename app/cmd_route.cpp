@@ -1,9 +1,12 @@
 // `loom route SCENE ...`: plan, spline, audit and repair every cable; write routed.xml,
-// report.json and cables.ply.
+// report.json, cables.ply, view.html and render.png (--render-size WxH). Progress bars on
+// stderr when it is a terminal.
 #include "app/commands.hpp"
 
 #include "core/error.hpp"
 #include "core/io/scene_load.hpp"
+#include "core/progress.hpp"
+#include "routing/render.hpp"
 #include "routing/route_report.hpp"
 #include "routing/view_html.hpp"
 
@@ -13,7 +16,6 @@
 #include <iostream>
 #include <memory>
 #include <set>
-#include <unistd.h>
 
 namespace loom::app {
 
@@ -24,7 +26,8 @@ void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
   std::set<std::string> unrouted;
   for (const auto& u : rep.unrouted) unrouted.insert(u.cable);
   std::printf("route %s: %zu/%zu cables routed (%s, seed %u), clearance %.4g %s\n", a.scene.c_str(),
-              a.cables.size() - unrouted.size(), a.cables.size(), rep.planner.c_str(), rep.seed, rep.clearance,
+              rep.routed.cables.size() - unrouted.size(), rep.routed.cables.size(), rep.planner.c_str(), rep.seed,
+              rep.clearance,
               a.units.c_str());
   std::printf("  time: load %.0f ms, simplify %.0f ms, index %.0f ms, plan %.0f ms, spline %.0f ms, audit %.0f ms, "
               "repair %.0f ms, total %.0f ms\n",
@@ -55,8 +58,14 @@ void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
 }  // namespace
 
 int run_route(const std::string& scene_path, const RouteCommandOptions& o) {
+  RenderOptions render;
+  if (!o.render_size.empty()) parse_render_size(o.render_size, "--render-size", render);
+  ProgressBar bar(stderr, o.quiet || o.json);
+  render.progress = bar.fn();
+  SceneLoadOptions lo;
+  lo.progress = bar.fn();
   SceneLoadReport lr;
-  Scene scene = load_scene(scene_path, {}, &lr);
+  Scene scene = load_scene(scene_path, lo, &lr);
   if (!scene.has_harness) throw InputError({scene_path, 0, "[harness]"}, "the scene has no harness to route");
   RouteOptions ro;
   ro.planner = o.planner;
@@ -64,12 +73,7 @@ int run_route(const std::string& scene_path, const RouteCommandOptions& o) {
   ro.seed = o.seed;
   ro.threads = o.threads;
   ro.simplify = o.simplify;
-  const bool tty = !o.quiet && ::isatty(STDERR_FILENO);
-  if (tty)
-    ro.progress = [](const std::string& stage, double f) {
-      std::fprintf(stderr, "\r%-8s %5.1f%%", stage.c_str(), 100.0 * f);
-      if (f >= 1.0) std::fprintf(stderr, "\n");
-    };
+  ro.progress = bar.fn();
   RouteReport rep = route_scene(scene, ro);
   rep.timing.load = lr.load_ms;
   rep.audit.load_ms = lr.load_ms;
@@ -77,7 +81,7 @@ int run_route(const std::string& scene_path, const RouteCommandOptions& o) {
   // Tube resolution: a tenth of the smallest cable radius is finer than any viewer needs.
   const double chord = 0.1 * 0.5 * scene.harness.smallest_diameter();
   write_route_outputs(rep, o.out, chord > 0 ? chord : 0.01);
-  write_view_outputs(o.out, scene, rep.routed, route_report_json(rep));  // view.html, render.png (issue 9)
+  write_view_outputs(o.out, scene, rep.routed, route_report_json(rep), render);  // view.html, render.png (issue 9)
   if (o.json) std::cout << route_report_json(rep).dump(2) << "\n";
   else if (!o.quiet) print_summary(rep, o.out);
   return rep.exit_code();
@@ -87,12 +91,14 @@ void add_route_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("route", "Route every cable of a scene's harness, then audit it against the exact geometry");
   auto scene = std::make_shared<std::string>();
   auto o = std::make_shared<RouteCommandOptions>();
+  o->render_size = default_render_size();
   cmd->add_option("SCENE", *scene, "Scene file (TOML)")->required();
   cmd->add_option("--out", o->out, "Output directory (routed.xml, report.json, cables.ply)")->capture_default_str();
   cmd->add_option("--planner", o->planner, "OMPL planner (rrtconnect, rrtstar, bitstar, prmstar, lazyprmstar, ...)");
   cmd->add_option("--time-limit", o->time_limit, "Planning seconds per segment (default: scene [routing])");
   cmd->add_option("--seed", o->seed, "Random seed (default: scene [routing])");
   cmd->add_option("--threads", o->threads, "Audit threads (default: all cores)");
+  cmd->add_option("--render-size", o->render_size, "Size of render.png, WIDTHxHEIGHT")->capture_default_str();
   cmd->add_flag("--simplify", o->simplify, "Plan among α-simplified parts instead of the exact ones (α-SIM, DESIGN §6)");
   cmd->add_flag("--json", o->json, "Print the report as JSON");
   cmd->add_flag("--quiet", o->quiet, "Print nothing (exit status only)");

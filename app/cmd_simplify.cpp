@@ -6,6 +6,7 @@
 #include "core/io/atomic_file.hpp"
 #include "core/io/mesh_write.hpp"
 #include "core/io/scene_load.hpp"
+#include "core/progress.hpp"
 #include "index/alpha_sim.hpp"
 
 #include <CLI/CLI.hpp>
@@ -45,7 +46,10 @@ std::string file_stem(const std::string& name, std::set<std::string>& used) {
 double finite_or_zero(double v) { return std::isfinite(v) ? v : 0.0; }
 
 int run_simplify(const SimplifyCommandOptions& o) {
-  Scene scene = load_scene(o.scene);
+  ProgressBar bar(stderr, o.quiet);
+  SceneLoadOptions lo;
+  lo.progress = bar.fn();
+  Scene scene = load_scene(o.scene, lo);
   const bool given = !std::isnan(o.dim_pre);
   const double dim_pre = given ? o.dim_pre : scene.simplify.dim_pre.value;
   if (!(std::isfinite(dim_pre) && dim_pre > 0.0))
@@ -57,6 +61,7 @@ int run_simplify(const SimplifyCommandOptions& o) {
   opt.dim_pre = dim_pre;
   opt.scene_size = scene.bounds().diagonal();
   if (o.step) opt.step_dir = out_dir;
+  opt.progress = bar.fn();
   if (!o.quiet)
     std::fprintf(stderr, "loom simplify: %zu parts, dim_pre %g %s (%s)\n", scene.parts.size(), dim_pre,
                  unit_name(scene.units), given ? "--dim-pre" : scene.simplify.dim_pre.source.c_str());

@@ -24,6 +24,7 @@ int run_info(const std::string& scene, bool json, bool quiet);
 /// Flags of `loom route`.
 struct RouteCommandOptions {
   std::string out = "loom-route";
+  std::string render_size;   ///< render.png "WxH"; empty: default_render_size()
   std::string planner;       ///< empty: the scene's
   double time_limit = -1.0;  ///< < 0: the scene's
   long seed = -1;            ///< < 0: the scene's
@@ -39,6 +40,8 @@ int run_route(const std::string& scene, const RouteCommandOptions& options);
 void add_demo_command(CLI::App& app, int& exit_code);
 /// `loom render`: a ray-cast PNG of a scene, its cables and a report's clashes (issue 9).
 void add_render_command(CLI::App& app, int& exit_code);
+/// The size of render.png when --render-size is not given, as "WxH" (RenderOptions' default).
+std::string default_render_size();
 /// Path of the bundled demo scene ($LOOM_EXAMPLES_DIR overrides the built-in path).
 std::string demo_scene_path();
 

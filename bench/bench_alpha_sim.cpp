@@ -4,7 +4,9 @@
 //     Hausdorff distance, containment, time;
 //  2. clearance (closest-point) query speed on the simplified vs the original geometry,
 //     both through EmbreeIndex;
-//  3. throughput (input triangles/s) with 1 and 2 TBB threads;
+//     and for points within 5·dim_pre of the original surface (routing's clearance queries);
+//  3. throughput (input triangles/s, wall and CPU) with 1 and 2 TBB threads (the wing's
+//     translated copies — ribs, boxes — are simplified once, as simplify_parts does);
 //  4. sweep of dim_pre on occt/motor.stl: triangles, Hausdorff, time, query speed.
 // Writes bench/results/alpha_sim_parts.csv, alpha_sim_sweep.csv, alpha_sim.png.
 #include "core/io/mesh_read.hpp"
@@ -12,11 +14,13 @@
 #include "index/alpha_sim.hpp"
 #include "index/embree_index.hpp"
 
+#include <sys/resource.h>
 #include <tbb/global_control.h>
 
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -30,6 +34,14 @@ using Clock = std::chrono::steady_clock;
 namespace {
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/// CPU time (user + system) of the process so far, all threads (s): comparable on a busy
+/// machine, unlike wall time.
+double cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
 
 /// Closest-point queries per second on `parts` through EmbreeIndex (random points in box).
 double query_rate(const std::vector<Part>& parts, const AABB& box, double radius, int n, std::uint64_t seed) {
@@ -45,6 +57,32 @@ double query_rate(const std::vector<Part>& parts, const AABB& box, double radius
   volatile double sink = 0;
   for (const auto& h : hits) sink = sink + (h.found() ? h.distance : 0.0);
   return n / s;
+}
+
+/// Closest-point queries per second through EmbreeIndex for points near the original
+/// surface (what routing asks): surface samples of `near` moved by up to `radius` in a
+/// random direction, searched within `radius`.
+double near_query_rate(const std::vector<Part>& parts, const std::vector<Part>& near, double radius, int n,
+                       std::uint64_t seed) {
+  Mesh all;
+  for (const auto& p : near) all.append(p.mesh);
+  auto surf = dense_surface_samples(all, radius, 0.0, 0, seed);
+  std::mt19937_64 rng(seed);
+  std::shuffle(surf.begin(), surf.end(), rng);
+  surf.resize(std::min<std::size_t>(surf.size(), static_cast<std::size_t>(n)));
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (auto& p : surf) {
+    const Vec3 dir = Vec3(g(rng), g(rng), g(rng)).normalized();
+    p += dir * (radius * u(rng));
+  }
+  EmbreeIndex idx(parts);
+  const auto t0 = Clock::now();
+  const auto hits = idx.closest_batch(surf, radius, 1);
+  const double s = seconds_since(t0);
+  volatile double sink = 0;
+  for (const auto& h : hits) sink = sink + (h.found() ? h.distance : 0.0);
+  return static_cast<double>(surf.size()) / s;
 }
 
 Part load_part(const std::string& rel) {
@@ -66,7 +104,8 @@ int main(int argc, char** argv) {
   // ---- 1 + 2: per part, at the scene's dim_pre (wing) or 2% of the part diagonal (real meshes).
   std::ofstream parts_csv(out_dir / "alpha_sim_parts.csv");
   parts_csv << "set,part,dim_pre,triangles_before,triangles_after,ratio,hausdorff,containment,status,fallback,time_ms,"
-               "query_rate_original,query_rate_simplified,query_speedup\n";
+               "query_rate_original,query_rate_simplified,query_speedup,near_rate_original,near_rate_simplified,"
+               "near_speedup,copy_of\n";
   struct Set {
     std::string name;
     std::vector<Part> parts;
@@ -94,12 +133,18 @@ int main(int argc, char** argv) {
     AlphaSimOptions opt;
     opt.dim_pre = set.dim_pre;
     std::vector<AlphaSimResult> res;
+    const double cpu0 = cpu_seconds();
+    const auto t_set = Clock::now();
     const auto simple = simplify_parts(set.parts, opt, &res);
+    const double set_cpu = cpu_seconds() - cpu0, set_wall = seconds_since(t_set);
     AABB box;
     for (const auto& p : set.parts) box.extend(p.mesh.bounds());
     const double radius = 0.05 * box.diagonal();
     const double q_orig = query_rate(set.parts, box, radius, n_queries, 11);
     const double q_simp = query_rate(simple, box, radius, n_queries, 11);
+    // Near the surface, within 5 cable diameters (= dim_pre).
+    const double qn_orig = near_query_rate(set.parts, set.parts, 5.0 * set.dim_pre, n_queries, 13);
+    const double qn_simp = near_query_rate(simple, set.parts, 5.0 * set.dim_pre, n_queries, 13);
     std::size_t before = 0, after = 0;
     double haus = 0, time_ms = 0, cont = 1;
     for (std::size_t i = 0; i < res.size(); ++i) {
@@ -113,13 +158,15 @@ int main(int argc, char** argv) {
                 << r.triangles_after << "," << double(r.triangles_after) / std::max<std::size_t>(1, r.triangles_before)
                 << "," << r.hausdorff << "," << r.containment << "," << alpha_sim_status_name(r.status) << ","
                 << alpha_sim_fallback_name(r.fallback) << "," << r.time_ms << "," << q_orig << "," << q_simp << ","
-                << q_simp / q_orig << "\n";
+                << q_simp / q_orig << "," << qn_orig << "," << qn_simp << "," << qn_simp / qn_orig << "," << r.copy_of
+                << "\n";
     }
     total_in += before;
-    std::printf("%-24s dim_pre %-8.4g tris %7zu -> %6zu (%5.1f%%) hausdorff %-9.4g containment %.6f  %7.0f ms  "
-                "queries/s %.3g -> %.3g (x%.2f)\n",
+    std::printf("%-24s dim_pre %-8.4g tris %7zu -> %6zu (%5.1f%%) hausdorff %-9.4g containment %.6f  %7.0f ms parts, "
+                "simplify_parts %.2f s CPU %.2f s wall  queries/s in box %.3g -> %.3g (x%.2f), near surface %.3g -> "
+                "%.3g (x%.2f)\n",
                 set.name.c_str(), set.dim_pre, before, after, 100.0 * after / std::max<std::size_t>(1, before), haus,
-                cont, time_ms, q_orig, q_simp, q_simp / q_orig);
+                cont, time_ms, set_cpu, set_wall, q_orig, q_simp, q_simp / q_orig, qn_orig, qn_simp, qn_simp / qn_orig);
   }
 
   // ---- 3: throughput on all real-mesh parts together, 1 vs 2 threads.
@@ -131,11 +178,12 @@ int main(int argc, char** argv) {
       all_tris += p.mesh.triangle_count();
     }
   std::ofstream tp_csv(out_dir / "alpha_sim_throughput.csv");
-  tp_csv << "threads,triangles,seconds,triangles_per_second,measure\n";
+  tp_csv << "threads,triangles,seconds,triangles_per_second,measure,cpu_seconds,triangles_per_cpu_second\n";
   for (int measure = 0; measure <= 1; ++measure)
     for (int threads : {1, 2}) {
       tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
       const auto t0 = Clock::now();
+      const double cpu0 = cpu_seconds();
       for (std::size_t s = 0; s < sets.size(); ++s) {
         AlphaSimOptions o;
         o.dim_pre = sets[s].dim_pre;
@@ -143,10 +191,13 @@ int main(int argc, char** argv) {
         std::vector<AlphaSimResult> res;
         simplify_parts(sets[s].parts, o, &res);
       }
-      const double sec = seconds_since(t0);
-      tp_csv << threads << "," << all_tris << "," << sec << "," << all_tris / sec << "," << measure << "\n";
-      std::printf("throughput (%s): %d thread(s): %zu triangles in %.2f s = %.3g triangles/s\n",
-                  measure ? "with verification" : "without mesh verification", threads, all_tris, sec, all_tris / sec);
+      const double sec = seconds_since(t0), cpu = cpu_seconds() - cpu0;
+      tp_csv << threads << "," << all_tris << "," << sec << "," << all_tris / sec << "," << measure << "," << cpu << ","
+             << all_tris / cpu << "\n";
+      std::printf("throughput (%s): %d thread(s): %zu triangles in %.2f s = %.3g triangles/s (CPU %.2f s = %.3g "
+                  "triangles per CPU second)\n",
+                  measure ? "with verification" : "without mesh verification", threads, all_tris, sec, all_tris / sec,
+                  cpu, all_tris / cpu);
     }
 
   // ---- 4: dim_pre sweep on the motor.

@@ -8,6 +8,7 @@
 // Writes bench/results/audit*.csv and charts (gnuplot). Fixed seeds.
 //
 //   bench_audit [--quick]      (--quick: smaller scenes, for a smoke run)
+//   bench_audit --probe TRIS_PER_PART [THREADS]   (one audit of the triangle-scaling scene)
 #include "index/embree_index.hpp"
 #include "routing/clash_check.hpp"
 
@@ -191,6 +192,33 @@ void gnuplot(const std::string& script) {
   std::filesystem::remove(path);
 }
 
+/// One certified audit of the triangle-scaling scene (seed 7: the same 200 parts and 100
+/// cables at every size, only the tessellation changes) with `tris_per_part` triangles per
+/// part, for CPU time and instruction counts: `valgrind --tool=callgrind bench_audit --probe
+/// N`, then the inclusive count of loom::check_clashes in callgrind_annotate --inclusive=yes
+/// (a --toggle-collect on it would be toggled off again by its own nested lambdas). The
+/// audit runs twice: the first run pays for anything the index builds lazily.
+int probe(int tris_per_part, int threads) {
+  const BenchScene sc = make_scene(200, tris_per_part, 100, 1.0, 7);
+  const double b0 = cpu_ms();
+  const EmbreeIndex idx(sc.parts);
+  const double index_cpu = cpu_ms() - b0;
+  ClashRequest req;
+  req.routing_clearance = 3.0;
+  req.threads = threads;
+  const double c0 = cpu_ms();
+  const ClashResult r = check_clashes(sc.cables, sc.parts, &idx, req);
+  const double first = cpu_ms() - c0;
+  const double c1 = cpu_ms();
+  check_clashes(sc.cables, sc.parts, &idx, req);  // again: what is left once the index is warm
+  std::printf("probe: %zu triangles, %d threads: index cpu %.1f ms, audit cpu %.1f ms (again %.1f ms), %lld distance queries, %lld inside queries, %lld samples, "
+              "%zu clashes, %zu violations\n",
+              sc.triangles, threads, index_cpu, first, cpu_ms() - c1, static_cast<long long>(r.counters.distance_queries),
+              static_cast<long long>(r.counters.inside_queries), static_cast<long long>(r.counters.samples),
+              r.clashes.size(), r.violations.size());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -199,6 +227,7 @@ int main(int argc, char** argv) {
   std::filesystem::create_directories(dir);
   const int base_parts = quick ? 40 : 200, base_cables = quick ? 20 : 100, tris = 7500;
 
+  if (argc > 2 && std::string(argv[1]) == "--probe") return probe(std::atoi(argv[2]), argc > 3 ? std::atoi(argv[3]) : 1);
   const bool breakdown_only = argc > 1 && std::string(argv[1]) == "--breakdown";
   {
     // Where the certified time goes (each check kind alone), paper-scale scene.

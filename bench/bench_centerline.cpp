@@ -5,6 +5,8 @@
 // + BRepMesh at the same deflection — the seed's own tool chain), plus the charts
 // fairing ε/α → max deviation and ∫κ²ds, and sweep tolerance → triangles and time.
 // Writes bench/results/centerline*.csv and .png (gnuplot). Fixed seeds. Scene units: mm.
+// `bench_centerline --quick`: only the per-cable and 1-thread batch figures, printed with a
+// fingerprint of one cable's results (no baseline, no files) — for profiling changes.
 #include "core/centerline.hpp"
 #include "routing/fairing.hpp"
 #include "routing/sweep.hpp"
@@ -30,6 +32,7 @@
 
 #include <signal.h>
 #include <sys/wait.h>
+#include <malloc.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -57,6 +60,9 @@ constexpr int kCables = 1000;
 constexpr unsigned kBaselineTimeoutSeconds = 900;
 /// Cables timed in the OpenCASCADE baseline (it takes seconds per cable).
 constexpr int kBaselineCables = 3;
+/// Heap the process keeps instead of returning freed pages to the kernel, in the second
+/// measurement (larger than all meshes of a batch in flight).
+constexpr int kRetainedHeapBytes = 1 << 30;
 
 /// Single-thread measures use this thread's CPU time (the machine is shared: wall time
 /// would count other processes); batch measures use wall time.
@@ -185,27 +191,24 @@ std::pair<double, double> occt_baseline(const std::vector<std::vector<Vec3>>& ca
   return {in[0], in[1]};
 }
 
-void gnuplot(const std::string& name, const std::string& script) {
-  const std::string gp = kResults + name + ".gp";
-  std::ofstream(gp) << "set terminal pngcairo size 900,560\nset output '" << kResults << name << ".png'\n"
-                    << "set datafile separator ','\nset grid\n"
-                    << script;
-  const std::string cmd = "gnuplot '" + gp + "' 2>/dev/null";
-  if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "gnuplot failed for %s\n", name.c_str());
-  std::remove(gp.c_str());
+/// Single-cable and batch figures of one heap configuration.
+struct Measures {
+  double single = 0, interp = 0, fair = 0, sweep = 0;  ///< medians, µs of thread CPU time
+  double triangles = 0, rings = 0;                      ///< means per cable
+  double batch1 = 0, batch2 = 0;                        ///< 1000 cables, ms wall, 1 and 2 threads
+  double batch1_cpu = 0;                                ///< 1000 cables on 1 thread, ms of process CPU time
+};
+
+double process_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
 }
 
-}  // namespace
-
-int main() {
-  std::vector<std::vector<Vec3>> cables;
-  for (int i = 0; i < kCables; ++i) cables.push_back(cable_points(1000u + i));
-
-  // --- same-process baseline: OpenCASCADE pipe + mesh (forked before TBB starts threads) ---
-  const std::vector<std::vector<Vec3>> sample(cables.begin(), cables.begin() + kBaselineCables);
-  const auto [occt_us, occt_tris] = occt_baseline(sample);
-
-  // --- one cable on one core ------------------------------------------------------------
+/// One cable on one core (600 runs over 200 cables), then 1000 cables on 1 and (unless
+/// quick) 2 threads, three runs each (medians).
+Measures measure(const std::vector<std::vector<Vec3>>& cables, bool quick) {
+  Measures m;
   std::vector<double> ti, tf, ts, tt;
   std::size_t tris = 0;
   int rings = 0;
@@ -220,36 +223,105 @@ int main() {
       tris += p.triangles;
       rings += p.rings;
     }
-  const double single = median(tt);
-  const double mean_tris = static_cast<double>(tris) / tt.size();
-  const double mean_rings = static_cast<double>(rings) / tt.size();
-
-  // --- 1000 cables on 1 and 2 threads ---------------------------------------------------
-  auto batch = [&](int threads) {
+  m.single = median(tt);
+  m.interp = median(ti);
+  m.fair = median(tf);
+  m.sweep = median(ts);
+  m.triangles = static_cast<double>(tris) / tt.size();
+  m.rings = static_cast<double>(rings) / tt.size();
+  auto batch = [&](int threads, double* cpu_ms) {
     tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
-    std::vector<double> runs;
+    std::vector<double> runs, cpu;
     for (int rep = 0; rep < 3; ++rep) {
       const auto t0 = Wall::now();
+      const double c0 = process_cpu_ms();
       tbb::parallel_for(0, kCables, [&](int i) { run_cable(cables[i], false); });
+      cpu.push_back(process_cpu_ms() - c0);
       runs.push_back(wall_us_since(t0) / 1000.0);
     }
+    if (cpu_ms) *cpu_ms = median(cpu);
     return median(runs);
   };
-  const double batch1 = batch(1), batch2 = batch(2);
+  m.batch1 = batch(1, &m.batch1_cpu);
+  m.batch2 = quick ? 0.0 : batch(2, nullptr);
+  return m;
+}
 
+void gnuplot(const std::string& name, const std::string& script) {
+  const std::string gp = kResults + name + ".gp";
+  std::ofstream(gp) << "set terminal pngcairo size 900,560\nset output '" << kResults << name << ".png'\n"
+                    << "set datafile separator ','\nset grid\n"
+                    << script;
+  const std::string cmd = "gnuplot '" + gp + "' 2>/dev/null";
+  if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "gnuplot failed for %s\n", name.c_str());
+  std::remove(gp.c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // --quick: only the single-cable and 1000-cable measures, printed (process CPU time for the
+  // batch), no OpenCASCADE baseline, no CSV or charts — for profiling on a busy machine.
+  const bool quick = argc > 1 && std::string(argv[1]) == "--quick";
+  std::vector<std::vector<Vec3>> cables;
+  for (int i = 0; i < kCables; ++i) cables.push_back(cable_points(1000u + i));
+
+  // --- same-process baseline: OpenCASCADE pipe + mesh (forked before TBB starts threads) ---
+  const std::vector<std::vector<Vec3>> sample(cables.begin(), cables.begin() + kBaselineCables);
+  const auto [occt_us, occt_tris] = quick ? std::pair<double, double>(-1, 0) : occt_baseline(sample);
+
+  // --- one cable on one core; 1000 cables on 1 and 2 threads -----------------------------
+  // Measured twice: with glibc's default heap policy (every discarded ~0.5 MB mesh goes back
+  // to the kernel, the next cable page-faults it in again: what a program that keeps its
+  // meshes pays too, once per mesh), then with the freed heap kept (the algorithm alone).
+  const Measures fresh = measure(cables, quick);
+  mallopt(M_MMAP_THRESHOLD, kRetainedHeapBytes);
+  mallopt(M_TRIM_THRESHOLD, kRetainedHeapBytes);
+  const Measures kept = measure(cables, quick);
+  if (quick) {
+    {  // fingerprint of one cable's pipeline output (to check that speed-ups change no result)
+      InterpolationOptions io;
+      io.start_tangent = Vec3::UnitX();
+      io.end_tangent = (cables[5].back() - cables[5][cables[5].size() - 2]).normalized();
+      FairingOptions f;
+      f.tolerance = kFairingTolerance;
+      const FairingResult fr = fair_energy(Centerline::interpolate(cables[5], io), f);
+      const SweepResult sw = sweep_tube(fr.curve, kRadius, {kChordTolerance, true});
+      double sum = 0.0;
+      for (const Vec3& v : sw.mesh.vertices) sum += v.x() + 2.0 * v.y() + 3.0 * v.z();
+      std::printf("fingerprint: length %.17g alpha %.17g energy %.17g vertices %zu sum %.17g turn %.17g\n",
+                  fr.curve.length(), fr.alpha, fr.energy_after, sw.mesh.vertices.size(), sum, sw.max_frame_turn);
+    }
+    for (const Measures* m : {&fresh, &kept})
+      std::printf("%s: one cable %.1f us CPU (interp %.1f, fair %.1f, sweep %.1f), %.0f triangles, %.0f rings; "
+                  "1000 cables on 1 thread %.1f ms CPU\n",
+                  m == &fresh ? "default heap" : "heap kept", m->single, m->interp, m->fair, m->sweep, m->triangles,
+                  m->rings, m->batch1_cpu);
+    return 0;
+  }
+  const double single = fresh.single, batch1 = fresh.batch1, batch2 = fresh.batch2;
 
   {
     std::ofstream o(kResults + "centerline.csv");
     o << "measure,value,unit,target\n";
     o << "single_cable_total," << single << ",us_cpu,90\n";
-    o << "single_cable_interpolate," << median(ti) << ",us_cpu,\n";
-    o << "single_cable_fair," << median(tf) << ",us_cpu,\n";
-    o << "single_cable_sweep," << median(ts) << ",us_cpu,\n";
-    o << "single_cable_triangles," << mean_tris << ",count,\n";
-    o << "single_cable_rings," << mean_rings << ",count,\n";
+    o << "single_cable_interpolate," << fresh.interp << ",us_cpu,\n";
+    o << "single_cable_fair," << fresh.fair << ",us_cpu,\n";
+    o << "single_cable_sweep," << fresh.sweep << ",us_cpu,\n";
+    o << "single_cable_triangles," << fresh.triangles << ",count,\n";
+    o << "single_cable_rings," << fresh.rings << ",count,\n";
     o << "batch_1000_cables_1_thread," << batch1 << ",ms,\n";
     o << "batch_1000_cables_2_threads," << batch2 << ",ms,50\n";
     o << "speedup_2_threads," << batch1 / batch2 << ",ratio,\n";
+    o << "batch_1000_cables_1_thread_cpu," << fresh.batch1_cpu << ",ms_cpu,\n";
+    // The same with the freed heap kept by the process (no page faults for discarded meshes).
+    o << "heap_kept_single_cable_total," << kept.single << ",us_cpu,90\n";
+    o << "heap_kept_single_cable_interpolate," << kept.interp << ",us_cpu,\n";
+    o << "heap_kept_single_cable_fair," << kept.fair << ",us_cpu,\n";
+    o << "heap_kept_single_cable_sweep," << kept.sweep << ",us_cpu,\n";
+    o << "heap_kept_batch_1000_cables_1_thread," << kept.batch1 << ",ms,\n";
+    o << "heap_kept_batch_1000_cables_1_thread_cpu," << kept.batch1_cpu << ",ms_cpu,\n";
+    o << "heap_kept_batch_1000_cables_2_threads," << kept.batch2 << ",ms,50\n";
     o << "occt_pipe_mesh_baseline," << occt_us << ",us_cpu,\n";
     o << "occt_baseline_triangles," << occt_tris << ",count,\n";
     o << "speedup_vs_occt," << (occt_us > 0 ? occt_us / single : 0.0) << ",ratio,\n";
@@ -258,10 +330,14 @@ int main() {
     getloadavg(load, 3);
     o << "machine_load_average_1min," << load[0] << ",processes,\n";
   }
-  std::printf("one cable (1 m, r 2 mm, tol 0.01 mm): %.1f us total (interp %.1f, fair %.1f, sweep %.1f), "
-              "%.0f triangles, %.0f rings\n",
-              single, median(ti), median(tf), median(ts), mean_tris, mean_rings);
-  std::printf("1000 cables: %.1f ms on 1 thread, %.1f ms on 2 threads (x%.2f)\n", batch1, batch2, batch1 / batch2);
+  for (const Measures* m : {&fresh, &kept}) {
+    std::printf("%s: one cable (1 m, r 2 mm, tol 0.01 mm): %.1f us total (interp %.1f, fair %.1f, sweep %.1f), "
+                "%.0f triangles, %.0f rings\n",
+                m == &fresh ? "default heap" : "heap kept", m->single, m->interp, m->fair, m->sweep, m->triangles,
+                m->rings);
+    std::printf("  1000 cables: %.1f ms on 1 thread (%.1f ms CPU), %.1f ms on 2 threads (x%.2f)\n", m->batch1,
+                m->batch1_cpu, m->batch2, m->batch1 / m->batch2);
+  }
   std::printf("OpenCASCADE pipe + mesh baseline: %.1f us per cable (%.0f triangles) -> x%.1f\n", occt_us, occt_tris,
               occt_us > 0 ? occt_us / single : 0.0);
 
@@ -305,7 +381,7 @@ int main() {
           " '' every ::1 using (strcol(1) eq 'alpha' ? $3 : NaN):5 axes x1y2 with linespoints title 'int kappa^2 ds'\n"
           "unset multiplot\n");
 
-  // --- sweep tolerance → triangles, time ------------------------------------------------------
+  // --- sweep tolerance → triangles, time (with the freed heap kept, as set above) ----------------
   {
     InterpolationOptions io;
     io.start_tangent = Vec3::UnitX();

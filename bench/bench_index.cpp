@@ -3,6 +3,10 @@
 // queries/s on 1 and 2 threads for points within 10 cable radii of a 1M-triangle scene
 // against the brute-force and FCL baselines in the same run, voxelisation time, distance
 // map lookups/s, and voxel size against distance error and lookup time.
+// Also: Embree LOW / MEDIUM / HIGH builds on 1M triangles (build time against query rate,
+// index_build_quality.csv), and the 1M query rows on both the automatic (LOW) and a MEDIUM
+// build. Modes: --build-only, --quality-only, --queries-only, --micro-only, and
+// --probe TRIS QUALITY (20k closest queries, for callgrind instruction counts).
 // Writes bench/results/index_*.csv and index_*.png (gnuplot). Fixed seeds throughout.
 #include "core/io/atomic_file.hpp"
 #include "core/io/mesh_read.hpp"
@@ -174,12 +178,49 @@ void build_scaling() {
               "'' every ::5::5 using 2:6 with points pt 2 ps 2 title 'motor.stl (per CPU-s)'\n");
 }
 
+/// Build quality trade-off on the 1M-triangle query scene: build time (wall and CPU) and
+/// closest-point queries per CPU-second (1 thread, points within 10 cable radii) for
+/// Embree's LOW / MEDIUM / HIGH builds. Justifies the automatic choice in EmbreeIndex.
+void build_quality_tradeoff() {
+  const auto parts = generated_scene(1000000, 7);
+  const std::size_t n = count_tris(parts);
+  const double reach = 10 * kCableRadius;
+  const auto pts = near_surface_points(parts, 100000, reach, 8);
+  std::ostringstream csv;
+  csv << "quality,triangles,build_s,mtris_per_s,build_cpu_s,queries_per_cpu_s_1t,embree_bytes_per_tri,load_avg\n";
+  for (int quality : {0, 1, 2}) {
+    EmbreeOptions o;
+    o.build_quality = quality;
+    double best = 1e30, best_cpu = 1e30;
+    std::size_t bytes = 0;
+    for (int rep = 0; rep < 2; ++rep) {
+      const double c0 = cpu_now();
+      const EmbreeIndex e(parts, o);
+      best_cpu = std::min(best_cpu, cpu_now() - c0);
+      best = std::min(best, e.build_seconds());
+      bytes = e.memory_bytes();
+    }
+    const EmbreeIndex e(parts, o);
+    e.closest_batch(std::vector<Vec3>(pts.begin(), pts.begin() + 10000), reach, 1);  // warm-up
+    const double c0 = cpu_now();
+    const auto hits = e.closest_batch(pts, reach, 1);
+    const double qc = cpu_now() - c0;
+    benchmark::DoNotOptimize(hits.data());
+    csv << quality << "," << n << "," << best << "," << rate(n, best) / 1e6 << "," << best_cpu << "," << rate(pts.size(), qc)
+        << "," << static_cast<double>(bytes) / static_cast<double>(n) << "," << load_avg() << "\n";
+    std::cout << "build quality " << quality << ": " << best << " s wall (" << rate(n, best) / 1e6 << " M tris/s), "
+              << best_cpu << " s cpu, closest " << rate(pts.size(), qc) / 1e6 << " M/cpu-s (1 thread), "
+              << static_cast<double>(bytes) / static_cast<double>(n) << " B/tri\n";
+  }
+  write_csv("index_build_quality.csv", csv.str());
+}
+
 void query_throughput() {
   const auto parts = generated_scene(1000000, 7);
   const std::size_t n = count_tris(parts);
   const double reach = 10 * kCableRadius;
   const auto pts = near_surface_points(parts, 400000, reach, 8);
-  const EmbreeIndex e(parts);
+  const EmbreeIndex e(parts);  // automatic build quality (LOW at this size)
   std::ostringstream csv;
   csv << "index,query,threads,points,seconds,queries_per_s,cpu_seconds,queries_per_cpu_s,load_avg\n";
   // Runs f() on n queries and writes a CSV row; returns the wall-clock rate.
@@ -203,6 +244,19 @@ void query_throughput() {
       benchmark::DoNotOptimize(hits.data());
     });
     (threads == 1 ? one : two) = r;
+  }
+  // The same queries on a MEDIUM (SAH) build: the automatic choice for this scene size is
+  // LOW, which builds ~2.6x faster (build_quality_tradeoff) but visits more nodes per query.
+  {
+    EmbreeOptions medium;
+    medium.build_quality = 1;
+    const EmbreeIndex em(parts, medium);
+    em.closest_batch(std::vector<Vec3>(pts.begin(), pts.begin() + 20000), reach, 2);  // warm-up
+    for (int threads : {1, 2})
+      measure("embree-medium-build", "closest(r=10 radii)", threads, pts.size(), [&] {
+        const auto hits = em.closest_batch(pts, reach, threads);
+        benchmark::DoNotOptimize(hits.data());
+      });
   }
   // A tight start radius is most of the speed: a caller walking along a cable knows the
   // previous distance + its step (here: true distance + 1 mm).
@@ -387,9 +441,40 @@ BENCHMARK(BM_EmbreeSegmentWithin);
 
 int main(int argc, char** argv) {
   std::filesystem::create_directories(kResults);
-  const bool quick = argc > 1 && std::string(argv[1]) == "--micro-only";
-  if (!quick) {
+  // --micro-only: Google Benchmark only; --build-only / --quality-only / --queries-only:
+  // one scenario.
+  const std::string mode = argc > 1 ? argv[1] : "";
+  if (mode == "--build-only") {
     build_scaling();
+    build_quality_tradeoff();
+    return 0;
+  }
+  if (mode == "--probe" && argc > 3) {
+    // For instruction counts: valgrind --tool=callgrind --collect-atstart=no
+    //   --toggle-collect='loom::ObstacleIndex::closest_batch*' bench_index --probe TRIS QUALITY
+    const auto parts = generated_scene(std::strtoul(argv[2], nullptr, 10), 7);
+    EmbreeOptions o;
+    o.build_quality = std::atoi(argv[3]);
+    const EmbreeIndex e(parts, o);
+    const auto pts = near_surface_points(parts, 20000, 10 * kCableRadius, 8);
+    const double c0 = cpu_now();
+    const auto hits = e.closest_batch(pts, 10 * kCableRadius, 1);
+    std::cout << "probe: " << count_tris(parts) << " triangles, quality " << o.build_quality << ": "
+              << rate(pts.size(), cpu_now() - c0) / 1e6 << " M closest/cpu-s\n";
+    benchmark::DoNotOptimize(hits.data());
+    return 0;
+  }
+  if (mode == "--quality-only") {
+    build_quality_tradeoff();
+    return 0;
+  }
+  if (mode == "--queries-only") {
+    query_throughput();
+    return 0;
+  }
+  if (mode != "--micro-only") {
+    build_scaling();
+    build_quality_tradeoff();
     query_throughput();
     voxel_tradeoff();
   }

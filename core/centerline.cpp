@@ -395,9 +395,6 @@ void Centerline::set_key_parameters(std::vector<double> u) {
 // ---------------------------------------------------------------------------------------
 // Evaluation
 
-double Centerline::u_min() const { return knots_.empty() ? 0.0 : knots_[degree_]; }
-double Centerline::u_max() const { return knots_.empty() ? 0.0 : knots_[cps_.size()]; }
-
 int Centerline::find_span(double u) const {
   const int n = static_cast<int>(cps_.size()) - 1;
   const auto first = knots_.begin() + degree_;
@@ -426,6 +423,15 @@ void Centerline::evaluate_on_span(int piece, double u, int nder, Vec3* out) cons
   const int p = degree_;
   const Vec3* c = &poly_[static_cast<std::size_t>(piece) * (p + 1)];
   const double t = u - span_u_[piece];
+  if (p == 3) {
+    // The cubic case unrolled: the same operations in the same order as the general loop
+    // below (so the same results), without its loop and factorial bookkeeping.
+    out[0] = ((c[3] * t + c[2]) * t + c[1]) * t + c[0];
+    if (nder >= 1) out[1] = ((3.0 * c[3]) * t + 2.0 * c[2]) * t + c[1];
+    if (nder >= 2) out[2] = (6.0 * c[3]) * t + 2.0 * c[2];
+    if (nder >= 3) out[3] = 6.0 * c[3];
+    return;
+  }
   for (int k = 0; k <= nder; ++k) {
     if (k > p) {
       out[k] = Vec3::Zero();

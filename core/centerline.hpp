@@ -7,6 +7,8 @@
 
 #include <cstddef>
 #include <optional>
+#include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -66,8 +68,8 @@ class Centerline {
   void set_key_parameters(std::vector<double> u);
 
   /// First / last parameter of the curve's domain.
-  double u_min() const;
-  double u_max() const;
+  double u_min() const { return knots_.empty() ? 0.0 : knots_[degree_]; }
+  double u_max() const { return knots_.empty() ? 0.0 : knots_[cps_.size()]; }
   /// C(u).
   Vec3 position(double u) const;
   /// k-th derivative C⁽ᵏ⁾(u), k = 0..3.
@@ -92,6 +94,16 @@ class Centerline {
   /// domain. With left_limit, at an interior knot the span to the left is used (one-sided
   /// derivatives: tangent kinks, third-derivative jumps).
   void evaluate(double u, int nder, Vec3* out, bool left_limit = false) const;
+  /// As evaluate(), for a caller that knows the breakpoint interval: u must lie in
+  /// [breakpoints()[k], breakpoints()[k + 1]] (not clamped: outside, the interval's
+  /// polynomial is extended). Inside the interval (or at its left end) the result equals
+  /// evaluate(u, nder, out) exactly; it skips the interval search. nder ≤ 3. Throws
+  /// std::out_of_range if k is not an interval of the curve.
+  void evaluate_in_interval(std::size_t k, double u, int nder, Vec3* out) const {
+    if (k + 1 >= span_u_.size())
+      throw std::out_of_range("Centerline::evaluate_in_interval: no interval " + std::to_string(k));
+    evaluate_on_span(static_cast<int>(k), u, nder < 0 ? 0 : (nder > 3 ? 3 : nder), out);
+  }
   /// Distinct knot values u_min = v_0 < v_1 < ... < v_K = u_max (span boundaries).
   const std::vector<double>& breakpoints() const { return span_u_; }
 

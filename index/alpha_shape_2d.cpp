@@ -10,6 +10,8 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <queue>
+#include <tuple>
 
 namespace loom {
 
@@ -87,6 +89,7 @@ struct BucketGrid {
 
 struct AlphaShape2D::Impl {
   double alpha = 0.0;
+  double short_edge = 0.0;
   DT dt;
   std::vector<Face> faces;                  // finite faces, indexed by info()
   std::vector<std::array<Vec2, 3>> coords;  // their corners (CCW)
@@ -98,6 +101,10 @@ struct AlphaShape2D::Impl {
   std::vector<std::array<int, 2>> segment_edge;  // (face id, edge index)
   BucketGrid tri_grid, seg_grid;
   double area = 0.0;
+
+  /// Numbers the finite faces and keeps those of the α rule (circumradius < α or longest
+  /// edge ≤ short_edge); then refresh().
+  void classify();
 
   bool is_kept(Face f) const { return !dt.is_infinite(f) && kept[static_cast<std::size_t>(f->info())]; }
 
@@ -143,26 +150,18 @@ struct AlphaShape2D::Impl {
     tri_grid.for_cell(tri_grid.cx(p.x()), tri_grid.cy(p.y()), [&](std::uint32_t k) {
       if (inside) return;
       const auto& c = kept_coords[k];
-      // Floating-point orientations decide clear cases; near an edge the exact CGAL
-      // predicate decides, so that points on shared edges count as inside.
-      bool near = false;
+      // Closed triangle, with a relative slack of 1e-12 (far below any tolerance of the
+      // callers): points on shared edges and at vertices count as inside, without the
+      // exact predicate, whose filter fails on exactly such degenerate cases (samples at
+      // triangulation vertices) and falls back to slow exact arithmetic.
       for (int e = 0; e < 3; ++e) {
         const Vec2 a = c[e], b = c[(e + 1) % 3];
         const double o = (b.x() - a.x()) * (p.y() - a.y()) - (b.y() - a.y()) * (p.x() - a.x());
         const double scale = (std::abs(b.x() - a.x()) + std::abs(b.y() - a.y())) *
                              (std::abs(p.x() - a.x()) + std::abs(p.y() - a.y()));
-        if (o < -1e-12 * scale) return;  // clearly right of an edge: outside
-        if (o <= 1e-12 * scale) near = true;
+        if (o < -1e-12 * scale) return;  // right of an edge: outside
       }
-      if (!near) {
-        inside = true;
-        return;
-      }
-      const CPoint q(p.x(), p.y());
-      const CPoint a(c[0].x(), c[0].y()), b(c[1].x(), c[1].y()), d(c[2].x(), c[2].y());
-      if (CGAL::orientation(a, b, q) != CGAL::RIGHT_TURN && CGAL::orientation(b, d, q) != CGAL::RIGHT_TURN &&
-          CGAL::orientation(d, a, q) != CGAL::RIGHT_TURN)
-        inside = true;
+      inside = true;
     });
     return inside;
   }
@@ -194,26 +193,46 @@ struct AlphaShape2D::Impl {
 AlphaShape2D::AlphaShape2D(const std::vector<Vec2>& points, double alpha, double short_edge)
     : impl_(std::make_unique<Impl>()) {
   impl_->alpha = alpha;
+  impl_->short_edge = short_edge;
   std::vector<CPoint> pts;
   pts.reserve(points.size());
   for (const auto& p : points) pts.emplace_back(p.x(), p.y());
   impl_->dt.insert(pts.begin(), pts.end());
+  impl_->classify();
+}
+
+void AlphaShape2D::Impl::classify() {
+  faces.clear();
+  coords.clear();
+  kept.clear();
   int id = 0;
   const double a2 = alpha * alpha;
-  for (auto f = impl_->dt.finite_faces_begin(); f != impl_->dt.finite_faces_end(); ++f) {
+  for (auto f = dt.finite_faces_begin(); f != dt.finite_faces_end(); ++f) {
     f->info() = id++;
-    impl_->faces.push_back(f);
+    faces.push_back(f);
     const auto& p0 = f->vertex(0)->point();
     const auto& p1 = f->vertex(1)->point();
     const auto& p2 = f->vertex(2)->point();
-    impl_->coords.push_back({to_vec(p0), to_vec(p1), to_vec(p2)});
+    coords.push_back({to_vec(p0), to_vec(p1), to_vec(p2)});
     const double r2 = CGAL::squared_radius(p0, p1, p2);
-    const auto& c = impl_->coords.back();
+    const auto& c = coords.back();
     const double longest2 =
         std::max({(c[1] - c[0]).squaredNorm(), (c[2] - c[1]).squaredNorm(), (c[0] - c[2]).squaredNorm()});
-    impl_->kept.push_back(r2 < a2 || longest2 <= short_edge * short_edge ? 1 : 0);
+    kept.push_back(r2 < a2 || longest2 <= short_edge * short_edge ? 1 : 0);
   }
-  impl_->refresh();
+  refresh();
+}
+
+std::size_t AlphaShape2D::refine(const std::vector<Vec2>& points, double tol) {
+  Impl& m = *impl_;
+  std::vector<CPoint> add;
+  for (const auto& p : points)
+    if (!contains(p, tol)) add.emplace_back(p.x(), p.y());
+  if (add.empty()) return 0;
+  const std::size_t before = m.dt.number_of_vertices();
+  m.dt.insert(add.begin(), add.end());
+  m.classify();
+  return m.dt.number_of_vertices() - before;
 }
 
 AlphaShape2D::~AlphaShape2D() = default;
@@ -466,6 +485,129 @@ std::size_t merge_collinear(std::vector<Vec2>& ring, double angle_tol_rad, doubl
   }
   ring = std::move(out);
   return n0 - ring.size();
+}
+
+std::size_t grow_simplify(std::vector<PolygonWithHoles2>& polys, double max_dev) {
+  // Every ring as a circular doubly linked list over one node array.
+  struct Node {
+    Vec2 p;
+    std::uint32_t prev, next, ring;
+    double dev;  // accumulated deviation of the edge node → next
+    std::uint32_t version;
+    bool alive;
+  };
+  std::vector<Node> nodes;
+  std::vector<std::vector<Vec2>*> rings;
+  for (auto& poly : polys) {
+    rings.push_back(&poly.outer);
+    for (auto& h : poly.holes) rings.push_back(&h);
+  }
+  std::vector<std::size_t> ring_start(rings.size()), ring_alive(rings.size());
+  for (std::size_t r = 0; r < rings.size(); ++r) {
+    const auto& ring = *rings[r];
+    const auto base = static_cast<std::uint32_t>(nodes.size()), n = static_cast<std::uint32_t>(ring.size());
+    ring_start[r] = base;
+    ring_alive[r] = n;
+    for (std::uint32_t i = 0; i < n; ++i)
+      nodes.push_back({ring[i], base + (i + n - 1) % n, base + (i + 1) % n, static_cast<std::uint32_t>(r), 0.0, 0, true});
+  }
+  if (nodes.empty() || !(max_dev > 0.0)) return 0;
+
+  // Uniform grid over the vertices (about two per cell) for the empty-triangle test.
+  Vec2 lo = nodes[0].p, hi = nodes[0].p;
+  for (const auto& nd : nodes) {
+    lo = lo.cwiseMin(nd.p);
+    hi = hi.cwiseMax(nd.p);
+  }
+  const Vec2 ext = (hi - lo).cwiseMax(Vec2::Constant(max_dev));
+  const double cell = std::max(std::sqrt(ext.x() * ext.y() / (0.5 * static_cast<double>(nodes.size()))),
+                               std::max(ext.x(), ext.y()) / 4096.0);
+  const int nx = static_cast<int>(ext.x() / cell) + 1, ny = static_cast<int>(ext.y() / cell) + 1;
+  auto cx = [&](double x) { return std::clamp(static_cast<int>((x - lo.x()) / cell), 0, nx - 1); };
+  auto cy = [&](double y) { return std::clamp(static_cast<int>((y - lo.y()) / cell), 0, ny - 1); };
+  std::vector<std::uint32_t> start(static_cast<std::size_t>(nx) * ny + 1, 0), items(nodes.size());
+  for (const auto& nd : nodes) ++start[static_cast<std::size_t>(cy(nd.p.y())) * nx + cx(nd.p.x()) + 1];
+  for (std::size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+  {
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (std::uint32_t i = 0; i < nodes.size(); ++i)
+      items[fill[static_cast<std::size_t>(cy(nodes[i].p.y())) * nx + cx(nodes[i].p.x())]++] = i;
+  }
+
+  auto to_c = [](const Vec2& v) { return CPoint(v.x(), v.y()); };
+  // Candidate: removing b adds the triangle (a, b, c); b must turn right (strictly).
+  auto deviation = [&](std::uint32_t b) {
+    const Node& nb = nodes[b];
+    const Node &na = nodes[nb.prev], &nc = nodes[nb.next];
+    if (ring_alive[nb.ring] <= 3) return std::numeric_limits<double>::infinity();
+    if (CGAL::orientation(to_c(na.p), to_c(nb.p), to_c(nc.p)) != CGAL::RIGHT_TURN)
+      return std::numeric_limits<double>::infinity();
+    const Vec2 ac = nc.p - na.p, ab = nb.p - na.p;
+    const double h = std::abs(ac.x() * ab.y() - ac.y() * ab.x()) / ac.norm();
+    return std::max(na.dev, nb.dev) + h;
+  };
+  auto triangle_empty = [&](std::uint32_t b) {
+    const Node& nb = nodes[b];
+    const std::uint32_t a = nb.prev, c = nb.next;
+    const CPoint pa = to_c(nodes[a].p), pb = to_c(nb.p), pc = to_c(nodes[c].p);
+    const Vec2 tlo = nodes[a].p.cwiseMin(nb.p).cwiseMin(nodes[c].p), thi = nodes[a].p.cwiseMax(nb.p).cwiseMax(nodes[c].p);
+    for (int y = cy(tlo.y()); y <= cy(thi.y()); ++y)
+      for (int x = cx(tlo.x()); x <= cx(thi.x()); ++x) {
+        const std::size_t cidx = static_cast<std::size_t>(y) * nx + x;
+        for (std::uint32_t k = start[cidx]; k < start[cidx + 1]; ++k) {
+          const std::uint32_t q = items[k];
+          if (q == a || q == b || q == c || !nodes[q].alive) continue;
+          const CPoint pq = to_c(nodes[q].p);
+          // Closed clockwise triangle (a, b, c): inside or on unless strictly left of a side.
+          if (CGAL::orientation(pa, pb, pq) != CGAL::LEFT_TURN && CGAL::orientation(pb, pc, pq) != CGAL::LEFT_TURN &&
+              CGAL::orientation(pc, pa, pq) != CGAL::LEFT_TURN)
+            return false;
+        }
+      }
+    return true;
+  };
+  using Entry = std::tuple<double, double, double, std::uint32_t, std::uint32_t>;  // dev, x, y, node, version
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap;
+  auto push = [&](std::uint32_t b) {
+    const double d = deviation(b);
+    if (d < max_dev) heap.emplace(d, nodes[b].p.x(), nodes[b].p.y(), b, nodes[b].version);
+  };
+  for (std::uint32_t i = 0; i < nodes.size(); ++i) push(i);
+  std::size_t removed = 0;
+  while (!heap.empty()) {
+    const auto [d, x, y, b, version] = heap.top();
+    heap.pop();
+    (void)x;
+    (void)y;
+    Node& nb = nodes[b];
+    if (!nb.alive || nb.version != version) continue;
+    if (!(deviation(b) < max_dev) || !triangle_empty(b)) continue;
+    const std::uint32_t a = nb.prev, c = nb.next;
+    nodes[a].dev = d;
+    nodes[a].next = c;
+    nodes[c].prev = a;
+    nb.alive = false;
+    --ring_alive[nb.ring];
+    ++removed;
+    ++nodes[a].version;
+    ++nodes[c].version;
+    push(a);
+    push(c);
+  }
+  // Rebuild the rings from their first surviving vertex, in the original order.
+  for (std::size_t r = 0; r < rings.size(); ++r) {
+    auto& ring = *rings[r];
+    const std::size_t n = ring.size();
+    std::uint32_t s = static_cast<std::uint32_t>(ring_start[r]);
+    while (!nodes[s].alive && s < ring_start[r] + n - 1) ++s;
+    ring.clear();
+    std::uint32_t k = s;
+    do {
+      ring.push_back(nodes[k].p);
+      k = nodes[k].next;
+    } while (k != s && ring.size() <= n);
+  }
+  return removed;
 }
 
 double ring_signed_area(const std::vector<Vec2>& ring) {

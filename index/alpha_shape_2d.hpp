@@ -49,6 +49,12 @@ class AlphaShape2D {
   /// Area of the convex hull of the points (= area after keep_all()).
   double hull_area() const;
 
+  /// Denser sampling where the shape erodes the projection: inserts every given point that
+  /// is farther than tol from the region as a triangulation vertex and re-applies the α rule
+  /// to all triangles (earlier cover()/keep_all() changes are dropped: call it first).
+  /// A notch that a boundary chord cuts into a sliver of the projection then closes with
+  /// small triangles instead of the large ones cover() would add. Returns points inserted.
+  std::size_t refine(const std::vector<Vec2>& points, double tol);
   /// Keeps every finite Delaunay triangle: the region becomes the convex hull.
   void keep_all();
   /// Makes the region contain every triangulation vertex (an isolated one gets its incident
@@ -75,6 +81,15 @@ class AlphaShape2D {
 /// and removes repeated vertices. Every removed vertex stays within
 /// max(dist_tol, sin(angle_tol)·chord) of the new boundary. Returns the number removed.
 std::size_t merge_collinear(std::vector<Vec2>& ring, double angle_tol_rad, double dist_tol = 0.0);
+
+/// Simplifies the boundary of a region (its pieces: outer rings CCW, holes CW, so the
+/// region lies left of every ring) so that the region only GROWS, by less than max_dev
+/// (scene units): a vertex where the boundary turns right (a notch, a hole's rim) is
+/// removed when the chord that replaces it stays within max_dev of the boundary it
+/// replaces (accumulated over earlier removals) and the triangle it adds holds no other
+/// vertex of any ring, so that rings stay simple and disjoint. Deterministic (smallest
+/// deviation first, ties by position). Returns the number of vertices removed.
+std::size_t grow_simplify(std::vector<PolygonWithHoles2>& polys, double max_dev);
 
 /// Signed area of a closed polygon (positive when counter-clockwise).
 double ring_signed_area(const std::vector<Vec2>& ring);

@@ -27,6 +27,7 @@
 #include <gp_Pln.hxx>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
@@ -153,22 +154,8 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-/// The paper's point cloud: mesh vertices plus the points of a subdivision whose edges are
-/// ≤ L_max (shared edges subdivided once), and check points (sub-triangle centroids and
-/// sub-edge midpoints) that the 2D shapes must cover.
-struct Cloud {
-  std::vector<Vec3> points;
-  std::vector<Vec3> checks;
-};
-
-Cloud sample_cloud(const Mesh& mesh, double l_max) {
-  Cloud cl;
-  std::vector<char> used(mesh.vertices.size(), 0);
-  for (const auto& f : mesh.triangles)
-    for (auto i : f) used[i] = 1;
-  for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
-    if (used[i]) cl.points.push_back(mesh.vertices[i]);
-  // Unique edges, deterministic order.
+/// Unique edges of a mesh's triangles (a < b), sorted: shared edges are subdivided once.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> unique_edges(const Mesh& mesh) {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
   edges.reserve(mesh.triangles.size() * 3);
   for (const auto& f : mesh.triangles)
@@ -179,26 +166,101 @@ Cloud sample_cloud(const Mesh& mesh, double l_max) {
     }
   std::sort(edges.begin(), edges.end());
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-  for (const auto& [a, b] : edges) {
-    const Vec3 pa = mesh.vertices[a], pb = mesh.vertices[b];
-    const int n = std::max(1, static_cast<int>(std::ceil((pb - pa).norm() / l_max)));
-    for (int k = 1; k < n; ++k) cl.points.push_back(pa + (pb - pa) * (static_cast<double>(k) / n));
-    for (int k = 0; k < n; ++k) cl.checks.push_back(pa + (pb - pa) * ((k + 0.5) / n));
-  }
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    const auto c = mesh.corners(t);
-    const double longest = std::max({(c[1] - c[0]).norm(), (c[2] - c[1]).norm(), (c[0] - c[2]).norm()});
-    const int n = std::max(1, static_cast<int>(std::ceil(longest / l_max)));
-    const Vec3 e1 = (c[1] - c[0]) / n, e2 = (c[2] - c[0]) / n;
-    for (int i = 1; i < n; ++i)
-      for (int j = 1; i + j < n; ++j) cl.points.push_back(c[0] + i * e1 + j * e2);
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; i + j < n; ++j) {
-        cl.checks.push_back(c[0] + (i + 1.0 / 3.0) * e1 + (j + 1.0 / 3.0) * e2);
-        if (i + j + 1 < n) cl.checks.push_back(c[0] + (i + 2.0 / 3.0) * e1 + (j + 2.0 / 3.0) * e2);
+  return edges;
+}
+
+/// The paper's point cloud (step 1), sampled directly in one projection plane (step 2):
+/// the projected vertices, the projected edges subdivided to pieces ≤ L_max, and the nodes
+/// of a lattice of spacing L_max (aligned to the plane origin, so that overlapping
+/// triangles share nodes) inside each projected triangle. The projected surface is then
+/// sampled about as densely as by a 3D subdivision of edge ≤ L_max (projection only
+/// shortens distances), but a face seen edge-on costs only its silhouette and a long
+/// sliver triangle only its area, not (longest edge / L_max)². Checks (points the α-shape
+/// must cover) are the sub-edge midpoints, the centres of the lattice cells inside each
+/// triangle and its centroid.
+/// Coordinates are snapped to the grid `snap`; points and checks are sorted and unique.
+struct PlaneSamples {
+  std::vector<Vec2> points, checks;
+};
+
+/// Calls emit for each lattice node (offset 0) or cell centre (offset 0.5) of spacing h in
+/// the closed triangle abc (boundary within rounding).
+template <class F>
+void lattice_in_triangle(const Vec2& a, const Vec2& b, const Vec2& c, double h, double offset, F&& emit) {
+  const double ymin = std::min({a.y(), b.y(), c.y()}), ymax = std::max({a.y(), b.y(), c.y()});
+  const long j0 = static_cast<long>(std::ceil(ymin / h - offset)), j1 = static_cast<long>(std::floor(ymax / h - offset));
+  const Vec2 v[3] = {a, b, c};
+  for (long j = j0; j <= j1; ++j) {
+    const double y = (static_cast<double>(j) + offset) * h;
+    double xl = std::numeric_limits<double>::infinity(), xr = -xl;
+    for (int e = 0; e < 3; ++e) {
+      const Vec2& p = v[e];
+      const Vec2& q = v[(e + 1) % 3];
+      if ((p.y() - y) * (q.y() - y) > 0.0) continue;  // edge entirely above or below the row
+      if (p.y() == q.y()) {
+        xl = std::min({xl, p.x(), q.x()});
+        xr = std::max({xr, p.x(), q.x()});
+        continue;
       }
+      const double x = p.x() + (q.x() - p.x()) * (y - p.y()) / (q.y() - p.y());
+      xl = std::min(xl, x);
+      xr = std::max(xr, x);
+    }
+    if (!(xl <= xr)) continue;
+    const long i0 = static_cast<long>(std::ceil(xl / h - offset)), i1 = static_cast<long>(std::floor(xr / h - offset));
+    for (long i = i0; i <= i1; ++i) emit(Vec2((static_cast<double>(i) + offset) * h, y));
   }
-  return cl;
+}
+
+/// Upper bound on the samples of one plane (before removing duplicates).
+double plane_sample_estimate(const Mesh& mesh, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges,
+                             const AlphaSimPrism& pr, double l_max) {
+  double n = static_cast<double>(mesh.vertices.size());
+  for (const auto& [a, b] : edges)
+    n += std::ceil((pr.project(mesh.vertices[a]) - pr.project(mesh.vertices[b])).norm() / l_max);
+  for (const auto& f : mesh.triangles) {
+    const Vec2 a = pr.project(mesh.vertices[f[0]]), b = pr.project(mesh.vertices[f[1]]),
+               c = pr.project(mesh.vertices[f[2]]);
+    const Vec2 lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
+    const double area = 0.5 * std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
+    // Lattice rows crossed times nodes per row is at most area/h² plus one per row and column.
+    n += area / (l_max * l_max) + (hi - lo).sum() / l_max + 1.0;
+  }
+  return n;
+}
+
+PlaneSamples sample_projection(const Mesh& mesh, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges,
+                               const AlphaSimPrism& pr, double l_max, double snap) {
+  PlaneSamples s;
+  auto snapped = [snap](const Vec2& q) { return Vec2(std::round(q.x() / snap) * snap, std::round(q.y() / snap) * snap); };
+  std::vector<Vec2> proj(mesh.vertices.size());
+  std::vector<char> used(mesh.vertices.size(), 0);
+  for (const auto& f : mesh.triangles)
+    for (auto i : f) used[i] = 1;
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    proj[i] = pr.project(mesh.vertices[i]);
+    if (used[i]) s.points.push_back(snapped(proj[i]));
+  }
+  for (const auto& [a, b] : edges) {
+    const Vec2 pa = proj[a], pb = proj[b];
+    const int n = std::max(1, static_cast<int>(std::ceil((pb - pa).norm() / l_max)));
+    for (int k = 1; k < n; ++k) s.points.push_back(snapped(pa + (pb - pa) * (static_cast<double>(k) / n)));
+    for (int k = 0; k < n; ++k) s.checks.push_back(snapped(pa + (pb - pa) * ((k + 0.5) / n)));
+  }
+  for (const auto& f : mesh.triangles) {
+    const Vec2 a = proj[f[0]], b = proj[f[1]], c = proj[f[2]];
+    lattice_in_triangle(a, b, c, l_max, 0.0, [&](const Vec2& q) { s.points.push_back(snapped(q)); });
+    lattice_in_triangle(a, b, c, l_max, 0.5, [&](const Vec2& q) { s.checks.push_back(snapped(q)); });
+    s.checks.push_back(snapped((a + b + c) / 3.0));
+  }
+  auto sort_unique = [](std::vector<Vec2>& v) {
+    std::sort(v.begin(), v.end(),
+              [](const Vec2& p, const Vec2& q) { return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y()); });
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+  };
+  sort_unique(s.points);
+  sort_unique(s.checks);
+  return s;
 }
 
 /// Orthonormal frame (u, v, n = u × v) for a plane normal.
@@ -462,55 +524,57 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
     }
   }
 
-  // The cloud size is known before sampling: refuse what would not fit in memory.
+  // The sample count is known before sampling: refuse what would not fit in memory.
+  const auto edges = unique_edges(part.mesh);
   {
-    double estimate = 0.0;
-    for (std::size_t t = 0; t < part.mesh.triangles.size(); ++t) {
-      const auto c = part.mesh.corners(t);
-      const double longest = std::max({(c[1] - c[0]).norm(), (c[2] - c[1]).norm(), (c[0] - c[2]).norm()});
-      const double n = std::ceil(longest / r.l_max);
-      estimate += 0.5 * n * n + 1.5 * n;
-    }
+    std::vector<double> per_plane(specs.size());
+    tbb::parallel_for(std::size_t(0), specs.size(), [&](std::size_t k) {
+      per_plane[k] = plane_sample_estimate(part.mesh, edges, specs[k].frame, r.l_max);
+    });
+    const double estimate = *std::max_element(per_plane.begin(), per_plane.end());
     if (estimate > static_cast<double>(opt.max_cloud_points)) {
       keep_original(out, part, AlphaSimStatus::TooFine,
                     "sampling at L_max = " + full_precision(r.l_max) + " needs about " +
-                        std::to_string(static_cast<long long>(estimate)) + " points > " +
+                        std::to_string(static_cast<long long>(estimate)) + " points in a plane > " +
                         std::to_string(opt.max_cloud_points) + ": original kept (raise dim_pre)");
       return finish();
     }
   }
 
-  // 1. Sample (L_max), 2–3. project and build α-shapes per plane (in parallel).
-  const Cloud cloud = sample_cloud(part.mesh, r.l_max);
-  r.sample_points = cloud.points.size();
+  // Random surface points the α-shapes must cover (their Delaunay triangles are kept):
+  // they catch the thin gaps that the regular checks miss, such as slivers between the
+  // nearly coincident silhouettes of a faceted cylinder. Containment is verified below on
+  // an independent set (another seed).
+  const std::vector<Vec3> cover_samples =
+      dense_surface_samples(part.mesh, r.l_max, opt.containment_density, opt.containment_max_samples, opt.seed + 2);
+
+  // 1–2. Sample each projection (L_max), 3. build its α-shape (planes in parallel).
   std::vector<AlphaSimPrism> prisms(specs.size());
   std::vector<std::shared_ptr<AlphaShape2D>> shapes(specs.size());
   r.projections.resize(specs.size());
   std::atomic<bool> degenerate{false};
+  std::vector<PlaneSamples> plane_samples(specs.size());
+  // Snap projections to a grid of snap ≤ tol/4 and drop duplicates: points that are
+  // equal up to rounding (the same 3D edge subdivided from either end, front and back
+  // faces) would otherwise give sliver triangles and spurious boundary loops.
+  // A power of two, so that coordinates on a binary grid (integers, halves) stay exact.
+  const double snap = std::exp2(std::floor(std::log2(tol / 4.0)));
   tbb::parallel_for(std::size_t(0), specs.size(), [&](std::size_t k) {
     AlphaSimPrism pr = specs[k].frame;
     ProjectionReport& rep = r.projections[k];
     rep.plane = specs[k].name;
     rep.normal = pr.n;
-    std::vector<Vec2> pts;
-    pts.reserve(cloud.points.size());
     pr.depth_min = std::numeric_limits<double>::infinity();
     pr.depth_max = -pr.depth_min;
-    // Snap projections to a grid of snap ≤ tol/4 and drop duplicates: points that are
-    // equal up to rounding (the same 3D edge subdivided from either end, front and back
-    // faces) would otherwise give sliver triangles and spurious boundary loops.
-    // A power of two, so that coordinates on a binary grid (integers, halves) stay exact.
-    const double snap = std::exp2(std::floor(std::log2(tol / 4.0)));
-    for (const auto& p : cloud.points) {
-      const Vec2 q = pr.project(p);
-      pts.emplace_back(std::round(q.x() / snap) * snap, std::round(q.y() / snap) * snap);
-      const double d = p.dot(pr.n);
-      pr.depth_min = std::min(pr.depth_min, d);
-      pr.depth_max = std::max(pr.depth_max, d);
-    }
-    std::sort(pts.begin(), pts.end(),
-              [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
-    pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+    for (const auto& f : part.mesh.triangles)
+      for (auto i : f) {
+        const double d = part.mesh.vertices[i].dot(pr.n);
+        pr.depth_min = std::min(pr.depth_min, d);
+        pr.depth_max = std::max(pr.depth_max, d);
+      }
+    PlaneSamples& smp = plane_samples[k];
+    smp = sample_projection(part.mesh, edges, pr, r.l_max, snap);
+    const std::vector<Vec2>& pts = smp.points;
     rep.points = pts.size();
     auto shape = std::make_shared<AlphaShape2D>(pts, r.alpha, std::min(opt.short_edge_factor * r.l_max, r.alpha));
     rep.delaunay_triangles = shape->delaunay_triangle_count();
@@ -521,10 +585,10 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
       rep.status = ProjectionStatus::Empty;
       shape->keep_all();
     } else {
-      std::vector<Vec2> checks;
-      checks.reserve(cloud.checks.size());
-      for (const auto& p : cloud.checks) checks.push_back(pr.project(p));
-      const double added = shape->cover(checks, tol);
+      smp.checks.reserve(smp.checks.size() + cover_samples.size());
+      for (const auto& p : cover_samples) smp.checks.push_back(pr.project(p));
+      shape->refine(smp.checks, tol);
+      const double added = shape->cover(smp.checks, tol);
       if (added > opt.torn_fraction * shape->area()) {
         rep.status = ProjectionStatus::Torn;
         shape->keep_all();
@@ -536,48 +600,80 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
     prisms[k] = pr;
     shapes[k] = shape;
   });
+  for (const auto& rep : r.projections) r.sample_points += rep.points;
   if (degenerate) {
     keep_original(out, part, AlphaSimStatus::Thin, "a projection is degenerate (collinear points): original kept");
     return finish();
   }
 
-  // Verify containment of dense samples on the implicit solid; a plane that misses
-  // samples is replaced by its convex hull (which contains every projected point).
-  const std::vector<Vec3> samples =
-      dense_surface_samples(part.mesh, r.l_max, opt.containment_density, opt.containment_max_samples, opt.seed);
-  r.containment_samples = samples.size();
-  auto plane_misses = [&]() {
+  // Verify containment of dense samples on the implicit solid. A plane that misses some
+  // is refined with them (denser sampling where it eroded) and verified again on a fresh
+  // set of samples (another seed), so the final check never uses points it was repaired
+  // with; after kRefineRounds the plane is replaced by its convex hull (which contains
+  // every projected point).
+  constexpr int kRefineRounds = 3;
+  std::vector<Vec3> samples;
+  auto plane_misses = [&](std::vector<std::vector<Vec2>>& missed) {
     std::vector<std::size_t> miss(specs.size(), 0);
-    std::vector<std::atomic<std::size_t>> counter(specs.size());
-    for (auto& c : counter) c = 0;
+    tbb::enumerable_thread_specific<std::vector<std::vector<Vec2>>> local_missed(
+        [&] { return std::vector<std::vector<Vec2>>(specs.size()); });
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, samples.size(), 4096), [&](const auto& rg) {
-      std::vector<std::size_t> local(specs.size(), 0);
+      auto& lm = local_missed.local();
       for (std::size_t i = rg.begin(); i != rg.end(); ++i)
-        for (std::size_t k = 0; k < prisms.size(); ++k)
-          if (!prisms[k].shape->contains(prisms[k].project(samples[i]), tol)) ++local[k];
-      for (std::size_t k = 0; k < specs.size(); ++k) counter[k] += local[k];
+        for (std::size_t k = 0; k < prisms.size(); ++k) {
+          const Vec2 q = prisms[k].project(samples[i]);
+          if (!prisms[k].shape->contains(q, tol)) lm[k].push_back(q);
+        }
     });
-    for (std::size_t k = 0; k < specs.size(); ++k) miss[k] = counter[k];
+    missed.assign(specs.size(), {});
+    for (auto& lm : local_missed)
+      for (std::size_t k = 0; k < specs.size(); ++k) missed[k].insert(missed[k].end(), lm[k].begin(), lm[k].end());
+    for (std::size_t k = 0; k < specs.size(); ++k) {
+      // Deterministic order whatever the thread schedule.
+      std::sort(missed[k].begin(), missed[k].end(),
+                [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+      miss[k] = missed[k].size();
+    }
     return miss;
   };
-  for (int round = 0; round < 2; ++round) {
-    const auto miss = plane_misses();
-    bool any = false;
-    for (std::size_t k = 0; k < specs.size(); ++k)
-      if (miss[k] > 0) {
-        any = true;
-        if (round == 0) {
-          r.projections[k].status = ProjectionStatus::Eroded;
+  for (int round = 0;; ++round) {
+    samples = dense_surface_samples(part.mesh, r.l_max, opt.containment_density, opt.containment_max_samples,
+                                    opt.seed + 3 * static_cast<std::uint64_t>(round));
+    std::vector<std::vector<Vec2>> missed;
+    const auto miss = plane_misses(missed);
+    bool any = false, hull_missed = false;
+    for (std::size_t k = 0; k < specs.size(); ++k) {
+      if (miss[k] == 0) continue;
+      any = true;
+      auto& rep = r.projections[k];
+      if (rep.status == ProjectionStatus::Empty || rep.status == ProjectionStatus::Torn ||
+          rep.status == ProjectionStatus::Eroded) {
+        hull_missed = true;  // already the convex hull
+      } else if (round < kRefineRounds) {
+        auto& checks = plane_samples[k].checks;
+        checks.insert(checks.end(), missed[k].begin(), missed[k].end());
+        shapes[k]->refine(checks, tol);
+        const double added = shapes[k]->cover(checks, tol);
+        if (added > opt.torn_fraction * shapes[k]->area()) {
+          rep.status = ProjectionStatus::Torn;
           shapes[k]->keep_all();
+        } else if (added > 0.0) {
+          rep.status = ProjectionStatus::Repaired;
         }
+      } else {
+        rep.status = ProjectionStatus::Eroded;
+        shapes[k]->keep_all();
       }
+    }
     if (!any) break;
-    if (round == 1) {
+    if (hull_missed) {
       keep_original(out, part, AlphaSimStatus::Failed,
                     "convex hull of a projection misses surface samples: original kept");
       return finish();
     }
   }
+  r.containment_samples = samples.size();
+  plane_samples.clear();
   bool hull = false;
   for (std::size_t k = 0; k < specs.size(); ++k) {
     auto& rep = r.projections[k];
@@ -589,10 +685,19 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
   }
   auto solid = std::make_shared<AlphaSimSolid>(prisms);
   {
+    // Every sample lies in every 2D shape (checked above), so solid->contains(p, tol)
+    // reduces to the depth ranges: checked here without the 2D queries again.
     const std::size_t in = tbb::parallel_reduce(
         tbb::blocked_range<std::size_t>(0, samples.size(), 4096), std::size_t(0),
         [&](const auto& rg, std::size_t acc) {
-          for (std::size_t i = rg.begin(); i != rg.end(); ++i) acc += solid->contains(samples[i], tol) ? 1 : 0;
+          for (std::size_t i = rg.begin(); i != rg.end(); ++i) {
+            bool inside = true;
+            for (const auto& pr : prisms) {
+              const double d = samples[i].dot(pr.n);
+              inside = inside && d >= pr.depth_min - tol && d <= pr.depth_max + tol;
+            }
+            acc += inside ? 1 : 0;
+          }
           return acc;
         },
         std::plus<std::size_t>());
@@ -616,17 +721,23 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
   // region may shrink by merge_tol, which the containment tolerance covers (verified below).
   constexpr double kCollinearAngle = 1e-6 * M_PI / 180.0;
   const double merge_tol = tol / 4.0;
+  // merge_collinear looks at runs of at most 256 vertices: a second pass merges the chords
+  // of a long straight edge (a 1.5 m spar flange has ~10⁴ samples). Half the tolerance
+  // each, so that the total stays within merge_tol.
+  auto merge = [&](std::vector<Vec2>& ring) {
+    if (merge_collinear(ring, kCollinearAngle, merge_tol / 2.0) > 0) merge_collinear(ring, kCollinearAngle, merge_tol / 2.0);
+  };
   std::vector<std::vector<PolygonWithHoles2>> polys(specs.size());
   for (std::size_t k = 0; k < specs.size(); ++k) {
     polys[k] = shapes[k]->polygons();
     auto& rep = r.projections[k];
     std::vector<PolygonWithHoles2> kept;
     for (auto& p : polys[k]) {
-      merge_collinear(p.outer, kCollinearAngle, merge_tol);
+      merge(p.outer);
       if (p.outer.size() < 3) continue;
       std::vector<std::vector<Vec2>> holes;
       for (auto& h : p.holes) {
-        merge_collinear(h, kCollinearAngle, merge_tol);
+        merge(h);
         if (h.size() >= 3) holes.push_back(std::move(h));
       }
       p.holes = std::move(holes);
@@ -637,6 +748,9 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
     }
     rep.polygons = kept.size();
     polys[k] = std::move(kept);
+    // Coarser than the α-shape where it only adds material (notches, hole rims): fewer
+    // prism faces for the Booleans and fewer output triangles; containment is kept.
+    rep.polygon_vertices -= grow_simplify(polys[k], opt.polygon_growth_factor * opt.dim_pre);
   }
 
   r.shapes_ms = ms_since(t0);
@@ -759,9 +873,37 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
     for (const auto& p : parts) all.extend(p.mesh.bounds());
     o.scene_size = all.diagonal() > 0.0 ? all.diagonal() : 1.0;
   }
+  // Parts that are translated copies of an earlier part (ribs, boxes placed along a
+  // span) are simplified once: the result is translated, which keeps containment (up to
+  // the rounding of the copy, far below the tolerance) and every measure.
+  const double copy_tol = 1e-2 * o.containment_tolerance_factor * o.scene_size;
+  std::vector<std::size_t> source(parts.size());
+  std::vector<Vec3> shift(parts.size(), Vec3::Zero());
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    source[i] = i;
+    const Mesh& mi = parts[i].mesh;
+    // (Not when STEP files are written: each part gets its own OpenCASCADE solid.)
+    for (std::size_t j = 0; j < i && source[i] == i && !mi.empty() && o.step_dir.empty(); ++j) {
+      const Mesh& mj = parts[j].mesh;
+      if (source[j] != j || mj.vertices.size() != mi.vertices.size() || mj.triangles != mi.triangles) continue;
+      const Vec3 t = mi.vertices[0] - mj.vertices[0];
+      bool same = true;
+      for (std::size_t v = 0; v < mi.vertices.size() && same; ++v)
+        same = (mi.vertices[v] - mj.vertices[v] - t).cwiseAbs().maxCoeff() <= copy_tol;
+      if (same) {
+        source[i] = j;
+        shift[i] = t;
+      }
+    }
+  }
+  std::vector<std::size_t> unique;
+  for (std::size_t i = 0; i < parts.size(); ++i)
+    if (source[i] == i) unique.push_back(i);
   std::vector<Part> out(parts.size());
   std::vector<AlphaSimResult> res(parts.size());
-  tbb::parallel_for(std::size_t(0), parts.size(), [&](std::size_t i) {
+  ProgressCounter simplified(opt.progress, "simplify", parts.size(), "parts");
+  tbb::parallel_for(std::size_t(0), unique.size(), [&](std::size_t u) {
+    const std::size_t i = unique[u];
     AlphaSimPart sp = simplify_part(parts[i], o);
     Part p = parts[i];
     p.mesh = std::move(sp.mesh);
@@ -769,7 +911,30 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
     if (sp.result.fallback != AlphaSimFallback::Original) p.source_faces = sp.result.faces_after;
     out[i] = std::move(p);
     res[i] = std::move(sp.result);
+    simplified.add();
   });
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    if (source[i] == i) continue;
+    const auto t0 = Clock::now();
+    const std::size_t j = source[i];
+    Part p = parts[i];
+    if (res[j].fallback == AlphaSimFallback::Original) {
+      p.mesh = parts[i].mesh;
+    } else {
+      p.mesh = out[j].mesh;
+      for (auto& v : p.mesh.vertices) v += shift[i];
+      p.closed = out[j].closed;
+      p.source_faces = out[j].source_faces;
+    }
+    out[i] = std::move(p);
+    res[i] = res[j];
+    res[i].name = parts[i].name;
+    res[i].copy_of = parts[j].name;
+    res[i].time_ms = ms_since(t0);
+    res[i].shapes_ms = res[i].mesh_ms = res[i].measure_ms = 0.0;
+    simplified.add();
+  }
+  simplified.finish();
   if (results) *results = std::move(res);
   return out;
 }

@@ -9,6 +9,7 @@
 
 #include "core/mesh.hpp"
 #include "core/part.hpp"
+#include "core/progress.hpp"
 #include "index/alpha_shape_2d.hpp"
 
 #include <cstdint>
@@ -49,12 +50,19 @@ struct AlphaSimOptions {
   /// (at least the vertices, edge midpoints, centroids and two random points per triangle).
   double containment_density = 4.0;
   std::size_t containment_max_samples = 400000;
-  /// Largest 3D cloud sampled for one part (memory bound, ~100 bytes per point and plane).
+  /// Most samples in one projection plane (memory bound, ~100 bytes per point).
   std::size_t max_cloud_points = 4000000;
+  /// The boundary polygons that are extruded may grow the α-shape (never shrink it) by
+  /// less than polygon_growth_factor·dim_pre where that removes vertices (notches, hole
+  /// rims): fewer faces and triangles. The implicit solid keeps the exact α-shapes (so the
+  /// lost-space probe, which uses it, may miss up to this much of the mesh's growth).
+  double polygon_growth_factor = 0.25;
   bool build_mesh = true;       ///< OpenCASCADE prisms ∩ → triangle mesh (else implicit only)
   bool measure = true;          ///< containment of the mesh + Hausdorff distance
   std::filesystem::path step_dir;  ///< if set, writes <step_dir>/<part>.step (OpenCASCADE)
   std::uint64_t seed = 1;       ///< random containment samples
+  /// simplify_parts: stage "simplify", parts done, one call at a time from TBB workers.
+  ProgressFn progress;
 };
 
 /// What happened to one projection plane.
@@ -76,7 +84,7 @@ enum class AlphaSimStatus {
   Blocked,     ///< a feature hidden in every projection: space a cable could use was filled; original kept
   Failed,      ///< the mesh could not be built or did not contain the original: original kept
   EmptyInput,  ///< the part has no triangles
-  TooFine,     ///< dim_pre so small that the cloud would exceed max_cloud_points: original kept
+  TooFine,     ///< dim_pre so small that a plane would exceed max_cloud_points samples: original kept
 };
 /// "ok" | "hull_fallback" | "thin" | "blocked" | "failed" | "empty_input" | "too_fine".
 const char* alpha_sim_status_name(AlphaSimStatus s);
@@ -109,7 +117,7 @@ struct AlphaSimResult {
   AlphaSimFallback fallback = AlphaSimFallback::None;
   std::string reason;  ///< why a fallback was used (empty when none)
   double dim_pre = 0.0, alpha = 0.0, l_max = 0.0, tolerance = 0.0;
-  std::size_t sample_points = 0;       ///< 3D cloud size
+  std::size_t sample_points = 0;       ///< projected samples, summed over the planes
   std::size_t triangles_before = 0, triangles_after = 0;
   int faces_before = 0, faces_after = 0;  ///< B-rep faces (STEP sources), OpenCASCADE result faces
   bool closed_before = false, closed_after = false;
@@ -125,6 +133,9 @@ struct AlphaSimResult {
   double mesh_ms = 0.0;     ///< OpenCASCADE prisms, Booleans, meshing
   double measure_ms = 0.0;  ///< mesh containment, Hausdorff, lost-space probe
   std::vector<ProjectionReport> projections;
+  /// simplify_parts: the earlier part this one is a translated copy of (its result was
+  /// translated, not recomputed; time_ms is the copy's); empty otherwise.
+  std::string copy_of;
 };
 
 /// One extrusion: a 2D region in a plane frame swept over a depth range.
@@ -167,6 +178,8 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt);
 /// Simplifies every part in parallel (TBB) and returns them with the simplified meshes
 /// (names, roles, clearances kept), ready for any ObstacleIndex. opt.scene_size ≤ 0 is
 /// replaced by the diagonal of all parts. Results in part order if `results` is given.
+/// A part that is a translated copy of an earlier one (same triangles, vertices shifted by
+/// one vector within 1e-2 of the tolerance) gets that part's result translated (copy_of).
 std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimOptions& opt,
                                  std::vector<AlphaSimResult>* results);
 

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,13 @@ class ObstacleIndex {
   /// Closest point on one given part (found() == false if farther than max_radius).
   virtual ClosestHit closest_on_part(const Vec3& p, int part,
                                      double max_radius = std::numeric_limits<double>::infinity()) const = 0;
+  /// World-frame box (scene units) of the triangles of one part, when the index keeps it:
+  /// saves a caller a pass over the mesh. std::nullopt when this index does not store it.
+  /// Throws std::out_of_range for a bad part id in indices that store it.
+  virtual std::optional<AABB> part_bounds(int part) const {
+    (void)part;
+    return std::nullopt;
+  }
   /// True if p is strictly inside a closed part (open parts have no inside); the part id
   /// is written to *part when given. Correct for points near edges and vertices.
   virtual bool inside(const Vec3& p, int* part = nullptr) const = 0;

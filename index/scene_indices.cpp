@@ -42,8 +42,13 @@ const char* query_use_name(QueryUse u) {
 
 SceneIndices SceneIndices::build(const Scene& scene, const SceneIndicesOptions& opt) {
   SceneIndices out;
+  AABB box;
+  for (const Part& p : scene.parts) box.extend(p.mesh.bounds());
+  const bool want_voxel = opt.build_voxel && !box.empty();
+  ProgressCounter built(opt.progress, "index", 1 + (opt.build_fcl ? 1 : 0) + (want_voxel ? 1 : 0), "indices");
   const auto t0 = Clock::now();
   out.embree = std::make_shared<EmbreeIndex>(scene.parts, opt.embree);
+  built.add();
   out.log.push_back("embree: " + std::to_string(out.embree->triangle_count()) + " triangles in " +
                     std::to_string(scene.parts.size()) + " parts, built in " + full_precision(seconds_since(t0)) +
                     " s; " + out.embree->accuracy().description);
@@ -53,10 +58,9 @@ SceneIndices SceneIndices::build(const Scene& scene, const SceneIndicesOptions& 
     out.log.push_back("fcl: OBBRSS models built in " + full_precision(seconds_since(t1)) + " s; " +
                       std::to_string(out.fcl->direct_triangle_count()) +
                       " degenerate/tiny triangles answered by the exact kernels");
+    built.add();
   }
-  AABB box;
-  for (const Part& p : scene.parts) box.extend(p.mesh.bounds());
-  if (opt.build_voxel && !box.empty()) {
+  if (want_voxel) {
     const double r = scene.has_harness ? 0.5 * scene.harness.smallest_diameter() : 0.0;
     const double c = std::max(0.0, scene.routing.clearance.value);
     double res = 0.0;
@@ -103,6 +107,7 @@ SceneIndices SceneIndices::build(const Scene& scene, const SceneIndicesOptions& 
       out.log.push_back(std::string("voxel: not built: ") + e.what());
     }
   }
+  built.finish();
   // The rule.
   {
     IndexChoice plan{QueryUse::PlanningCoarse, "", ""};

@@ -8,6 +8,7 @@
 /// Every choice and derived setting is returned as text in `log` and `choices` (no global
 /// logger state), for the report.
 
+#include "core/progress.hpp"
 #include "core/scene.hpp"
 #include "index/embree_index.hpp"
 #include "index/fcl_index.hpp"
@@ -45,6 +46,9 @@ struct SceneIndicesOptions {
   std::size_t voxel_max_cells = std::size_t(64) << 20;  ///< dense grid budget; coarsens beyond
   EmbreeOptions embree;
   int threads = 0;  ///< TBB workers for builds (≤ 0: all)
+  /// Stage "index": indices built (Embree, then FCL and the voxel map if asked), reported
+  /// from the calling thread.
+  ProgressFn progress;
 };
 
 /// The built indices of a scene with the choice of index per use.

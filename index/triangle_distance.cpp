@@ -23,9 +23,8 @@ TrianglePointResult closest_point_on_segment(const Vec3& p, const Vec3& a, const
   return r;
 }
 
-bool is_degenerate(const Vec3& a, const Vec3& b, const Vec3& c, Vec3* normal) {
+bool is_degenerate(const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 n = (b - a).cross(c - a);
-  if (normal) *normal = n;
   const double e2 = std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
   return !(n.squaredNorm() > kDegenerateArea2Rel * e2 * e2);
 }
@@ -34,7 +33,12 @@ bool is_degenerate(const Vec3& a, const Vec3& b, const Vec3& c, Vec3* normal) {
 
 TrianglePointResult closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b,
                                               const Vec3& c) {
-  if (is_degenerate(a, b, c, nullptr)) {
+  return closest_point_on_triangle(p, a, b, c, is_degenerate(a, b, c));
+}
+
+TrianglePointResult closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b,
+                                              const Vec3& c, bool degenerate) {
+  if (degenerate) {
     TrianglePointResult best = closest_point_on_segment(p, a, b);
     for (const auto& r : {closest_point_on_segment(p, b, c), closest_point_on_segment(p, c, a)})
       if (r.dist2 < best.dist2) best = r;
@@ -123,11 +127,15 @@ SegmentSegmentResult closest_segment_segment(const Vec3& p0, const Vec3& p1, con
 
 SegmentTriangleResult closest_segment_triangle(const Vec3& a, const Vec3& b, const Vec3& t0,
                                                const Vec3& t1, const Vec3& t2) {
+  return closest_segment_triangle(a, b, t0, t1, t2, is_degenerate(t0, t1, t2));
+}
+
+SegmentTriangleResult closest_segment_triangle(const Vec3& a, const Vec3& b, const Vec3& t0,
+                                               const Vec3& t1, const Vec3& t2, bool degenerate) {
   SegmentTriangleResult best;
   best.dist2 = std::numeric_limits<double>::infinity();
-  Vec3 n;
-  const bool degenerate = is_degenerate(t0, t1, t2, &n);
   if (!degenerate) {
+    const Vec3 n = (t1 - t0).cross(t2 - t0);  // the same expression is_degenerate() tests
     // Proper crossing of the triangle's plane inside the triangle: distance 0.
     const double da = n.dot(a - t0), db = n.dot(b - t0);
     if ((da <= 0.0 && db >= 0.0) || (da >= 0.0 && db <= 0.0)) {
@@ -151,7 +159,7 @@ SegmentTriangleResult closest_segment_triangle(const Vec3& a, const Vec3& b, con
   // Otherwise the closest pair involves a segment endpoint or a triangle edge.
   for (int k = 0; k < 2; ++k) {
     const Vec3& p = k == 0 ? a : b;
-    const TrianglePointResult r = closest_point_on_triangle(p, t0, t1, t2);
+    const TrianglePointResult r = closest_point_on_triangle(p, t0, t1, t2, degenerate);
     if (r.dist2 < best.dist2) {
       best.s = k;
       best.segment_point = p;
@@ -205,12 +213,7 @@ double triangle_solid_angle(const Vec3& p, const Vec3& a, const Vec3& b, const V
   return 2.0 * std::atan2(num, den);
 }
 
-bool triangle_is_degenerate(const Vec3& a, const Vec3& b, const Vec3& c) { return is_degenerate(a, b, c, nullptr); }
-
-double point_box_dist2(const Vec3& p, const Vec3& lo, const Vec3& hi) {
-  const Vec3 d = (lo - p).cwiseMax(Vec3::Zero()).cwiseMax(p - hi);
-  return d.squaredNorm();
-}
+bool triangle_is_degenerate(const Vec3& a, const Vec3& b, const Vec3& c) { return is_degenerate(a, b, c); }
 
 double segment_box_dist2_lower(const Vec3& a, const Vec3& b, const Vec3& lo, const Vec3& hi) {
   const Vec3 m = 0.5 * (a + b);

@@ -19,6 +19,11 @@ struct TrianglePointResult {
 TrianglePointResult closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b,
                                               const Vec3& c);
 
+/// The same, with `degenerate` == triangle_is_degenerate(a, b, c) already known (an index
+/// stores it per triangle): skips that test, identical result.
+TrianglePointResult closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b,
+                                              const Vec3& c, bool degenerate);
+
 /// Closest points between two segments.
 struct SegmentSegmentResult {
   double s = 0.0;  ///< parameter on the first segment, in [0,1]
@@ -44,6 +49,11 @@ struct SegmentTriangleResult {
 SegmentTriangleResult closest_segment_triangle(const Vec3& a, const Vec3& b, const Vec3& t0,
                                                const Vec3& t1, const Vec3& t2);
 
+/// The same, with `degenerate` == triangle_is_degenerate(t0, t1, t2) already known: skips
+/// that test, identical result.
+SegmentTriangleResult closest_segment_triangle(const Vec3& a, const Vec3& b, const Vec3& t0,
+                                               const Vec3& t1, const Vec3& t2, bool degenerate);
+
 /// Result of a ray–triangle intersection in double precision.
 struct RayTriangleResult {
   bool hit = false;
@@ -66,8 +76,12 @@ double triangle_solid_angle(const Vec3& p, const Vec3& a, const Vec3& b, const V
 /// Such triangles are treated as the segments they collapse to.
 bool triangle_is_degenerate(const Vec3& a, const Vec3& b, const Vec3& c);
 
-/// Squared distance from p to the box [lo, hi] (0 inside).
-double point_box_dist2(const Vec3& p, const Vec3& lo, const Vec3& hi);
+/// Squared distance from p to the box [lo, hi] (0 inside). Inline: the indices call it
+/// once per candidate triangle.
+inline double point_box_dist2(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  const Vec3 d = (lo - p).cwiseMax(Vec3::Zero()).cwiseMax(p - hi);
+  return d.squaredNorm();
+}
 
 /// Lower bound on the squared distance from segment ab to the box [lo, hi] (exact when
 /// the segment is a point; otherwise uses the box around the segment's midpoint sphere).

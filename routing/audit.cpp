@@ -107,15 +107,18 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
 
   ClashRequest req = opt.check;
   req.routing_clearance = scene.routing.clearance.value;
+  if (!req.progress) req.progress = opt.progress;
   std::unique_ptr<ObstacleIndex> owned;
   const ObstacleIndex* index = nullptr;
   if (req.use_index || req.method == ClashMethod::Certified) {
     if (opt.index) {
       index = opt.index;
     } else {
+      ProgressCounter built(opt.progress, "index", 1, "indices");
       const auto t0 = std::chrono::steady_clock::now();
       owned = std::make_unique<EmbreeIndex>(scene.parts);
       rep.index_ms = ms_since(t0);
+      built.finish();
       index = owned.get();
     }
     rep.index_name = index->name();
@@ -134,7 +137,9 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
 AuditReport audit_scene_file(const std::filesystem::path& scene_file, const AuditOptions& opt, Scene* loaded) {
   const auto t0 = std::chrono::steady_clock::now();
   SceneLoadReport load_rep;
-  Scene scene = load_scene(scene_file, {}, &load_rep);
+  SceneLoadOptions load_opt;
+  load_opt.progress = opt.progress;
+  Scene scene = load_scene(scene_file, load_opt, &load_rep);
   if (opt.routes) apply_routes(scene, *opt.routes);
   const double load_ms = ms_since(t0);
   AuditReport rep = run_audit(scene, opt);

@@ -3,6 +3,7 @@
 /// clash, bend and clearance checks (timed as timing_ms.check) → an AuditReport, which
 /// report_json writes as report.json.
 
+#include "core/progress.hpp"
 #include "core/scene.hpp"
 #include "routing/clash_check.hpp"
 
@@ -21,6 +22,9 @@ struct AuditOptions {
   /// A prebuilt exact index of the scene's parts (e.g. SceneIndices::embree, shared with
   /// planning); null: run_audit builds an EmbreeIndex and times it.
   const ObstacleIndex* index = nullptr;
+  /// Stages "load" (audit_scene_file: part files loaded), "index" (when run_audit builds it) and,
+  /// unless check.progress is set, "audit" (cables checked). May be empty.
+  ProgressFn progress;
 };
 
 /// One cable of the harness as audited.

@@ -16,7 +16,6 @@
 #include <mutex>
 #include <numeric>
 #include <stdexcept>
-#include <thread>
 #include <unordered_map>
 
 namespace loom {
@@ -1051,13 +1050,7 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
   res.cables.resize(cables.size());
   std::vector<std::vector<ClashEntry>> per_clash(cables.size());
   std::vector<std::vector<Violation>> per_viol(cables.size());
-  std::atomic<std::size_t> done{0};
-  const auto caller = std::this_thread::get_id();
-  auto report = [&](std::size_t total) {
-    const std::size_t d = ++done;
-    if (request.progress && std::this_thread::get_id() == caller)
-      request.progress(0.9 * static_cast<double>(d) / static_cast<double>(std::max<std::size_t>(total, 1)));
-  };
+  ProgressCounter checked(request.progress, "audit", cables.size(), "cables");
 
   if (request.method == ClashMethod::Certified) {
     res.tolerance = ctx.tol;
@@ -1076,7 +1069,7 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
         sum.min_clearance = kInf;
       }
       check_bend(ctx, c, sum, per_viol[c]);
-      report(cables.size());
+      checked.add();
     });
   } else {
     std::vector<DiscreteSamples> ds(cables.size());
@@ -1101,7 +1094,7 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
         sum.min_clearance = std::max(tr.min_key, -cables[c].radius);
       }
       check_bend(ctx, c, sum, per_viol[c]);
-      report(cables.size());
+      checked.add();
     });
     std::vector<ClashEntry> pair_out;
     discrete_cable_pairs(ctx, ds, pair_out);
@@ -1119,7 +1112,7 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
     res.violations.insert(res.violations.end(), per_viol[c].begin(), per_viol[c].end());
   }
   res.counters = ctx.counters.snapshot();
-  if (request.progress) request.progress(1.0);
+  checked.finish();
   return res;
 }
 

@@ -25,6 +25,7 @@
 
 #include "core/centerline.hpp"
 #include "core/part.hpp"
+#include "core/progress.hpp"
 #include "index/obstacle_index.hpp"
 
 #include <cstdint>
@@ -94,8 +95,9 @@ struct ClashRequest {
   bool check_cable_cable = true;  ///< clashes between different cables
   bool check_self = true;         ///< self-interference
   bool check_bend = true;         ///< bend-radius violations
-  /// Called with the fraction done (0..1) from the calling thread; may be empty.
-  std::function<void(double)> progress;
+  /// Stage "audit": cables checked (done = total once the cable pairs are checked too);
+  /// called one at a time, from worker threads. May be empty.
+  ProgressFn progress;
 };
 
 /// What kind of clash.

@@ -112,7 +112,7 @@ double bending_energy(const Centerline& c) {
       const double b = bp[k] + (bp[k + 1] - bp[k]) * (part + 1) / kEnergySubdivisions;
       const double h = 0.5 * (b - a), m = 0.5 * (a + b);
       for (int q = 0; q < 8; ++q) {
-        c.evaluate(m + h * kGLx[q], 2, d);
+        c.evaluate_in_interval(k, m + h * kGLx[q], 2, d);  // inside interval k
         const double v = d[1].norm();
         if (!(v > 0.0)) continue;
         // κ²|C'| = |C'×C''|²/|C'|⁵ (same evaluation, no second lookup).
@@ -184,30 +184,51 @@ FairingResult fair_energy(const Centerline& interpolant, const FairingOptions& o
     }
     return dev;
   };
+  // The system (αG + M) restricted to the free control points has one sparsity pattern for
+  // every α: assemble it and analyse it once; each α only refills the values and factorises.
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt;
+  Eigen::SparseMatrix<double> A(nu, nu);
+  std::vector<double> g_val, m_val;  // G and M at A's stored entries (A = αG + M)
+  if (nu > 0) {
+    std::vector<int> cp_of(nu);
+    for (int i = 0; i < ncp; ++i)
+      if (!fixed[i]) cp_of[unknown[i]] = i;
+    std::vector<Eigen::Triplet<double>> trip;
+    trip.reserve(static_cast<std::size_t>(nu) * kOrder);
+    for (int i = 0; i < ncp; ++i) {
+      if (fixed[i]) continue;
+      for (int j = std::max(0, i - kDegree); j <= std::min(ncp - 1, i + kDegree); ++j)
+        if (!fixed[j] && unknown[j] <= unknown[i]) trip.emplace_back(unknown[i], unknown[j], 1.0);
+    }
+    A.setFromTriplets(trip.begin(), trip.end());
+    A.makeCompressed();
+    g_val.resize(static_cast<std::size_t>(A.nonZeros()));
+    m_val.resize(g_val.size());
+    for (int col = 0; col < A.outerSize(); ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator e(A, col); e; ++e) {
+        const int i = cp_of[e.row()], j = cp_of[e.col()];
+        const auto k = static_cast<std::size_t>(&e.value() - A.valuePtr());
+        g_val[k] = G.get(i, j);
+        m_val[k] = M.get(i, j);
+      }
+    ldlt.analyzePattern(A);
+  }
+  Eigen::MatrixX3d rhs(nu, 3);
   auto solve = [&](double alpha, std::vector<Vec3>& D) -> bool {
     if (nu == 0) {
       D = P0;
       return true;
     }
-    std::vector<Eigen::Triplet<double>> trip;
-    trip.reserve(static_cast<std::size_t>(nu) * kOrder);
-    Eigen::MatrixX3d rhs(nu, 3);
     for (int i = 0; i < ncp; ++i) {
       if (fixed[i]) continue;
       Eigen::RowVector3d row = r.row(i);
-      for (int j = std::max(0, i - kDegree); j <= std::min(ncp - 1, i + kDegree); ++j) {
-        const double aij = alpha * G.get(i, j) + M.get(i, j);
-        if (fixed[j])
-          row -= aij * P0[j].transpose();
-        else if (unknown[j] <= unknown[i])
-          trip.emplace_back(unknown[i], unknown[j], aij);
-      }
+      for (int j = std::max(0, i - kDegree); j <= std::min(ncp - 1, i + kDegree); ++j)
+        if (fixed[j]) row -= (alpha * G.get(i, j) + M.get(i, j)) * P0[j].transpose();
       rhs.row(unknown[i]) = row;
     }
-    Eigen::SparseMatrix<double> A(nu, nu);
-    A.setFromTriplets(trip.begin(), trip.end());
-    ldlt.compute(A);
+    double* value = A.valuePtr();
+    for (std::size_t k = 0; k < g_val.size(); ++k) value[k] = alpha * g_val[k] + m_val[k];
+    ldlt.factorize(A);
     if (ldlt.info() != Eigen::Success) return false;
     const Eigen::MatrixX3d X = ldlt.solve(rhs);
     D = P0;

@@ -34,6 +34,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
@@ -55,6 +56,8 @@ constexpr double kMarginRequired = 2.0;
 /// The diagnosis tube has this fraction of the required distance (a "thin line" that
 /// still does not slip through cracks between touching triangles).
 constexpr double kThinFraction = 0.05;
+/// Rays cast from a stub end to tell a sealed cavity from a merely hard problem.
+constexpr int kEnclosureRays = 96;
 /// Relative tolerance when comparing two costs of the same stretch (Riemann sums of the
 /// clearance term along different sample positions differ at this level).
 constexpr double kCostCompareTolerance = 1e-6;
@@ -598,6 +601,23 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
+/// The part that seals p in a cavity: every one of kEnclosureRays directions (a Fibonacci
+/// sphere) hits a part within `reach`. Returns the part hit by most rays, or -1 as soon as
+/// one ray escapes.
+int enclosing_part(const ObstacleIndex& index, const Vec3& p, double reach) {
+  std::map<int, int> hits;
+  const double golden = M_PI * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < kEnclosureRays; ++i) {
+    const double z = 1.0 - 2.0 * (i + 0.5) / kEnclosureRays, rho = std::sqrt(1.0 - z * z);
+    const Vec3 d(rho * std::cos(golden * i), rho * std::sin(golden * i), z);
+    const RayHit h = index.ray(p, d, reach);
+    if (!h.found()) return -1;
+    ++hits[h.part];
+  }
+  return std::max_element(hits.begin(), hits.end(), [](const auto& a, const auto& b) { return a.second < b.second; })
+      ->first;
+}
+
 /// Everything after the port checks: plan with `planner`, simplify, verify; on failure,
 /// diagnose with a thin tube. `ctx` belongs to `planner`.
 void plan_between_stubs(const ObstacleIndex& index, TubeContext& ctx, const ob::PlannerPtr& planner,
@@ -668,6 +688,20 @@ void plan_between_stubs(const ObstacleIndex& index, TubeContext& ctx, const ob::
     r.diagnose_ms = ms_since(t2);
   }
   if (!found) {
+    if (r.reason != NoPathReason::NoCorridor && settings.diagnosis_fraction > 0.0) {
+      // No thin path either: if an end is sealed in a cavity, say so (an unreachable port).
+      const double reach = ctx.bounds.diagonal();
+      for (const auto& [end, name] : {std::pair{start_end, "start"}, std::pair{goal_end, "goal"}}) {
+        const int part = enclosing_part(index, end, reach);
+        if (part < 0) continue;
+        r.reason = NoPathReason::Enclosed;
+        r.blocked_at = end;
+        r.blocking_part = part;
+        r.message = std::string("the ") + name + " " + fmt_point(end) + " is sealed in a cavity: all " +
+                    std::to_string(kEnclosureRays) + " rays cast from it hit part " + std::to_string(part);
+        return;
+      }
+    }
     if (r.reason != NoPathReason::NoCorridor) {
       r.reason = NoPathReason::Timeout;
       r.message = "no path found within " + fmt_len(time_limit) + " s" +
@@ -717,6 +751,7 @@ const char* reason_name(NoPathReason r) {
     case NoPathReason::GoalPortBlocked: return "goal_port_blocked";
     case NoPathReason::NoCorridor: return "no_corridor";
     case NoPathReason::Timeout: return "timeout";
+    case NoPathReason::Enclosed: return "enclosed";
     case NoPathReason::InvalidSolution: return "invalid_solution";
   }
   return "none";

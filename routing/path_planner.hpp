@@ -107,11 +107,12 @@ enum class NoPathReason {
   GoalPortBlocked,   ///< the second port's stub is blocked
   NoCorridor,        ///< a thin path exists, but no corridor wider than the tube was found
   Timeout,           ///< no path within the time budget (not even a thin one, or budget 0)
+  Enclosed,          ///< no thin path, and an end is sealed in a cavity (every ray from it hits a part)
   InvalidSolution,   ///< the planner's path failed the exact re-check (a bug; never returned as a route)
 };
 
 /// "none" | "start_in_obstacle" | "goal_in_obstacle" | "start_port_blocked" |
-/// "goal_port_blocked" | "no_corridor" | "timeout" | "invalid_solution".
+/// "goal_port_blocked" | "no_corridor" | "timeout" | "enclosed" | "invalid_solution".
 const char* reason_name(NoPathReason r);
 
 /// The key points of a route and what they cost.

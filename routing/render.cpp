@@ -223,6 +223,7 @@ Image render_scene(const Scene& scene, const Harness& harness, const nlohmann::j
   img.height = opt.height;
   img.rgb.resize(static_cast<std::size_t>(opt.width) * static_cast<std::size_t>(opt.height) * 3);
   const Basis b = basis_of(cam, opt.width, opt.height);
+  ProgressCounter rows(opt.progress, "render", static_cast<std::size_t>(opt.height), "rows");
   tbb::parallel_for(0, opt.height, [&](int y) {
     for (int x = 0; x < opt.width; ++x) {
       const double nx = (2.0 * (x + 0.5) / opt.width - 1.0) * b.tan_half * b.aspect;
@@ -244,7 +245,9 @@ Image render_scene(const Scene& scene, const Harness& harness, const nlohmann::j
       }
       put(img, x, y, colour);
     }
+    rows.add();
   });
+  rows.finish();
   st.rays = static_cast<std::size_t>(opt.width) * static_cast<std::size_t>(opt.height);
 
   // Markers over everything: violations first, clashes on top.

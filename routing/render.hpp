@@ -5,6 +5,7 @@
 
 #include "core/geometry.hpp"
 #include "core/harness.hpp"
+#include "core/progress.hpp"
 #include "core/scene.hpp"
 
 #include <nlohmann/json.hpp>
@@ -31,6 +32,8 @@ struct RenderOptions {
   std::optional<RenderCamera> camera;  ///< nullopt: frame_camera() on the harness (or scene)
   /// Radius of a clash/violation disc in pixels; 0 = derived: max(4, min(width, height) / 120).
   double marker_radius_px = 0.0;
+  /// Stage "render": image rows ray-cast, one call at a time from TBB workers. May be empty.
+  ProgressFn progress;
 };
 
 /// An 8-bit RGB picture, rows top to bottom.

@@ -5,6 +5,7 @@
 #include "index/alpha_sim.hpp"
 #include "index/embree_index.hpp"
 #include "routing/bend_repair.hpp"
+#include "routing/branch_layout.hpp"
 #include "routing/cable_geometry.hpp"
 
 #include <algorithm>
@@ -22,31 +23,23 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-/// Branch placement: Weiszfeld iterations for the geometric median of the neighbours.
-constexpr int kWeiszfeldIterations = 100;
-/// Moving a branch point clear: candidate directions per shell and shells tried, the shell
-/// radius growing by the required clearance each time.
-constexpr int kClearDirections = 26;
-constexpr int kClearShells = 40;
-/// The straight stubs at both ends of a segment take at most this share of its length.
-constexpr double kStubShare = 0.4;
+/// The straight stubs at both ends of a segment may eat at most this share of the way
+/// between its ends (the part of each stub that heads towards the other end).
+constexpr double kStubShare = 0.5;
 
-/// Directions on the unit sphere: the 26 neighbours of a cube cell, normalised.
-std::vector<Vec3> shell_directions() {
-  std::vector<Vec3> d;
-  for (int x = -1; x <= 1; ++x)
-    for (int y = -1; y <= 1; ++y)
-      for (int z = -1; z <= 1; ++z)
-        if (x || y || z) d.push_back(Vec3(x, y, z).normalized());
-  return d;
-}
+/// Re-plans of a segment whose bend repair failed: each with a fresh seed and twice the
+/// previous budget; the first whose curve meets the bend radius is kept.
+constexpr int kBendReplans = 2;
 
 /// A segment's key-point polyline and the curve through it.
 struct SegmentGeometry {
   std::vector<Vec3> points;  ///< from-node, interior key points, to-node
   InterpolationOptions interp;
   Centerline curve;
+  Vec3 a, a_stub, b_stub, b;  ///< the ends and their stub ends, as planned
+  PlanRequest request;        ///< what the planner was asked (for re-planning)
 };
+
 
 /// Removes consecutive points closer than `eps`.
 std::vector<Vec3> dedupe(const std::vector<Vec3>& pts, double eps) {
@@ -57,12 +50,27 @@ std::vector<Vec3> dedupe(const std::vector<Vec3>& pts, double eps) {
   return out;
 }
 
-/// Inserts the midpoint of every polyline edge: the interpolating cubic then follows the
-/// verified polyline more closely (the deviation falls roughly 4× per round).
+/// The key-point polyline of a segment: node, stub end, the planner's interior key points,
+/// stub end, node; coincident points removed.
+std::vector<Vec3> assemble(const SegmentGeometry& g, const std::vector<Vec3>& key_points, double eps) {
+  std::vector<Vec3> pts{g.a, g.a_stub};
+  pts.insert(pts.end(), key_points.begin(), key_points.end());
+  pts.push_back(g.b_stub);
+  pts.push_back(g.b);
+  return dedupe(pts, eps);
+}
+
+/// Inserts the midpoint of every polyline edge but the two end stubs: the interpolating
+/// cubic then follows the verified polyline more closely (the deviation falls roughly 4×
+/// per round). The stubs stay single chords: their curve is clamped to the exit direction
+/// at the node, and a short chord that fairing has turned slightly off that direction
+/// would bend the curve sharply right at the node.
 std::vector<Vec3> densify(const std::vector<Vec3>& pts) {
   std::vector<Vec3> out;
+  const bool keep_stubs = pts.size() > 3;
   for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
     out.push_back(pts[i]);
+    if (keep_stubs && (i == 0 || i + 2 == pts.size())) continue;
     out.push_back(0.5 * (pts[i] + pts[i + 1]));
   }
   out.push_back(pts.back());
@@ -92,81 +100,6 @@ BSplineData to_bspline(const Centerline& c) {
 
 }  // namespace
 
-std::vector<std::string> place_branch_points(Harness& h, const ObstacleIndex& index,
-                                             const std::function<double(int branch)>& clearance_of) {
-  std::vector<int> unplaced;
-  for (std::size_t b = 0; b < h.branches.size(); ++b)
-    if (!h.branches[b].position) unplaced.push_back(static_cast<int>(b));
-  std::vector<std::string> placed;
-  if (unplaced.empty()) return placed;
-  // Neighbours of each branch point.
-  std::map<std::string, std::vector<std::string>> nb;
-  for (const auto& s : h.segments) {
-    nb[s.from].push_back(s.to);
-    nb[s.to].push_back(s.from);
-  }
-  // Start from the mean of the placed neighbours (or of all ports when none is placed).
-  Vec3 port_mean = Vec3::Zero();
-  for (const auto& p : h.ports) port_mean += p.position;
-  if (!h.ports.empty()) port_mean /= static_cast<double>(h.ports.size());
-  std::map<int, Vec3> pos;
-  for (int b : unplaced) {
-    Vec3 sum = Vec3::Zero();
-    int n = 0;
-    for (const auto& id : nb[h.branches[b].id])
-      if (auto p = h.node_position(id)) sum += *p, ++n;
-    pos[b] = n ? Vec3(sum / n) : port_mean;
-  }
-  auto position_of = [&](const std::string& id) -> Vec3 {
-    if (int b = h.find_branch(id); b >= 0 && !h.branches[b].position) return pos[b];
-    return *h.node_position(id);
-  };
-  // Weiszfeld: each unplaced point moves to the distance-weighted mean of its neighbours;
-  // chains of unplaced points converge together (the sum of segment lengths is convex).
-  for (int it = 0; it < kWeiszfeldIterations; ++it) {
-    for (int b : unplaced) {
-      Vec3 num = Vec3::Zero();
-      double den = 0.0;
-      for (const auto& id : nb[h.branches[b].id]) {
-        const Vec3 q = position_of(id);
-        const double d = std::max((q - pos[b]).norm(), 1e-9);
-        num += q / d;
-        den += 1.0 / d;
-      }
-      if (den > 0) pos[b] = num / den;
-    }
-  }
-  // Move each clear of the obstacles: the nearest free point on growing shells.
-  const auto dirs = shell_directions();
-  for (int b : unplaced) {
-    const double need = clearance_of(b);
-    Vec3 p = pos[b];
-    if (index.inside(p) || index.any_within(p, need)) {
-      bool found = false;
-      for (int shell = 1; shell <= kClearShells && !found; ++shell) {
-        double best = std::numeric_limits<double>::infinity();
-        Vec3 best_p = p;
-        for (const auto& d : dirs) {
-          const Vec3 q = p + d * (need * shell);
-          if (index.inside(q) || index.any_within(q, need)) continue;
-          // Prefer the candidate that keeps the connected segments shortest.
-          double len = 0;
-          for (const auto& id : nb[h.branches[b].id]) len += (position_of(id) - q).norm();
-          if (len < best) best = len, best_p = q;
-        }
-        if (std::isfinite(best)) p = best_p, found = true;
-      }
-      if (!found)
-        throw InputError({h.source_file, h.branches[b].line, "branch '" + h.branches[b].id + "'"},
-                         "cannot place this branch point clear of the structure near its neighbours");
-    }
-    pos[b] = p;
-    h.branches[b].position = p;
-    placed.push_back(h.branches[b].id);
-  }
-  return placed;
-}
-
 RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
   const auto t_total = Clock::now();
   RouteReport rep;
@@ -179,18 +112,20 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
   rep.clearance = scene.routing.clearance.value;
   double part_extra = 0.0;
   for (const auto& p : scene.parts) part_extra = std::max(part_extra, p.clearance);
-  auto progress = [&](const std::string& stage, double f) {
-    if (opt.progress) opt.progress(stage, f);
-  };
 
   // 1. Planning obstacles: α-simplified parts (they contain the originals, so a route clear
   //    of them is clear of the real parts), indexed once.
   auto t0 = Clock::now();
   std::vector<Part> planning_parts;
-  if (opt.simplify && !scene.parts.empty()) {
+  const bool plan_on_other_parts = opt.planning_parts || (opt.simplify && !scene.parts.empty());
+  if (opt.planning_parts) {
+    planning_parts = *opt.planning_parts;
+    rep.notes.push_back("planning on " + std::to_string(planning_parts.size()) + " parts given by the caller");
+  } else if (opt.simplify && !scene.parts.empty()) {
     AlphaSimOptions ao;
     ao.dim_pre = scene.simplify.dim_pre.value;
     ao.detect_lost_space = true;
+    ao.progress = opt.progress;
     std::vector<AlphaSimResult> results;
     planning_parts = simplify_parts(scene.parts, ao, &results);
     std::size_t before = 0, after = 0;
@@ -202,64 +137,26 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
   }
   rep.timing.simplify = ms_since(t0);
   t0 = Clock::now();
+  ProgressCounter indexed(opt.progress, "index", 1, "indices");
   const EmbreeIndex plan_index(planning_parts);
+  indexed.finish();
   rep.timing.index = ms_since(t0);
 
-  // 2. Branch points the file leaves open.
-  auto branch_clearance = [&](int b) {
+  // 2. Branch points the file leaves open, placed where the legs are short and can turn
+  //    into their connectors within the bend radius; then the exit direction of every
+  //    segment at every branch point (main lines smooth through their node).
+  const std::vector<SegmentEnds> ends = segment_ends(topo, derived_stub_length);
+  BranchPlacementOptions bpo;
+  bpo.clearance_of = [&](int b) {
     double r = 0.0;
-    for (int s : topo.incident_segments(h.branches[b].id)) r = std::max(r, 0.5 * topo.segment_diameter(s));
+    for (int s : topo.incident_segments(h.branches[b].id)) r = std::max(r, ends[s].radius);
     return r + rep.clearance + part_extra;
   };
-  for (const auto& id : place_branch_points(h, plan_index, branch_clearance))
+  for (const auto& id : place_branch_points(h, topo, plan_index, ends, bpo))
     rep.notes.push_back("branch point '" + id + "' placed by the router");
-
-  // 3. Exit directions at every node. Ports: the connector axis. Branch points: the two
-  //    segments with most cables passing between them form the main line, smooth through
-  //    the node (opposite exit directions along the line joining their far ends); the third
-  //    leaves towards its far end (cables turning into it splay inside the breakout).
-  std::map<std::pair<int, bool>, Vec3> exit_dir;  // (segment, at its from-end) -> unit exit direction
+  const auto exit_dir = branch_exit_directions(h, topo, ends);
   std::map<std::string, double> breakout;
-  for (const auto& br : h.branches) {
-    const Vec3 bp = *br.position;
-    const auto inc = topo.incident_segments(br.id);
-    breakout[br.id] = breakout_length(topo, br.id);
-    auto far_end = [&](int seg) {
-      const Segment& sg = h.segments[seg];
-      return *h.node_position(sg.from == br.id ? sg.to : sg.from);
-    };
-    std::map<std::pair<int, int>, int> passes;
-    for (std::size_t c = 0; c < h.cables.size(); ++c) {
-      const auto& chain = topo.cable_chain(static_cast<int>(c));
-      for (std::size_t k = 0; k + 1 < chain.size(); ++k) {
-        const Segment& sg = h.segments[chain[k].segment];
-        const std::string& at = chain[k].reversed ? sg.from : sg.to;
-        if (at == br.id) passes[std::minmax(chain[k].segment, chain[k + 1].segment)]++;
-      }
-    }
-    std::pair<int, int> main{-1, -1};
-    int best = -1;
-    for (std::size_t i = 0; i < inc.size(); ++i)
-      for (std::size_t j = i + 1; j < inc.size(); ++j) {
-        const auto key = std::minmax(inc[i], inc[j]);
-        const int n = passes.count(key) ? passes[key] : 0;
-        if (n > best) best = n, main = key;
-      }
-    const Vec3 di = far_end(main.first), dj = far_end(main.second);
-    Vec3 d = dj - di;
-    if (d.norm() < 1e-12) d = Vec3::UnitX();
-    d.normalize();
-    for (int seg : inc) {
-      Vec3 e;
-      if (seg == main.first) e = -d;
-      else if (seg == main.second) e = d;
-      else {
-        e = far_end(seg) - bp;
-        e = e.norm() > 1e-12 ? Vec3(e.normalized()) : d;
-      }
-      exit_dir[{seg, h.segments[seg].from == br.id}] = e;
-    }
-  }
+  for (const auto& br : h.branches) breakout[br.id] = breakout_length(topo, br.id);
   auto end_frame = [&](int seg, bool from_end) {
     const Segment& sg = h.segments[seg];
     EndFrame e;
@@ -276,13 +173,14 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
 
   // 4. Plan each segment in the patent's order.
   const AABB box = scene.bounds();
+  const double eps = 1e-9 * std::max(1.0, box.diagonal());  // coincident key points
   std::map<int, SegmentGeometry> geom;
   std::set<std::string> failed_segments;
   const auto& order = topo.routing_order();
   seed_ompl_once(rep.seed);
-  for (std::size_t k = 0; k < order.size(); ++k) {
+  ProgressCounter planned(opt.progress, "plan", order.size(), "segments");
+  for (std::size_t k = 0; k < order.size(); ++k, planned.add()) {
     const int s = order[k];
-    progress("plan", static_cast<double>(k) / order.size());
     Segment& seg = h.segments[s];
     SegmentRouteInfo info;
     info.segment = s;
@@ -305,14 +203,19 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
     auto stub_for = [&](const EndFrame& e) {
       return e.is_port ? port_stub : free_stub(plan_index, e.position, e.exit, breakout[e.node], required);
     };
-    // Stubs of the two ends together take at most kStubShare of the distance between the
-    // ends; longer ones would cross and force the route into a hairpin.
+    // Stubs heading towards each other may together cover at most kStubShare of the way
+    // between the ends; longer ones would cross and force the route into a hairpin. A stub
+    // leaving sideways takes nothing from the way and is kept whole.
     double la = stub_for(ea), lb = stub_for(eb);
     const double span = (b - a).norm();
-    if (la + lb > kStubShare * span) {
-      const double f = kStubShare * span / (la + lb);
-      la *= f;
-      lb *= f;
+    if (span > 0.0) {
+      const Vec3 u = (b - a) / span;
+      const double eaten = la * std::max(0.0, ea.exit.dot(u)) + lb * std::max(0.0, -eb.exit.dot(u));
+      if (eaten > kStubShare * span) {
+        const double f = kStubShare * span / eaten;
+        la *= f;
+        lb *= f;
+      }
     }
     const Vec3 a_stub = ea.position + la * ea.exit;
     const Vec3 b_stub = eb.position + lb * eb.exit;
@@ -330,16 +233,36 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
     req.start = {a_stub, (b_stub - a_stub).norm() > 0 ? Vec3((b_stub - a_stub).normalized()) : Vec3::UnitX()};
     req.goal = {b_stub, (a_stub - b_stub).norm() > 0 ? Vec3((a_stub - b_stub).normalized()) : Vec3::UnitX()};
     PlanResult blocked;
+    bool branch_blocked = false;
+    auto at = [](const Vec3& p) {
+      return "(" + full_precision(p.x()) + ", " + full_precision(p.y()) + ", " + full_precision(p.z()) + ")";
+    };
     for (const EndFrame* e : {&ea, &eb}) {
-      if (!e->is_port || !blocked.message.empty()) continue;
+      if (!blocked.message.empty()) continue;
+      if (!e->is_port) {
+        // A branch point the file fixed inside a part, or so near one that the bundle
+        // itself would cut it: nothing the planner can do; the harness must move it.
+        int part = -1;
+        const bool in = plan_index.inside(e->position, &part);
+        const ClosestHit near = in ? ClosestHit{} : plan_index.closest(e->position, radius);
+        if (!in && !near.found()) continue;
+        branch_blocked = true;
+        blocked.reason = e == &ea ? NoPathReason::StartInObstacle : NoPathReason::GoalInObstacle;
+        blocked.blocked_at = e->position;
+        blocked.blocking_part = in ? part : near.part;
+        blocked.message = "branch point " + e->node + " at " + at(e->position) +
+                          (in ? " is inside part '" + planning_parts[part].name + "'"
+                              : " is " + full_precision(near.distance) + " from part '" + planning_parts[near.part].name +
+                                    "', less than the bundle radius " + full_precision(radius));
+        continue;
+      }
       int inside_part = -1;
       if (plan_index.inside(e->position, &inside_part)) {
         blocked.reason = e == &ea ? NoPathReason::StartInObstacle : NoPathReason::GoalInObstacle;
         blocked.blocked_at = e->position;
         blocked.blocking_part = inside_part;
-        blocked.message = "port " + e->node + " at (" + full_precision(e->position.x()) + ", " +
-                          full_precision(e->position.y()) + ", " + full_precision(e->position.z()) +
-                          ") is inside part '" + planning_parts[inside_part].name + "'";
+        blocked.message = "port " + e->node + " at " + at(e->position) + " is inside part '" +
+                          planning_parts[inside_part].name + "'";
         continue;
       }
       const Vec3 stub_end = e == &ea ? a_stub : b_stub;
@@ -388,25 +311,29 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
     info.plan = plan;
     if (!plan.solved()) {
       failed_segments.insert(seg.from + " -> " + seg.to);
+      // One entry per cable: the first segment (in routing order) that stopped it.
       for (int c : topo.segment_cables(s))
-        rep.unrouted.push_back({h.cables[c].id, seg.from + " -> " + seg.to, reason_name(plan.reason), plan.message});
+        if (std::none_of(rep.unrouted.begin(), rep.unrouted.end(),
+                         [&](const UnroutedCable& u) { return u.cable == h.cables[c].id; }))
+          rep.unrouted.push_back({h.cables[c].id, seg.from + " -> " + seg.to,
+                                  branch_blocked ? "branch_blocked" : reason_name(plan.reason), plan.message});
       rep.segments.push_back(info);
       continue;
     }
     info.planned = true;
     SegmentGeometry g;
-    g.points.push_back(a);
-    g.points.push_back(a_stub);
-    for (const auto& p : plan.key_points) g.points.push_back(p);
-    g.points.push_back(b_stub);
-    g.points.push_back(b);
-    g.points = dedupe(g.points, 1e-9 * std::max(1.0, box.diagonal()));
+    g.a = a;
+    g.a_stub = a_stub;
+    g.b_stub = b_stub;
+    g.b = b;
+    g.request = req;
+    g.points = assemble(g, plan.key_points, eps);
     g.interp.start_tangent = ea.exit;
     g.interp.end_tangent = -eb.exit;
     geom[s] = g;
     rep.segments.push_back(info);
   }
-  progress("plan", 1.0);
+  planned.finish();
 
   // 5. Splines: bend-radius repair within half the clearance margin, written into the harness.
   auto build_curve = [&](int s) {
@@ -467,13 +394,45 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
   for (auto& [s, g] : geom) build_curve(s);
   rep.timing.spline = ms_since(t0);
 
+  // 5b. A segment whose corners cannot be rounded within what the obstacles allow is
+  //     re-planned (another seed, twice the budget, up to kBendReplans times); the new
+  //     key points are kept only if their curve meets the bend radius.
+  auto info_of = [&](int s) -> SegmentRouteInfo& {
+    return *std::find_if(rep.segments.begin(), rep.segments.end(), [s](const SegmentRouteInfo& i) { return i.segment == s; });
+  };
+  auto bend_failed = [&](int s) { return info_of(s).bend_status.rfind("failed", 0) == 0; };
+  for (auto& [s, g] : geom) {
+    for (int attempt = 1; attempt <= kBendReplans && bend_failed(s); ++attempt) {
+      PlanRequest req = g.request;
+      req.seed = g.request.seed + 7919u * static_cast<unsigned>(attempt);
+      req.time_limit = g.request.time_limit * std::pow(2.0, attempt);
+      t0 = Clock::now();
+      const PlanResult plan = plan_path(plan_index, req);
+      rep.timing.plan += ms_since(t0);
+      if (!plan.solved()) continue;
+      const SegmentGeometry saved = g;
+      const SegmentRouteInfo saved_info = info_of(s);
+      g.points = assemble(g, plan.key_points, eps);
+      build_curve(s);
+      if (bend_failed(s)) {
+        g = saved;
+        build_curve(s);
+        info_of(s) = saved_info;
+      } else {
+        info_of(s).plan = plan;
+        info_of(s).replans = attempt;
+      }
+    }
+  }
+
   // 6. Exact audit against the real parts; repair segments whose curves clash or crowd.
   //    The exact index is built once: the planning index when planning used the exact parts.
   t0 = Clock::now();
   std::unique_ptr<EmbreeIndex> exact_owned;
-  if (opt.simplify && !scene.parts.empty()) exact_owned = std::make_unique<EmbreeIndex>(scene.parts);
+  if (plan_on_other_parts) exact_owned = std::make_unique<EmbreeIndex>(scene.parts);
   AuditOptions ao;
   ao.check.threads = opt.threads;
+  ao.progress = opt.progress;
   ao.index = exact_owned ? exact_owned.get() : &plan_index;
   rep.timing.index += ms_since(t0);
   Scene routed_scene;

@@ -5,11 +5,13 @@
 /// port exit tangents → bend-radius repair/fairing → exact certified audit → repair
 /// (denser key points where the smooth curve clashes) → routed harness + report.
 
+#include "core/progress.hpp"
 #include "core/scene.hpp"
 #include "routing/audit.hpp"
 #include "routing/path_planner.hpp"
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -26,9 +28,15 @@ struct RouteOptions {
   /// the exact 147k triangles plans in well under a second; turn it on for scenes whose
   /// detail (threads, rivets) slows the planner more than simplifying costs.
   bool simplify = false;
+  /// Planning obstacles computed by the caller (e.g. α-simplified once and reused across
+  /// runs, as bench_route does); when set, `simplify` is ignored. They must contain the
+  /// scene's parts for a route clear of them to be clear of the real geometry; the audit
+  /// always uses the scene's exact parts.
+  std::shared_ptr<const std::vector<Part>> planning_parts;
   int max_repair_rounds = 4; ///< audit → densify → re-spline rounds per segment
-  /// Called with (stage, fraction done) from the calling thread; may be empty.
-  std::function<void(const std::string&, double)> progress;
+  /// Progress of the stages: "simplify" (parts), "index" (planning index built), "plan"
+  /// (segments), "audit" (cables, each audit round); may be empty.
+  ProgressFn progress;
 };
 
 /// How one harness segment was routed.
@@ -39,6 +47,7 @@ struct SegmentRouteInfo {
   PlanResult plan;            ///< the planner's answer (when planned)
   std::size_t key_points = 0; ///< interior key points in the routed file
   int repair_rounds = 0;      ///< densification rounds after the audit
+  int replans = 0;            ///< re-plans that were kept because the bend repair failed
   std::string bend_status;    ///< outcome of the bend-radius repair
 };
 
@@ -72,11 +81,5 @@ struct RouteReport {
 
 /// Routes every unrouted segment of the scene's harness and audits the result.
 RouteReport route_scene(const Scene& scene, const RouteOptions& opt);
-
-/// Places branch points that have no position: each at the point minimising the summed
-/// distance to its three neighbours (Weiszfeld iterations over the tree), then moved clear
-/// of obstacles by at least `clearance_of(branch)` using `index`. Returns the ids placed.
-std::vector<std::string> place_branch_points(Harness& h, const ObstacleIndex& index,
-                                             const std::function<double(int branch)>& clearance_of);
 
 }  // namespace loom

@@ -84,6 +84,7 @@ json route_report_json(const RouteReport& rep) {
         o["planned_min_clearance"] = finite_or(info.plan.min_clearance, 0.0);
         o["key_points"] = info.key_points;
         o["repair_rounds"] = info.repair_rounds;
+        o["replans"] = info.replans;
         o["bend_repair"] = info.bend_status;
       }
     }

@@ -7,7 +7,10 @@
 #include "routing/sweep.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -16,10 +19,20 @@ namespace loom {
 
 namespace {
 
-/// Share of the chord tolerance given to the ring polygons (sagitta across the tube); the
-/// rest goes to the spacing of the rings along it (sagitta along the outer fibre). A point
-/// inside a quad is off by at most the sum of the two.
-constexpr double kCircumferentialShare = 0.5;
+/// Share of the chord tolerance given to the spacing of the rings along the tube: the
+/// outer-fibre sagitta between neighbouring rings stays within it.
+constexpr double kAxialShare = 0.5;
+/// Share given to the ring polygons (sagitta across the tube). Odd rings are rotated by
+/// half a vertex step, so the facets are near-equilateral triangles rather than halves of
+/// quads. Locally the tube is the quadratic ½(x²/r + b·y²) (x across, y along, |b| ≤ the
+/// outer fibre's κ(1 + rκ) per unit centerline length); scaled to isotropy (X = x/√r,
+/// Y = y·√b) a facet is an isosceles triangle of base H (ring sagitta H²/8 = s_c) and
+/// height K (axial sagitta K²/8 = s_a), and linear interpolation of ½|P|² on it errs by at
+/// most ρ²/2, ρ its circumradius (K ≥ H/2), or H²/8 (obtuse, K < H/2). With s_a ≤ ½·tol,
+/// s_c ≤ ¾·tol: ρ = (K² + H²/4)/(2K) ≤ 1.375·√tol, error ≤ 0.945·tol. The aligned quad
+/// layout errs by s_a + s_c and needed s_c ≤ ½·tol: this share needs √(½/¾) ≈ 0.82 times
+/// the vertices per ring at the same rings and tolerance.
+constexpr double kRingPolygonShare = 0.75;
 /// Fewest vertices per ring (a triangle) and most (beyond this the tolerance is absurd for
 /// the radius).
 constexpr int kMinCircumferential = 3;
@@ -38,20 +51,24 @@ constexpr double kMinStepRel = 1e-9;
 constexpr double kStationaryRelSpeed = 1e-12;
 
 
-/// Unit tangent at u from the first (or, at a stationary point, second) derivative.
-Vec3 unit_tangent(const Vec3* d, double min_speed, const Vec3& fallback) {
-  const double v = d[1].norm();
-  if (v > min_speed) return d[1] / v;
-  const double a = d[2].norm();
-  if (a > 0.0) return d[2] / a;
-  return fallback;
-}
-
-double curvature_of(const Vec3* d, double min_speed) {
-  const double v = d[1].norm();
-  if (!(v > min_speed)) return 0.0;
-  return d[1].cross(d[2]).norm() / (v * v * v);
-}
+/// C, C', C'' at one parameter with |C'| and the curvature, each computed once.
+struct Sample {
+  Vec3 d[3];
+  double speed = 0.0;  ///< |C'|
+  double kappa = 0.0;  ///< curvature (0 where |C'| ≤ the stationary threshold)
+  /// Fills speed and kappa from d.
+  void finish(double min_speed) {
+    speed = d[1].norm();
+    kappa = speed > min_speed ? d[1].cross(d[2]).norm() / (speed * speed * speed) : 0.0;
+  }
+  /// Unit tangent from the first (or, at a stationary point, second) derivative.
+  Vec3 tangent(double min_speed, const Vec3& fallback) const {
+    if (speed > min_speed) return d[1] / speed;
+    const double a = d[2].norm();
+    if (a > 0.0) return d[2] / a;
+    return fallback;
+  }
+};
 
 /// Largest axial step Δs whose outer-fibre sagitta κ(1 + rκ)Δs²/8 stays within tol.
 double axial_step(double kappa, double r, double tol) {
@@ -68,13 +85,25 @@ Vec3 any_perpendicular(const Vec3& t) {
   return (a - a.dot(t) * t).normalized();
 }
 
-/// Rotation angle (radians, [0, π]) taking the orthonormal frame (t0, b0, t0×b0) to
-/// (t1, b1, t1×b1): from R = Σ f1 f0ᵀ, tan θ = |axial(R)| / (tr R − 1), stable near 0 and π.
-double frame_turn(const Vec3& t0, const Vec3& b0, const Vec3& t1, const Vec3& b1) {
+/// Rotation angle θ ∈ [0, π] between two frames as the pair (sin θ, cos θ), both scaled by
+/// the same positive factor (atan2 of it is θ; comparing two needs no atan2).
+struct TurnAngle {
+  double sin = 0.0;
+  double cos = 1.0;
+  /// True if this angle exceeds `o` (sin(θ − θo) > 0 for θ, θo ∈ [0, π]).
+  bool exceeds(const TurnAngle& o) const { return sin * o.cos - cos * o.sin > 0.0; }
+  /// The angle in radians.
+  double radians() const { return std::atan2(sin, cos); }
+};
+
+/// Rotation taking the orthonormal frame (t0, b0, t0×b0) to (t1, b1, t1×b1): with
+/// R = Σ f1 f0ᵀ, sin θ = |axial(R)| / 2 and cos θ = (tr R − 1) / 2 (stable near 0 and π),
+/// where axial(R) = Σ f0 × f1 and tr R = Σ f0 · f1 (no matrix needed).
+TurnAngle frame_turn(const Vec3& t0, const Vec3& b0, const Vec3& t1, const Vec3& b1) {
   const Vec3 c0 = t0.cross(b0), c1 = t1.cross(b1);
-  const Eigen::Matrix3d R = t1 * t0.transpose() + b1 * b0.transpose() + c1 * c0.transpose();
-  const Vec3 axial(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1));
-  return std::atan2(0.5 * axial.norm(), 0.5 * (R.trace() - 1.0));
+  const Vec3 axial = t0.cross(t1) + b0.cross(b1) + c0.cross(c1);
+  const double trace = t0.dot(t1) + b0.dot(b1) + c0.dot(c1);
+  return {0.5 * axial.norm(), 0.5 * (trace - 1.0)};
 }
 
 /// Cross-sections with rotation-minimising frames for any radius law (RadiusFn(s) returns
@@ -85,7 +114,7 @@ std::vector<SweepSection> sections(const Centerline& c, const RadiusFn& radius_a
   if (c.empty()) throw std::invalid_argument(std::string(who) + ": empty centerline");
   if (!(opt.chord_tolerance > 0.0) || !std::isfinite(opt.chord_tolerance))
     throw std::invalid_argument(std::string(who) + ": chord_tolerance must be positive and finite");
-  const double tol_axial = (1.0 - kCircumferentialShare) * opt.chord_tolerance;
+  const double tol_axial = kAxialShare * opt.chord_tolerance;
   const double u0 = c.u_min(), u1 = c.u_max();
   const double L = c.length();
   const double min_speed = kStationaryRelSpeed * std::max(L, 1e-300) / (u1 - u0);
@@ -104,34 +133,79 @@ std::vector<SweepSection> sections(const Centerline& c, const RadiusFn& radius_a
   // --- rings along the curve ---------------------------------------------------------
   std::vector<SweepSection> rings;
   rings.reserve(64);
-  auto make_ring = [&](double u, double s, const Vec3* d, const Vec3& fallback) {
+  auto make_ring = [&](double u, double s, const Sample& d, const Vec3& fallback) {
     SweepSection g;
     g.u = u;
     g.s = s;
-    g.point = d[0];
-    g.tangent = unit_tangent(d, min_speed, fallback);
+    g.point = d.d[0];
+    g.tangent = d.tangent(min_speed, fallback);
     const auto [r, rs] = radius_at(s);
     check_radius(s, r, rs);
-    g.centre = variable_radius ? Vec3(d[0] - r * rs * g.tangent) : d[0];  // eq. 7
-    g.radius = variable_radius ? r * std::sqrt(1.0 - rs * rs) : r;       // eq. 8
+    g.centre = variable_radius ? Vec3(d.d[0] - r * rs * g.tangent) : d.d[0];  // eq. 7
+    g.radius = variable_radius ? r * std::sqrt(1.0 - rs * rs) : r;           // eq. 8
     return g;
   };
 
-  Vec3 d[3];
-  c.evaluate(u0, 2, d);
+  // --- rotation-minimising frame, carried along as rings are placed (its dependency chain
+  // then overlaps the march's) ---------------------------------------------------------------
+  Vec3 b1;          // frame normal at the last ring
+  TurnAngle worst;  // largest frame rotation between neighbours (one atan2 at the end)
+  auto frame_next = [&]() {
+    const std::size_t i = rings.size() - 1;
+    SweepSection& g = rings[i];
+    if (i == 0) {
+      b1 = any_perpendicular(g.tangent);
+      g.normal = b1;
+      return;
+    }
+    const SweepSection& prev = rings[i - 1];
+    // Double reflection: reflect (b1, t) in the bisector plane of x_i → x_{i+1}, then in
+    // the plane that maps the reflected tangent onto the new one.
+    const Vec3 v1 = g.point - prev.point;
+    const double c1 = v1.squaredNorm();
+    Vec3 rL = b1, tL = prev.tangent;
+    if (c1 > 0.0) {
+      rL = b1 - (2.0 / c1) * v1.dot(b1) * v1;
+      tL = tL - (2.0 / c1) * v1.dot(tL) * v1;
+    }
+    const Vec3 v2 = g.tangent - tL;
+    const double c2 = v2.squaredNorm();
+    Vec3 bn = c2 > 0.0 ? Vec3(rL - (2.0 / c2) * v2.dot(rL) * v2) : rL;
+    bn -= bn.dot(g.tangent) * g.tangent;  // remove rounding drift
+    const double len = bn.norm();
+    bn = len > 0.0 ? Vec3(bn / len) : any_perpendicular(g.tangent);
+    const TurnAngle turn = frame_turn(prev.tangent, b1, g.tangent, bn);
+    if (turn.exceeds(worst)) worst = turn;
+    b1 = bn;
+    g.normal = b1;
+  };
+
+  Sample d;  // at the current ring
+  c.evaluate(u0, 2, d.d);
+  d.finish(min_speed);
   {
     Vec3 fb = Vec3::UnitX();
-    if (c.length() > 0.0) fb = (c.position(u1) - d[0]).normalized();
+    if (c.length() > 0.0) fb = (c.position(u1) - d.d[0]).normalized();
     if (!is_finite(fb)) fb = Vec3::UnitX();
     rings.push_back(make_ring(u0, 0.0, d, fb));
+    frame_next();
   }
   double u = u0, s = 0.0;
   std::size_t bpi = 0;  // breakpoint interval holding u
+  // The sample at x ∈ [u, u1] from the breakpoint interval evaluate() would use there (the
+  // march knows where it is: no search).
+  auto sample_ahead = [&](double x, Sample& out) {
+    std::size_t k = bpi;
+    while (k + 2 < bp.size() && x >= bp[k + 1]) ++k;
+    c.evaluate_in_interval(k, x, 2, out.d);
+    out.finish(min_speed);
+  };
+  Sample dm, de;  // at the middle and the end of a step
   while (u < u1) {
     while (bpi + 2 < bp.size() && u >= bp[bpi + 1]) ++bpi;
     const double span_w = bp[bpi + 1] - bp[bpi];
-    const double speed0 = std::max(d[1].norm(), min_speed);
-    const double k0 = curvature_of(d, min_speed);
+    const double speed0 = std::max(d.speed, min_speed);
+    const double k0 = d.kappa;
     const double r0 = rings.back().radius;
     double ds = axial_step(k0, r0, tol_axial);
     if (variable_radius) {
@@ -143,63 +217,31 @@ std::vector<SweepSection> sections(const Centerline& c, const RadiusFn& radius_a
       if (rpp > 0.0) ds = std::min(ds, std::sqrt(8.0 * tol_axial / rpp));
     }
     double du = std::max(std::min(ds / speed0, kMaxSpanFraction * span_w), kMinStepRel * (u1 - u0));
-    Vec3 dm[3], de[3];
     for (int it = 0;; ++it) {
       du = std::min(du, u1 - u);
-      c.evaluate(u + 0.5 * du, 2, dm);
-      c.evaluate(u + du, 2, de);
-      const double vmax = std::max({d[1].norm(), dm[1].norm(), de[1].norm(), min_speed});
-      const double kmax = std::max({k0, curvature_of(dm, min_speed), curvature_of(de, min_speed)});
+      sample_ahead(u + 0.5 * du, dm);
+      sample_ahead(u + du, de);
+      const double vmax = std::max({d.speed, dm.speed, de.speed, min_speed});
+      const double kmax = std::max({k0, dm.kappa, de.kappa});
       const double allowed = axial_step(kmax, r0, tol_axial) / vmax;
       if (du <= allowed * 1.0000001 || it >= kStepShrinkIterations) break;
       du = std::max(allowed, kMinStepRel * (u1 - u0));
     }
     // Simpson on |C'| (the three derivatives we have) advances s for the radius law.
     const double un = (u1 - (u + du) <= 1e-12 * (u1 - u0)) ? u1 : u + du;
-    if (un == u1 && un != u + du) c.evaluate(un, 2, de);
-    s += (un - u) / 6.0 * (d[1].norm() + 4.0 * dm[1].norm() + de[1].norm());
+    if (un == u1 && un != u + du) sample_ahead(un, de);
+    s += (un - u) / 6.0 * (d.speed + 4.0 * dm.speed + de.speed);
     if (un == u1) s = L;
     u = un;
-    d[0] = de[0];
-    d[1] = de[1];
-    d[2] = de[2];
+    d = de;
     rings.push_back(make_ring(u, std::min(s, L), d, rings.back().tangent));
+    frame_next();
     if (rings.size() > kMaxRings)
       throw std::invalid_argument(std::string(who) + ": chord tolerance " + std::to_string(opt.chord_tolerance) +
                                   " needs more than " + std::to_string(kMaxRings) + " rings");
   }
 
-  // --- rotation-minimising frame --------------------------------------------------------
-  const std::size_t nr = rings.size();
-  Vec3 b1 = any_perpendicular(rings[0].tangent);
-  rings[0].normal = b1;
-  Vec3 prev_x = rings[0].point;
-  max_turn = 0.0;
-  for (std::size_t i = 1; i < nr; ++i) {
-    SweepSection& g = rings[i];
-    {
-      // Double reflection: reflect (b1, t) in the bisector plane of x_i → x_{i+1}, then in
-      // the plane that maps the reflected tangent onto the new one.
-      const Vec3 x = g.point;
-      const Vec3 v1 = x - prev_x;
-      const double c1 = v1.squaredNorm();
-      Vec3 rL = b1, tL = rings[i - 1].tangent;
-      if (c1 > 0.0) {
-        rL = b1 - (2.0 / c1) * v1.dot(b1) * v1;
-        tL = tL - (2.0 / c1) * v1.dot(tL) * v1;
-      }
-      const Vec3 v2 = g.tangent - tL;
-      const double c2 = v2.squaredNorm();
-      Vec3 bn = c2 > 0.0 ? Vec3(rL - (2.0 / c2) * v2.dot(rL) * v2) : rL;
-      bn -= bn.dot(g.tangent) * g.tangent;  // remove rounding drift
-      const double len = bn.norm();
-      bn = len > 0.0 ? Vec3(bn / len) : any_perpendicular(g.tangent);
-      max_turn = std::max(max_turn, frame_turn(rings[i - 1].tangent, b1, g.tangent, bn));
-      b1 = bn;
-      prev_x = x;
-    }
-    g.normal = b1;
-  }
+  max_turn = worst.radians();
   return rings;
 }
 
@@ -219,51 +261,80 @@ int circumferential_resolution(double radius, double tolerance) {
 
 namespace {
 
-/// Triangle mesh of rings at the sections (n vertices each) with fan end caps.
+using Tri = std::array<std::uint32_t, 3>;
+
+/// Triangle mesh of rings at the sections (n vertices each, odd rings rotated by π/n) with
+/// fan end caps. Sizes are known up front: vertices and triangles are written in place,
+/// indices by formula.
 SweepResult mesh_sections(const std::vector<SweepSection>& rings, const SweepOptions& opt, double max_turn) {
   double rmax = 0.0;
   for (const SweepSection& g : rings) rmax = std::max(rmax, g.radius);
-  const int n = circumferential_resolution(rmax, kCircumferentialShare * opt.chord_tolerance);
+  const int n = circumferential_resolution(rmax, kRingPolygonShare * opt.chord_tolerance);
   SweepResult out;
   out.circumferential = n;
   out.rings = static_cast<int>(rings.size());
   out.max_frame_turn = max_turn;
   Mesh& m = out.mesh;
   const std::size_t nr = rings.size();
-  m.vertices.reserve(nr * n + (opt.end_caps ? 2 : 0));
-  std::vector<double> cs(n), sn(n);
-  for (int j = 0; j < n; ++j) {
-    cs[j] = std::cos(2.0 * M_PI * j / n);
-    sn[j] = std::sin(2.0 * M_PI * j / n);
-  }
-  for (const SweepSection& g : rings) {
-    const Vec3 e1 = g.radius * g.normal, e2 = g.radius * g.tangent.cross(g.normal);
-    for (int j = 0; j < n; ++j) m.vertices.emplace_back(g.centre + cs[j] * e1 + sn[j] * e2);  // eq. 9
-  }
-
-  // --- triangles: quads between rings, fans for the caps (outward, counter-clockwise) -----
-  using Tri = std::array<std::uint32_t, 3>;
-  m.triangles.reserve(2 * (nr - 1) * n + (opt.end_caps ? 2 * n : 0));
-  auto& t = m.triangles;
-  for (std::size_t i = 0; i + 1 < nr; ++i) {
-    const auto a0 = static_cast<std::uint32_t>(i * n), b0 = static_cast<std::uint32_t>((i + 1) * n);
-    for (int j = 0; j < n; ++j) {
-      const std::uint32_t j1 = static_cast<std::uint32_t>(j + 1 == n ? 0 : j + 1);
-      const std::uint32_t jj = static_cast<std::uint32_t>(j);
-      t.push_back(Tri{a0 + jj, a0 + j1, b0 + j1});
-      t.push_back(Tri{a0 + jj, b0 + j1, b0 + jj});
+  const std::size_t un = static_cast<std::size_t>(n);
+  const std::size_t ring_vertices = nr * un;
+  if (ring_vertices + 2 > std::numeric_limits<std::uint32_t>::max())
+    throw std::invalid_argument("sweep: " + std::to_string(ring_vertices) + " vertices exceed 32-bit indices");
+  // Unit circle (cos, sin) at the even rings' angles 2πj/n, then at the odd rings' 2π(j + ½)/n.
+  std::vector<Eigen::Vector2d> circle(2 * un);
+  for (std::size_t j = 0; j < un; ++j)
+    for (std::size_t odd = 0; odd < 2; ++odd) {
+      const double a = M_PI * static_cast<double>(2 * j + odd) / n;
+      circle[odd * un + j] = Eigen::Vector2d(std::cos(a), std::sin(a));
     }
+  m.vertices.resize(ring_vertices + (opt.end_caps ? 2 : 0));
+  Vec3* v = m.vertices.data();
+  for (std::size_t i = 0; i < nr; ++i) {
+    const SweepSection& g = rings[i];
+    Eigen::Matrix<double, 3, 2> E;  // radius × (normal, tangent × normal)
+    E.col(0) = g.radius * g.normal;
+    E.col(1) = g.radius * g.tangent.cross(g.normal);
+    const Vec3 o = g.centre;
+    const Eigen::Vector2d* cs = circle.data() + (i % 2) * un;
+    for (std::size_t j = 0; j < un; ++j) *v++ = o + E * cs[j];  // eq. 9
   }
   if (opt.end_caps) {
-    const auto c0 = static_cast<std::uint32_t>(nr * n), c1 = c0 + 1;
-    m.vertices.push_back(rings.front().centre);
-    m.vertices.push_back(rings.back().centre);
-    const auto last = static_cast<std::uint32_t>((nr - 1) * n);
-    for (int j = 0; j < n; ++j) {
-      const std::uint32_t j1 = static_cast<std::uint32_t>(j + 1 == n ? 0 : j + 1);
-      const std::uint32_t jj = static_cast<std::uint32_t>(j);
-      t.push_back(Tri{c0, j1, jj});
-      t.push_back(Tri{c1, last + jj, last + j1});
+    m.vertices[ring_vertices] = rings.front().centre;
+    m.vertices[ring_vertices + 1] = rings.back().centre;
+  }
+  // --- triangles: strips between rings, fans for the caps (outward, counter-clockwise) ---
+  // Between ring i and i + 1 each vertex j contributes two triangles. Ring i is rotated by
+  // (i mod 2)·π/n, so an even ring's vertex j + ½ step sits between the odd ring's j and
+  // j + 1, and vice versa. A strip is its parity's index pattern (relative to ring i's
+  // first vertex) plus i·n: built in a small buffer and appended, so the big array is
+  // written once (no zero-fill) and the offset loop vectorises.
+  static_assert(sizeof(Tri) == 3 * sizeof(std::uint32_t), "Tri is three packed indices (as Embree reads it)");
+  const auto N = static_cast<std::uint32_t>(n);
+  std::vector<Tri> pattern(4 * un);  // even strip, then odd strip
+  for (std::uint32_t j = 0; j < N; ++j) {
+    const std::uint32_t j1 = j + 1 == N ? 0 : j + 1;
+    pattern[2 * j] = Tri{j, j1, N + j};
+    pattern[2 * j + 1] = Tri{j1, N + j1, N + j};
+    pattern[2 * un + 2 * j] = Tri{j, j1, N + j1};
+    pattern[2 * un + 2 * j + 1] = Tri{j, N + j1, N + j};
+  }
+  m.triangles.reserve(2 * (nr - 1) * un + (opt.end_caps ? 2 * un : 0));
+  std::vector<Tri> strip(2 * un);
+  std::uint32_t* flat = strip.data()->data();  // flat views of the packed indices
+  const std::size_t strip_indices = 6 * un;
+  for (std::size_t i = 0; i + 1 < nr; ++i) {
+    const std::uint32_t* pat = pattern.data()->data() + (i % 2) * strip_indices;
+    const auto a = static_cast<std::uint32_t>(i * un);
+    for (std::size_t q = 0; q < strip_indices; ++q) flat[q] = pat[q] + a;
+    m.triangles.insert(m.triangles.end(), strip.begin(), strip.end());
+  }
+  if (opt.end_caps) {
+    const auto c0 = static_cast<std::uint32_t>(ring_vertices), c1 = c0 + 1;
+    const auto last = static_cast<std::uint32_t>((nr - 1) * un);
+    for (std::uint32_t j = 0; j < N; ++j) {
+      const std::uint32_t j1 = j + 1 == N ? 0 : j + 1;
+      m.triangles.push_back(Tri{c0, j1, j});
+      m.triangles.push_back(Tri{c1, last + j, last + j1});
     }
   }
   return out;

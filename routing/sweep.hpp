@@ -25,8 +25,9 @@ struct SweepResult {
 };
 
 /// One cross-section of a sweep: a circle in the plane normal to `tangent` (world
-/// coordinates, scene units). Mesh rings place vertex j at
-/// centre + radius·(cos 2πj/n · normal + sin 2πj/n · tangent × normal).
+/// coordinates, scene units). Mesh ring i places vertex j at
+/// centre + radius·(cos φ · normal + sin φ · tangent × normal), φ = 2π(j + (i mod 2)/2)/n:
+/// odd rings are rotated by half a step, so the facets are near-equilateral.
 struct SweepSection {
   double u = 0.0;       ///< curve parameter
   double s = 0.0;       ///< arc length from the start

@@ -291,9 +291,9 @@ ViewStats write_view_html(const std::filesystem::path& file, const Scene& scene,
 }
 
 ViewStats write_view_outputs(const std::filesystem::path& dir, const Scene& scene, const Harness& harness,
-                             const nlohmann::json& report) {
+                             const nlohmann::json& report, const RenderOptions& render) {
   const ViewStats st = write_view_html(dir / "view.html", scene, harness, report);
-  write_png(dir / "render.png", render_scene(scene, harness, report));
+  write_png(dir / "render.png", render_scene(scene, harness, report, render));
   return st;
 }
 

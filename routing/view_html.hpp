@@ -7,6 +7,7 @@
 #include "core/harness.hpp"
 #include "core/mesh.hpp"
 #include "core/scene.hpp"
+#include "routing/render.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -57,8 +58,9 @@ ViewStats write_view_html(const std::filesystem::path& file, const Scene& scene,
                           const nlohmann::json& report, const ViewOptions& opt = {});
 
 /// What `loom route` and `loom audit` write beside report.json: DIR/view.html and
-/// DIR/render.png (routing/render.hpp, default size). Returns the page's stats.
+/// DIR/render.png (routing/render.hpp; size, camera and progress from `render`). Returns the
+/// page's stats.
 ViewStats write_view_outputs(const std::filesystem::path& dir, const Scene& scene, const Harness& harness,
-                             const nlohmann::json& report);
+                             const nlohmann::json& report, const RenderOptions& render = {});
 
 }  // namespace loom

@@ -228,6 +228,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
   if (const toml::node* pn = doc.get("part")) {
     const toml::array* parts = pn->as_array();
     if (!parts) r.fail(pn, "part", "expected [[part]] tables");
+    ProgressCounter loaded(opt.load_parts ? opt.progress : ProgressFn(), "load", parts->size(), "files");
     int idx = 0;
     for (const toml::node& node : *parts) {
       ++idx;
@@ -310,7 +311,9 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
         if (!names.insert(p.name).second) r.fail(&node, pwhere, "duplicate part name '" + p.name + "'");
         scene.parts.push_back(std::move(p));
       }
+      loaded.add();
     }
+    loaded.finish();
   }
   // Ports and branch points must be finite (checked by the XML reader) and, if the scene has
   // parts, inside the OctoMap-addressable range; that check belongs to the voxel map.

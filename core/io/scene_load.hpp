@@ -2,6 +2,7 @@
 /// Loading a whole scene: the TOML file, every part file (meshes and CAD), the harness,
 /// and the derived settings (DESIGN §3, §7).
 
+#include "core/progress.hpp"
 #include "core/scene.hpp"
 
 #include <filesystem>
@@ -14,6 +15,8 @@ namespace loom {
 struct SceneLoadOptions {
   bool load_parts = true;    ///< false: only TOML + harness (fast, for tests of settings)
   bool use_cache = true;     ///< cache CAD tessellations keyed by file hash and deflection
+  /// Stage "load": part files ([[part]] entries) read and triangulated, from the calling thread.
+  ProgressFn progress;
 };
 
 /// What loading took and noticed.

@@ -435,6 +435,44 @@ TEST(Centerline, BasisFunctionsFormAPartitionOfUnity) {
   }
 }
 
+TEST(Centerline, EvaluationMatchesTheBasisFunctionSum) {
+  // Oracle: C⁽ᵏ⁾(u) = Σ N⁽ᵏ⁾ᵢ(u)·Pᵢ from the basis functions (Piegl & Tiller A2.3), independent
+  // of the per-span Taylor coefficients evaluate() uses (unrolled for cubics, a loop for
+  // other degrees). evaluate_in_interval() must give evaluate()'s values exactly.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> coord(-5.0, 5.0);
+  for (int degree : {1, 2, 3, 5}) {
+    const int ncp = 12;
+    std::vector<Vec3> P;
+    for (int i = 0; i < ncp; ++i) P.emplace_back(coord(rng), coord(rng), coord(rng));
+    std::vector<double> U(degree + 1, 0.0);
+    for (int i = 1; i < ncp - degree; ++i) U.push_back(i + 0.37 * (i % 3));  // non-uniform interior knots
+    U.resize(U.size() + degree + 1, U.back() + 1.0);
+    const Centerline c(degree, U, P);
+    const double scale = scale_of(P);
+    const std::vector<double>& bp = c.breakpoints();
+    std::vector<double> N(4 * (degree + 1));
+    for (std::size_t k = 0; k + 1 < bp.size(); ++k)
+      for (int q = 0; q < 7; ++q) {
+        const double u = bp[k] + (bp[k + 1] - bp[k]) * q / 7.0;  // interval k, left end included
+        Vec3 d[4], e[4];
+        c.evaluate(u, 3, d);
+        c.evaluate_in_interval(k, u, 3, e);
+        const int i0 = loom::bspline_basis(U, degree, u, 3, N.data());
+        for (int order = 0; order <= 3; ++order) {
+          Vec3 ref = Vec3::Zero();
+          for (int j = 0; j <= degree; ++j) ref += N[order * (degree + 1) + j] * P[i0 + j];
+          // Derivatives scale as scale / (knot spacing)^order; knot spacing is ~1 here.
+          EXPECT_LE((d[order] - ref).norm(), 1e-12 * scale * (1.0 + ref.norm() / scale))
+              << "degree " << degree << " order " << order << " u " << u;
+          EXPECT_EQ(d[order], e[order]) << "degree " << degree << " order " << order << " u " << u;
+        }
+      }
+    Vec3 d[3];
+    EXPECT_THROW(c.evaluate_in_interval(bp.size() - 1, bp.back(), 2, d), std::out_of_range);
+  }
+}
+
 // --- properties -----------------------------------------------------------------------
 
 RC_GTEST_PROP(CenterlineProperty, InterpolatesFiniteAndLongerThanItsPolygon, ()) {

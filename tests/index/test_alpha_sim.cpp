@@ -210,6 +210,148 @@ TEST(AlphaShape2D, MergeCollinearKeepsCorners) {
   EXPECT_DOUBLE_EQ(ring_signed_area(notch), a0);
 }
 
+namespace {
+
+double point_segment_distance(const Vec2& p, const Vec2& a, const Vec2& b) {
+  const Vec2 ab = b - a;
+  const double t = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
+  return (a + t * ab - p).norm();
+}
+
+/// Even-odd point-in-region test over all rings, or within eps of a ring (independent
+/// of the library's triangle-based region).
+bool in_rings(const Vec2& p, const std::vector<std::vector<Vec2>>& rings, double eps) {
+  bool in = false;
+  for (const auto& r : rings)
+    for (std::size_t i = 0, j = r.size() - 1; i < r.size(); j = i++) {
+      if (point_segment_distance(p, r[j], r[i]) <= eps) return true;
+      if ((r[i].y() > p.y()) != (r[j].y() > p.y()) &&
+          p.x() < (r[j].x() - r[i].x()) * (p.y() - r[i].y()) / (r[j].y() - r[i].y()) + r[i].x())
+        in = !in;
+    }
+  return in;
+}
+
+double distance_to_rings(const Vec2& p, const std::vector<std::vector<Vec2>>& rings) {
+  double d = std::numeric_limits<double>::infinity();
+  for (const auto& r : rings)
+    for (std::size_t i = 0, j = r.size() - 1; i < r.size(); j = i++) d = std::min(d, point_segment_distance(p, r[j], r[i]));
+  return d;
+}
+
+/// True if two segments properly cross or touch away from a shared endpoint.
+bool segments_touch(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
+  auto orient = [](const Vec2& p, const Vec2& q, const Vec2& r) {
+    const double o = (q - p).x() * (r - p).y() - (q - p).y() * (r - p).x();
+    return (o > 0) - (o < 0);
+  };
+  if (a == c || a == d || b == c || b == d) return false;
+  const int o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a), o4 = orient(c, d, b);
+  return o1 != o2 && o3 != o4;
+}
+
+std::vector<std::vector<Vec2>> rings_of(const std::vector<PolygonWithHoles2>& polys) {
+  std::vector<std::vector<Vec2>> rings;
+  for (const auto& p : polys) {
+    rings.push_back(p.outer);
+    for (const auto& h : p.holes) rings.push_back(h);
+  }
+  return rings;
+}
+
+}  // namespace
+
+TEST(AlphaShape2D, GrowSimplifyOnlyGrowsTheRegion) {
+  // A gear-like outer ring (notches of random depth) around a finely faceted round hole,
+  // next to a second piece: the notches and the hole's rim may go, convex corners stay.
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> depth(0.0, 1.5);
+  PolygonWithHoles2 gear;
+  const int teeth = 40;
+  for (int k = 0; k < 4 * teeth; ++k) {
+    const double a = 2 * M_PI * k / (4 * teeth);
+    const double r = (k % 4 < 2) ? 20.0 : 20.0 - depth(rng);
+    gear.outer.emplace_back(r * std::cos(a), r * std::sin(a));
+  }
+  std::vector<Vec2> hole;
+  for (int k = 0; k < 200; ++k) {
+    const double a = -2 * M_PI * k / 200;  // clockwise
+    hole.emplace_back(3.0 + 8.0 * std::cos(a), 8.0 * std::sin(a));
+  }
+  gear.holes.push_back(hole);
+  PolygonWithHoles2 square;
+  square.outer = {{21.2, -2}, {25, -2}, {25, 2}, {21.2, 2}};
+  std::vector<PolygonWithHoles2> polys = {gear, square};
+  const auto before = rings_of(polys);
+  const double max_dev = 0.5;
+  const std::size_t removed = grow_simplify(polys, max_dev);
+  const auto after = rings_of(polys);
+  EXPECT_GT(removed, 150u);
+  ASSERT_EQ(after.size(), before.size());
+  EXPECT_EQ(after[2].size(), 4u);  // the square is convex: unchanged
+  EXPECT_LT(after[1].size(), 60u);  // the hole's rim: chords of sagitta < 0.5 on r = 8
+  std::size_t total = 0;
+  for (std::size_t r = 0; r < after.size(); ++r) {
+    total += after[r].size();
+    EXPECT_GT(ring_signed_area(after[r]) * ring_signed_area(before[r]), 0.0);  // orientation kept
+    // Every vertex left is an original vertex.
+    for (const auto& v : after[r]) EXPECT_NE(std::find(before[r].begin(), before[r].end(), v), before[r].end());
+  }
+  EXPECT_EQ(total + removed, 4u * teeth + 200u + 4u);
+  // The region only grows (dense samples of the old region are in the new one), by < max_dev.
+  std::uniform_real_distribution<double> u(-26, 26);
+  for (int i = 0; i < 20000; ++i) {
+    const Vec2 p(u(rng), u(rng));
+    if (in_rings(p, before, 0.0)) {
+      ASSERT_TRUE(in_rings(p, after, 1e-9)) << p.transpose();
+    } else if (in_rings(p, after, 0.0)) {
+      ASSERT_LT(distance_to_rings(p, before), max_dev) << p.transpose();
+    }
+  }
+  for (const auto& r : before)
+    for (const auto& v : r) ASSERT_LT(distance_to_rings(v, after), max_dev);
+  // Rings stay simple and disjoint.
+  for (std::size_t r1 = 0; r1 < after.size(); ++r1)
+    for (std::size_t r2 = r1; r2 < after.size(); ++r2)
+      for (std::size_t i = 0; i < after[r1].size(); ++i)
+        for (std::size_t j = 0; j < after[r2].size(); ++j) {
+          if (r1 == r2 && i == j) continue;
+          const auto& A = after[r1];
+          const auto& B = after[r2];
+          ASSERT_FALSE(segments_touch(A[i], A[(i + 1) % A.size()], B[j], B[(j + 1) % B.size()]))
+              << r1 << ":" << i << " " << r2 << ":" << j;
+        }
+  // A convex ring cannot grow by removing vertices: unchanged.
+  std::vector<PolygonWithHoles2> disc(1);
+  for (int k = 0; k < 48; ++k) disc[0].outer.emplace_back(5 * std::cos(2 * M_PI * k / 48), 5 * std::sin(2 * M_PI * k / 48));
+  EXPECT_EQ(grow_simplify(disc, 1.0), 0u);
+}
+
+TEST(AlphaShape2D, RefineClosesANotchThatCoverWouldBridge) {
+  // A silhouette x = 0 sampled at y = 0, 4, a sample 0.064 inside it at y = 2 (the
+  // midpoint of a facet diagonal), material to the left, free space to the right. The
+  // chord through the inner sample cuts a sliver of the projection off the α-shape.
+  std::vector<Vec2> pts = grid_points(-16, -8, -4, 12, 4.0);
+  for (double y = -8; y <= 12; y += 4) pts.emplace_back(0.0, y);
+  pts.emplace_back(-0.064, 2.0);
+  pts.emplace_back(-0.064, 6.0);
+  for (double y = -8; y <= 12; y += 4) pts.emplace_back(30.0, y);  // far material on the right
+  const Vec2 sliver(-0.004, 2.47);  // inside the true projection (x ≤ 0)
+  AlphaShape2D plain(pts, 3.8, 3.8);
+  ASSERT_FALSE(plain.contains(sliver, 1e-9));
+  const double area0 = plain.area();
+  AlphaShape2D refined(pts, 3.8, 3.8);
+  EXPECT_EQ(refined.refine({{0.0, 2.0}, {0.0, 6.0}, {-2.0, 2.0}}, 1e-9), 2u);  // (-2, 2) is covered already
+  EXPECT_TRUE(refined.contains(sliver, 1e-9));
+  EXPECT_TRUE(refined.contains({0.0, 2.0}, 1e-9));
+  EXPECT_FALSE(refined.contains({1.0, 2.0}, 1e-9));  // no bridge to the far material
+  EXPECT_LT(refined.area() - area0, 1.0);
+  // cover() alone bridges the gap with a big triangle (what refine avoids).
+  AlphaShape2D covered(pts, 3.8, 3.8);
+  covered.cover({{0.0, 2.0}}, 1e-9);
+  EXPECT_GT(covered.area() - area0, 10.0);
+}
+
 // --------------------------------------------------------------- closed-form parts
 
 TEST(AlphaSim, PlateSmallHolesVanishBigHolesStay) {
@@ -455,6 +597,63 @@ TEST(AlphaSim, SimplifiedPartsPlugIntoAnObstacleIndex) {
   EXPECT_FALSE(original.inside(in_small_hole));
   EXPECT_TRUE(simplified.inside(in_small_hole));
   EXPECT_EQ(simple[1].mesh.triangle_count(), 12u);
+}
+
+TEST(AlphaSim, LongBoxIsTwelveTriangles) {
+  // A spar-web-like plate 1500 × 6 × 200 at dim_pre 8: each projection is a rectangle with
+  // thousands of boundary samples along its long sides; merged, the result is the box.
+  Part web = make_part("web", box_mesh({0, 0, 0}, {1500, 6, 200}));
+  const auto sp = simplify_part(web, options(8.0));
+  EXPECT_EQ(sp.result.status, AlphaSimStatus::Ok) << sp.result.reason;
+  EXPECT_EQ(sp.mesh.triangle_count(), 12u);
+  for (const auto& p : sp.result.projections) EXPECT_EQ(p.polygon_vertices, 4u) << p.plane;
+  EXPECT_NEAR(sp.result.volume_after, 1500.0 * 6.0 * 200.0, 1e-6 * 1500.0 * 6.0 * 200.0);
+  EXPECT_DOUBLE_EQ(sp.result.containment, 1.0);
+}
+
+TEST(AlphaSim, FacetedCylinderAcrossTheAxesIsNotEroded) {
+  // The actuator case: a cylinder along x whose side facets are split by diagonals; seen
+  // along z its silhouette has samples just inside it (diagonal midpoints) that notch the
+  // α-shape. Refinement closes the notches: no convex-hull fallback, containment 1.
+  Mesh m = cylinder_mesh(35.0, 170.0, 96);
+  m.transform(Eigen::Affine3d(Eigen::Translation3d(480, 600, 100) * Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY())));
+  Part c = make_part("body", m);
+  const auto sp = simplify_part(c, options(8.0));
+  EXPECT_EQ(sp.result.status, AlphaSimStatus::Ok) << sp.result.reason;
+  EXPECT_EQ(sp.result.fallback, AlphaSimFallback::None);
+  EXPECT_DOUBLE_EQ(sp.result.containment, 1.0);
+  EXPECT_DOUBLE_EQ(sp.result.containment_implicit, 1.0);
+  // Merging nearly collinear boundary points may shave up to the tolerance off the circle.
+  EXPECT_GE(sp.result.volume_after, sp.result.volume_before * (1 - 1e-6));
+  const auto samples = dense_surface_samples(c.mesh, 4.0, 1.0, 20000, 9);
+  EXPECT_DOUBLE_EQ(oracle_containment(sp.mesh, samples, sp.result.tolerance), 1.0);
+}
+
+TEST(AlphaSim, TranslatedCopiesAreSimplifiedOnce) {
+  auto plate = [](const Vec3& at) {
+    Mesh m = extruded_grid(12, 12, 1.0, 2.0, [](int i, int j) { return !(i == 3 && j == 3) && !(i >= 6 && i < 10 && j >= 6 && j < 10); });
+    for (auto& v : m.vertices) v += at;
+    return m;
+  };
+  std::vector<Part> parts = {make_part("a", plate({0, 0, 0})), make_part("b", plate({100.3, 7.1, -2.0})),
+                             make_part("c", plate({0, 0, 0}))};
+  parts[2].mesh.transform(Eigen::Affine3d(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ())));  // not a translation
+  std::vector<AlphaSimResult> res;
+  const auto simple = simplify_parts(parts, options(1.5), &res);
+  ASSERT_EQ(res.size(), 3u);
+  EXPECT_TRUE(res[0].copy_of.empty());
+  EXPECT_EQ(res[1].copy_of, "a");
+  EXPECT_EQ(res[1].name, "b");
+  EXPECT_TRUE(res[2].copy_of.empty());
+  ASSERT_EQ(simple[1].mesh.vertices.size(), simple[0].mesh.vertices.size());
+  EXPECT_EQ(simple[1].mesh.triangles, simple[0].mesh.triangles);
+  for (std::size_t i = 0; i < simple[0].mesh.vertices.size(); ++i)
+    ASSERT_LT((simple[1].mesh.vertices[i] - simple[0].mesh.vertices[i] - Vec3(100.3, 7.1, -2.0)).norm(), 1e-9);
+  // The copy contains its own original (independent oracle), like a direct simplification.
+  const auto samples = dense_surface_samples(parts[1].mesh, 0.75, 1.0, 20000, 5);
+  EXPECT_DOUBLE_EQ(oracle_containment(simple[1].mesh, samples, res[1].tolerance), 1.0);
+  EXPECT_EQ(res[1].triangles_after, res[0].triangles_after);
+  EXPECT_EQ(simplify_part(parts[1], options(1.5)).result.status, AlphaSimStatus::Ok);
 }
 
 // ----------------------------------------------------------------------- property

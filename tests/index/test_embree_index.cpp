@@ -240,6 +240,70 @@ TEST(EmbreeIndex, ConcurrentFirstUseOfPartScenes) {
     ASSERT_NEAR(got[i], b.closest_on_part(pts[i], static_cast<int>(i % parts.size())).distance, 1e-9) << i;
 }
 
+TEST(EmbreeIndex, BoundedClosestOnPartMatchesBruteForce) {
+  // A bounded closest_on_part searches the main BVH skipping other parts; an unbounded one
+  // uses the part's own BVH. Both against brute force, with radii just above and below
+  // the true distance, from points among all the parts.
+  const auto parts = mixed_scene(Vec3(-3, 1, 2));
+  const EmbreeIndex e(parts);
+  const BruteForceIndex b(parts);
+  std::mt19937_64 rng(31);
+  const double small = 0.02 * e.half_extent();  // below the filtered-search threshold
+  // Half the points among all parts, half within ~1.5 small radii of a vertex of the part
+  // queried (so the bounded search finds something there as often as not).
+  auto pts = random_points(rng, scene_box(parts), 5, 300);
+  std::uniform_real_distribution<double> u(-1.5 * small, 1.5 * small);
+  for (std::size_t i = pts.size(); i < 600; ++i) {
+    const Mesh& m = parts[i % parts.size()].mesh;
+    pts.push_back(m.vertices[rng() % m.vertices.size()] + Vec3(u(rng), u(rng), u(rng)));
+  }
+  int bounded_found = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const int part = static_cast<int>(i % parts.size());
+    const ClosestHit bp = b.closest_on_part(pts[i], part);
+    ASSERT_TRUE(bp.found()) << i;
+    for (double radius : {small, 0.5 * small, e.half_extent()}) {
+      const ClosestHit ep = e.closest_on_part(pts[i], part, radius);
+      ASSERT_EQ(ep.found(), bp.distance <= radius) << i << " radius " << radius;
+      if (!ep.found()) continue;
+      bounded_found += radius == small ? 1 : 0;
+      EXPECT_EQ(ep.part, part);
+      EXPECT_NEAR(ep.distance, bp.distance, 1e-12 * std::max(1.0, bp.distance)) << i;
+      EXPECT_NEAR((ep.point - pts[i]).norm(), ep.distance, 1e-12 * std::max(1.0, bp.distance)) << i;
+    }
+  }
+  EXPECT_GT(bounded_found, 50);  // the bounded path was exercised with hits, not just misses
+}
+
+TEST(EmbreeIndex, PartBoundsAreTheMeshBoxes) {
+  const auto parts = mixed_scene(Vec3(7, -2, 5));
+  const EmbreeIndex e(parts);
+  for (int i = 0; i < e.part_count(); ++i) {
+    const std::optional<AABB> box = e.part_bounds(i);
+    ASSERT_TRUE(box.has_value());
+    const AABB ref = parts[static_cast<std::size_t>(i)].mesh.bounds();
+    EXPECT_EQ(box->min, ref.min) << i;
+    EXPECT_EQ(box->max, ref.max) << i;
+  }
+  EXPECT_THROW(e.part_bounds(e.part_count()), std::out_of_range);
+  EXPECT_FALSE(BruteForceIndex(parts).part_bounds(0).has_value());  // the interface default
+}
+
+TEST(EmbreeIndex, EveryBuildQualityMatchesBruteForce) {
+  // LOW (Morton), MEDIUM and HIGH builds cull differently; the answers must not change.
+  const auto parts = mixed_scene(Vec3(0.5, 0.25, -1));
+  const BruteForceIndex b(parts);
+  std::mt19937_64 rng(57);
+  const auto pts = random_points(rng, scene_box(parts), 8, 200);
+  for (int quality : {0, 1, 2}) {
+    EmbreeOptions o;
+    o.build_quality = quality;
+    const EmbreeIndex e(parts, o);
+    SCOPED_TRACE("build quality " + std::to_string(quality));
+    expect_distances_match(e, b, pts, kEmbreeRel, 1e-3);
+  }
+}
+
 TEST(EmbreeIndex, RejectsBadMeshes) {
   Mesh bad;
   bad.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0)};

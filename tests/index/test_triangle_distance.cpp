@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 using namespace loom;
@@ -177,6 +178,45 @@ TEST(TriangleDistance, BoxDistances) {
   EXPECT_NEAR(point_box_dist2(Vec3(2, 3, 0.5), Vec3::Zero(), Vec3::Ones()), 5.0, 1e-15);
   // The lower bound never exceeds the true segment–box distance.
   EXPECT_LE(segment_box_dist2_lower(Vec3(-1, 2, 0.5), Vec3(2, 2, 0.5), Vec3::Zero(), Vec3::Ones()), 1.0);
+}
+
+TEST(TriangleDistance, SegmentBoxLowerBoundAgainstSampling) {
+  // Oracle: the minimum over dense samples of the segment of the exact point–box distance
+  // (the true segment–box distance is at most that, and at least that minus half a step).
+  std::mt19937_64 rng(17);
+  constexpr int kSamples = 2000;
+  for (int k = 0; k < 300; ++k) {
+    const Vec3 a = rnd(rng, 3), b = a + rnd(rng, 2), c0 = rnd(rng, 2), c1 = c0 + rnd(rng, 1).cwiseAbs();
+    double sampled = std::numeric_limits<double>::infinity();
+    for (int i = 0; i <= kSamples; ++i)
+      sampled = std::min(sampled, std::sqrt(point_box_dist2(a + (b - a) * (double(i) / kSamples), c0, c1)));
+    const double exact_lower = std::max(0.0, sampled - 0.5 * (b - a).norm() / kSamples);
+    EXPECT_LE(std::sqrt(segment_box_dist2_lower(a, b, c0, c1)), exact_lower + 1e-12) << k;
+  }
+}
+
+TEST(TriangleDistance, KnownDegeneracyGivesIdenticalResults) {
+  // The overloads taking triangle_is_degenerate() as known must agree bit for bit with the
+  // ones that test it, on proper, sliver, collinear and point triangles.
+  std::mt19937_64 rng(23);
+  for (int k = 0; k < 2000; ++k) {
+    Vec3 a = rnd(rng, 5), b = rnd(rng, 5), c = rnd(rng, 5);
+    switch (k % 4) {
+      case 1: c = a + 0.5 * (b - a); break;                       // collinear
+      case 2: b = c = a; break;                                  // a point
+      case 3: c = a + 0.3 * (b - a) + Vec3(1e-14, 0, 0); break;  // sliver
+      default: break;
+    }
+    const Vec3 p = rnd(rng, 8), q = rnd(rng, 8);
+    const bool deg = triangle_is_degenerate(a, b, c);
+    const TrianglePointResult r0 = closest_point_on_triangle(p, a, b, c), r1 = closest_point_on_triangle(p, a, b, c, deg);
+    EXPECT_EQ(r0.dist2, r1.dist2) << k;
+    EXPECT_EQ(r0.point, r1.point) << k;
+    const SegmentTriangleResult s0 = closest_segment_triangle(p, q, a, b, c), s1 = closest_segment_triangle(p, q, a, b, c, deg);
+    EXPECT_EQ(s0.dist2, s1.dist2) << k;
+    EXPECT_EQ(s0.s, s1.s) << k;
+    EXPECT_EQ(s0.triangle_point, s1.triangle_point) << k;
+  }
 }
 
 RC_GTEST_PROP(TriangleDistanceProps, ClosestIsNoFartherThanCornersAndTranslationInvariant, ()) {

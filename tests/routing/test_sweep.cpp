@@ -82,6 +82,14 @@ double distance_to_curve(const Centerline& c, const Dense& d, const Vec3& q) {
 
 double angle(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
 
+/// Volume per unit length of a straight stack of regular n-gons of circumradius r, each
+/// rotated by π/n against its neighbours and joined by triangles (an antiprism stack): the
+/// prismatoid formula h/6·(A + A + 4·A_mid), exact since the section area is quadratic in
+/// height; A_mid is the regular 2n-gon of circumradius r·cos(π/2n).
+double staggered_area(int n, double r) {
+  return n * r * r * std::sin(M_PI / n) * (1.0 + 2.0 * std::cos(M_PI / n)) / 3.0;
+}
+
 /// Generalised winding number of a closed triangle mesh around q (1 inside, 0 outside).
 double winding_number(const Mesh& m, const Vec3& q) {
   double w = 0.0;
@@ -134,9 +142,9 @@ TEST(Sweep, TubeIsWatertightAndOutward) {
   EXPECT_EQ(topo.misoriented_edges, 0u);
   EXPECT_EQ(topo.degenerate_triangles, 0u);
   EXPECT_EQ(loom::first_non_finite_vertex(res.mesh), -1);
-  // Volume: polygon area × length (Pappus) within the axial chord error.
+  // Volume: staggered section area × length (Pappus) within the axial chord error.
   const int n = res.circumferential;
-  const double expected = 0.5 * n * r * r * std::sin(2.0 * M_PI / n) * c.length();
+  const double expected = staggered_area(n, r) * c.length();
   EXPECT_NEAR(res.mesh.signed_volume(), expected, 2e-3 * expected);
   // Without caps it is an open tube with exactly two boundary loops.
   const loom::SweepResult open = loom::sweep_tube(c, r, {tol, false});
@@ -150,8 +158,12 @@ TEST(Sweep, RotationMinimisingFrameNeverFlipsWhereFrenetDoes) {
   const loom::SweepResult res = loom::sweep_tube(c, r, {0.01, true});
   ASSERT_EQ(sec.size(), static_cast<std::size_t>(res.rings));
   // The mesh rings are built on these frames.
-  for (std::size_t i = 0; i < sec.size(); ++i)
-    ASSERT_LE((res.mesh.vertices[i * res.circumferential] - (sec[i].centre + r * sec[i].normal)).norm(), 1e-12);
+  for (std::size_t i = 0; i < sec.size(); ++i) {
+    const double phi = (i % 2) * M_PI / res.circumferential;  // odd rings rotated by half a step
+    const Vec3 across = sec[i].tangent.cross(sec[i].normal);
+    const Vec3 first = sec[i].centre + r * (std::cos(phi) * sec[i].normal + std::sin(phi) * across);
+    ASSERT_LE((res.mesh.vertices[i * res.circumferential] - first).norm(), 1e-12);
+  }
   double max_frenet_jump = 0.0, max_turn = 0.0;
   int frenet_undefined = 0;
   for (std::size_t i = 0; i < sec.size(); ++i) {
@@ -183,7 +195,7 @@ TEST(Sweep, StraightRunHasAFrameWhereFrenetIsUndefined) {
   EXPECT_EQ(loom::first_non_finite_vertex(res.mesh), -1);
   EXPECT_NEAR(res.max_frame_turn, 0.0, 1e-12);
   const int n = res.circumferential;
-  EXPECT_NEAR(res.mesh.signed_volume(), 0.5 * n * 0.0625 * std::sin(2 * M_PI / n) * 5.0, 1e-9);
+  EXPECT_NEAR(res.mesh.signed_volume(), staggered_area(n, 0.25) * 5.0, 1e-9);
 }
 
 TEST(Sweep, ResolutionFollowsTheChordTolerance) {
@@ -192,9 +204,9 @@ TEST(Sweep, ResolutionFollowsTheChordTolerance) {
   for (double tol : {0.1, 0.05, 0.02, 0.01, 0.005}) {
     const loom::SweepResult res = loom::sweep_tube(c, 1.0, {tol, true});
     const int n = res.circumferential;
-    // Smallest n with ring sagitta ≤ tol/2.
-    EXPECT_LE(1.0 - std::cos(M_PI / n), 0.5 * tol + 1e-15);
-    EXPECT_GT(1.0 - std::cos(M_PI / (n - 1)), 0.5 * tol);
+    // Smallest n with ring sagitta ≤ ¾·tol (staggered rings, see sweep.cpp).
+    EXPECT_LE(1.0 - std::cos(M_PI / n), 0.75 * tol + 1e-15);
+    EXPECT_GT(1.0 - std::cos(M_PI / (n - 1)), 0.75 * tol);
     EXPECT_GT(res.mesh.triangle_count(), prev);
     prev = res.mesh.triangle_count();
   }
