@@ -12,6 +12,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <map>
 #include <mutex>
 #include <numeric>
@@ -1029,7 +1030,9 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
   ClashResult res;
   ctx.info.resize(parts.size());
   for (std::size_t q = 0; q < parts.size(); ++q) {
-    ctx.info[q].box = parts[q].mesh.bounds();
+    // The index keeps each part's box: no pass over every triangle per audit.
+    const std::optional<AABB> kept = index ? index->part_bounds(static_cast<int>(q)) : std::nullopt;
+    ctx.info[q].box = kept ? *kept : parts[q].mesh.bounds();
     ctx.info[q].required = std::max(0.0, request.routing_clearance + parts[q].clearance);
     ctx.info[q].keep_out = parts[q].role == PartRole::KeepOut;
     ctx.info[q].closed = parts[q].closed;
