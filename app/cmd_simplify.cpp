@@ -103,6 +103,7 @@ int run_simplify(const SimplifyCommandOptions& o) {
                      {"fallback", alpha_sim_fallback_name(r.fallback)},
                      {"status", alpha_sim_status_name(r.status)},
                      {"reason", r.reason},
+                     {"copy_of", r.copy_of},
                      {"projections", projections}});
     if (!o.quiet)
       std::fprintf(stderr, "  %-24s %8zu -> %6zu triangles  hausdorff %-10.4g %-13s %s\n", r.name.c_str(),
