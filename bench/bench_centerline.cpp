@@ -7,6 +7,8 @@
 // Writes bench/results/centerline*.csv and .png (gnuplot). Fixed seeds. Scene units: mm.
 // `bench_centerline --quick`: only the per-cable and 1-thread batch figures, printed with a
 // fingerprint of one cable's results (no baseline, no files) — for profiling changes.
+// Each thread sweeps its cables into one SweepResult whose storage it reuses (as a batch
+// writer would); the single-cable figures are also given with a new mesh per cable.
 #include "core/centerline.hpp"
 #include "routing/fairing.hpp"
 #include "routing/sweep.hpp"
@@ -27,6 +29,7 @@
 #include <TopoDS_Face.hxx>
 #include <TopoDS_Wire.hxx>
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
@@ -105,8 +108,9 @@ struct Pipeline {
   int rings = 0;
 };
 
-/// One cable: interpolate (exit tangents), fair (energy), sweep (tube).
-Pipeline run_cable(const std::vector<Vec3>& p, bool timed) {
+/// One cable: interpolate (exit tangents), fair (energy), sweep (tube) into `sw` (its
+/// storage reused when the caller keeps it across cables).
+Pipeline run_cable(const std::vector<Vec3>& p, bool timed, SweepResult& sw) {
   Pipeline r;
   InterpolationOptions io;
   io.start_tangent = Vec3::UnitX();
@@ -120,7 +124,7 @@ Pipeline run_cable(const std::vector<Vec3>& p, bool timed) {
   const FairingResult fr = fair_energy(c, f);
   if (timed) r.fair_us = us_since(t0);
   t0 = Clock::now();
-  const SweepResult sw = sweep_tube(fr.curve, kRadius, {kChordTolerance, true});
+  sweep_tube(fr.curve, kRadius, {kChordTolerance, true}, sw);
   if (timed) r.sweep_us = us_since(t0);
   r.triangles = sw.mesh.triangle_count();
   r.rings = sw.rings;
@@ -206,16 +210,19 @@ double process_cpu_ms() {
 }
 
 /// One cable on one core (600 runs over 200 cables), then 1000 cables on 1 and (unless
-/// quick) 2 threads, three runs each (medians).
-Measures measure(const std::vector<std::vector<Vec3>>& cables, bool quick) {
+/// quick) 2 threads, three runs each (medians). With `reuse`, each thread sweeps into one
+/// SweepResult kept across its cables; without, every cable gets a new one.
+Measures measure(const std::vector<std::vector<Vec3>>& cables, bool quick, bool reuse) {
   Measures m;
+  SweepResult kept_result;
   std::vector<double> ti, tf, ts, tt;
   std::size_t tris = 0;
   int rings = 0;
   for (int rep = 0; rep < 3; ++rep)
     for (int i = 0; i < 200; ++i) {
       const auto t0 = Clock::now();
-      const Pipeline p = run_cable(cables[i], true);
+      SweepResult fresh_result;
+      const Pipeline p = run_cable(cables[i], true, reuse ? kept_result : fresh_result);
       tt.push_back(us_since(t0));
       ti.push_back(p.interp_us);
       tf.push_back(p.fair_us);
@@ -232,10 +239,14 @@ Measures measure(const std::vector<std::vector<Vec3>>& cables, bool quick) {
   auto batch = [&](int threads, double* cpu_ms) {
     tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
     std::vector<double> runs, cpu;
+    tbb::enumerable_thread_specific<SweepResult> per_thread;
     for (int rep = 0; rep < 3; ++rep) {
       const auto t0 = Wall::now();
       const double c0 = process_cpu_ms();
-      tbb::parallel_for(0, kCables, [&](int i) { run_cable(cables[i], false); });
+      tbb::parallel_for(0, kCables, [&](int i) {
+        SweepResult fresh_result;
+        run_cable(cables[i], false, reuse ? per_thread.local() : fresh_result);
+      });
       cpu.push_back(process_cpu_ms() - c0);
       runs.push_back(wall_us_since(t0) / 1000.0);
     }
@@ -271,13 +282,19 @@ int main(int argc, char** argv) {
   const auto [occt_us, occt_tris] = quick ? std::pair<double, double>(-1, 0) : occt_baseline(sample);
 
   // --- one cable on one core; 1000 cables on 1 and 2 threads -----------------------------
-  // Measured twice: with glibc's default heap policy (every discarded ~0.5 MB mesh goes back
-  // to the kernel, the next cable page-faults it in again: what a program that keeps its
-  // meshes pays too, once per mesh), then with the freed heap kept (the algorithm alone).
-  const Measures fresh = measure(cables, quick);
+  // Measured with glibc's default heap policy, each thread reusing one SweepResult (the
+  // headline figures); with a new mesh per cable (every discarded ~0.5 MB mesh goes back to
+  // the kernel and the next cable page-faults it in again: what a program that keeps all
+  // its meshes pays too, once per mesh); then with the freed heap kept by the process.
+  const Measures fresh = measure(cables, quick, true);
+  const Measures unreused = measure(cables, quick, false);
   mallopt(M_MMAP_THRESHOLD, kRetainedHeapBytes);
   mallopt(M_TRIM_THRESHOLD, kRetainedHeapBytes);
-  const Measures kept = measure(cables, quick);
+  const Measures kept = measure(cables, quick, true);
+  auto heap_name = [&](const Measures* m) {
+    return m == &fresh ? "default heap, mesh reused"
+                       : m == &unreused ? "default heap, new mesh per cable" : "heap kept, mesh reused";
+  };
   if (quick) {
     {  // fingerprint of one cable's pipeline output (to check that speed-ups change no result)
       InterpolationOptions io;
@@ -290,13 +307,12 @@ int main(int argc, char** argv) {
       double sum = 0.0;
       for (const Vec3& v : sw.mesh.vertices) sum += v.x() + 2.0 * v.y() + 3.0 * v.z();
       std::printf("fingerprint: length %.17g alpha %.17g energy %.17g vertices %zu sum %.17g turn %.17g\n",
-                  fr.curve.length(), fr.alpha, fr.energy_after, sw.mesh.vertices.size(), sum, sw.max_frame_turn);
+                  fr.curve.length(), fr.alpha, bending_energy(fr.curve), sw.mesh.vertices.size(), sum, sw.max_frame_turn);
     }
-    for (const Measures* m : {&fresh, &kept})
+    for (const Measures* m : {&fresh, &unreused, &kept})
       std::printf("%s: one cable %.1f us CPU (interp %.1f, fair %.1f, sweep %.1f), %.0f triangles, %.0f rings; "
                   "1000 cables on 1 thread %.1f ms CPU\n",
-                  m == &fresh ? "default heap" : "heap kept", m->single, m->interp, m->fair, m->sweep, m->triangles,
-                  m->rings, m->batch1_cpu);
+                  heap_name(m), m->single, m->interp, m->fair, m->sweep, m->triangles, m->rings, m->batch1_cpu);
     return 0;
   }
   const double single = fresh.single, batch1 = fresh.batch1, batch2 = fresh.batch2;
@@ -314,6 +330,11 @@ int main(int argc, char** argv) {
     o << "batch_1000_cables_2_threads," << batch2 << ",ms,50\n";
     o << "speedup_2_threads," << batch1 / batch2 << ",ratio,\n";
     o << "batch_1000_cables_1_thread_cpu," << fresh.batch1_cpu << ",ms_cpu,\n";
+    // The same with a new SweepResult per cable (its mesh memory page-faulted in each time).
+    o << "new_mesh_single_cable_total," << unreused.single << ",us_cpu,90\n";
+    o << "new_mesh_single_cable_sweep," << unreused.sweep << ",us_cpu,\n";
+    o << "new_mesh_batch_1000_cables_1_thread_cpu," << unreused.batch1_cpu << ",ms_cpu,\n";
+    o << "new_mesh_batch_1000_cables_2_threads," << unreused.batch2 << ",ms,50\n";
     // The same with the freed heap kept by the process (no page faults for discarded meshes).
     o << "heap_kept_single_cable_total," << kept.single << ",us_cpu,90\n";
     o << "heap_kept_single_cable_interpolate," << kept.interp << ",us_cpu,\n";
@@ -330,10 +351,10 @@ int main(int argc, char** argv) {
     getloadavg(load, 3);
     o << "machine_load_average_1min," << load[0] << ",processes,\n";
   }
-  for (const Measures* m : {&fresh, &kept}) {
+  for (const Measures* m : {&fresh, &unreused, &kept}) {
     std::printf("%s: one cable (1 m, r 2 mm, tol 0.01 mm): %.1f us total (interp %.1f, fair %.1f, sweep %.1f), "
                 "%.0f triangles, %.0f rings\n",
-                m == &fresh ? "default heap" : "heap kept", m->single, m->interp, m->fair, m->sweep, m->triangles,
+                heap_name(m), m->single, m->interp, m->fair, m->sweep, m->triangles,
                 m->rings);
     std::printf("  1000 cables: %.1f ms on 1 thread (%.1f ms CPU), %.1f ms on 2 threads (x%.2f)\n", m->batch1,
                 m->batch1_cpu, m->batch2, m->batch1 / m->batch2);
@@ -347,6 +368,7 @@ int main(int argc, char** argv) {
     InterpolationOptions io;
     io.start_tangent = Vec3::UnitX();
     const Centerline c = Centerline::interpolate(p, io);
+    const double energy_interpolant = bending_energy(c);
     std::ofstream o(kResults + "centerline_fairing.csv");
     o << "mode,epsilon_mm,alpha_mm3,max_deviation_mm,energy_per_mm,energy_interpolant_per_mm,time_us_cpu\n";
     for (double e = 0.001; e <= 20.0; e *= 1.5) {
@@ -355,8 +377,8 @@ int main(int argc, char** argv) {
       const auto t0 = Clock::now();
       const FairingResult r = fair_energy(c, f);
       const double t = us_since(t0);
-      o << "epsilon," << e << "," << r.alpha << "," << r.max_deviation << "," << r.energy_after << ","
-        << r.energy_before << "," << t << "\n";
+      o << "epsilon," << e << "," << r.alpha << "," << r.max_deviation << "," << bending_energy(r.curve) << ","
+        << energy_interpolant << "," << t << "\n";
     }
     for (double a = 1e-2; a <= 1e7; a *= 2.0) {
       FairingOptions f;
@@ -366,8 +388,8 @@ int main(int argc, char** argv) {
       const auto t0 = Clock::now();
       const FairingResult r = fair_energy(c, f);
       const double t = us_since(t0);
-      o << "alpha,," << r.alpha << "," << r.max_deviation << "," << r.energy_after << "," << r.energy_before << ","
-        << t << "\n";
+      o << "alpha,," << r.alpha << "," << r.max_deviation << "," << bending_energy(r.curve) << ","
+        << energy_interpolant << "," << t << "\n";
     }
   }
   gnuplot("centerline_fairing",
@@ -393,7 +415,7 @@ int main(int argc, char** argv) {
       SweepResult sw;
       for (int rep = 0; rep < 30; ++rep) {
         const auto t0 = Clock::now();
-        sw = sweep_tube(c, kRadius, {tol, true});
+        sweep_tube(c, kRadius, {tol, true}, sw);  // storage reused across repetitions
         t.push_back(us_since(t0));
       }
       o << tol << "," << sw.mesh.triangle_count() << "," << sw.rings << "," << sw.circumferential << "," << median(t)

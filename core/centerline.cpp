@@ -517,7 +517,7 @@ double Centerline::span_length(int piece, double a, double b) const {
 
 void Centerline::build_length_table() {
   span_u_.clear();
-  span_len_.clear();
+  span_len_.reset();
   span_index_.clear();
   const int n = static_cast<int>(cps_.size()) - 1;
   // Typical speed: control-polygon length over the parameter range.
@@ -527,7 +527,6 @@ void Centerline::build_length_table() {
   scale_length_ = poly;
   if (!(typical_speed_ > 0.0)) typical_speed_ = 1.0;
   span_u_.push_back(u_min());
-  span_len_.push_back(0.0);
   poly_.clear();
   for (int i = degree_; i <= n; ++i) {
     if (!(knots_[i] < knots_[i + 1])) continue;
@@ -549,18 +548,29 @@ void Centerline::build_length_table() {
       poly_[k * (p + 1) + j] = v / fact;
     }
   }
-  for (std::size_t k = 0; k < span_index_.size(); ++k)
-    span_len_.push_back(span_len_.back() + span_length(static_cast<int>(k), span_u_[k], span_u_[k + 1]));
 }
 
-double Centerline::length() const { return span_len_.empty() ? 0.0 : span_len_.back(); }
+std::vector<double> Centerline::build_lengths() const {
+  std::vector<double> len;
+  len.reserve(span_index_.size() + 1);
+  len.push_back(0.0);
+  for (std::size_t k = 0; k < span_index_.size(); ++k)
+    len.push_back(len.back() + span_length(static_cast<int>(k), span_u_[k], span_u_[k + 1]));
+  return len;
+}
+
+const std::vector<double>& Centerline::lengths() const {
+  return span_len_.get([this] { return build_lengths(); });
+}
+
+double Centerline::length() const { return cps_.empty() ? 0.0 : lengths().back(); }
 
 double Centerline::arc_length_at(double u) const {
   if (cps_.empty()) return 0.0;
   if (u <= u_min()) return 0.0;
   if (u >= u_max()) return length();
   const std::size_t k = std::upper_bound(span_u_.begin(), span_u_.end(), u) - span_u_.begin() - 1;
-  return span_len_[k] + span_length(static_cast<int>(k), span_u_[k], u);
+  return lengths()[k] + span_length(static_cast<int>(k), span_u_[k], u);
 }
 
 double Centerline::solve_length_in_span(std::size_t k, double u0, double s0, double target) const {
@@ -568,7 +578,8 @@ double Centerline::solve_length_in_span(std::size_t k, double u0, double s0, dou
   // (u0, s0) in that span: safeguarded Newton on s(u) − target with bisection bracketing.
   const int span = static_cast<int>(k);
   double lo = span_u_[k], hi = span_u_[k + 1];
-  double s_lo = span_len_[k], s_hi = span_len_[k + 1];
+  const std::vector<double>& span_len = lengths();
+  double s_lo = span_len[k], s_hi = span_len[k + 1];
   if (target <= s_lo) return lo;
   if (target >= s_hi) return hi;
   // Start from linear interpolation if the anchor is not informative.
@@ -603,9 +614,10 @@ double Centerline::parameter_at_length(double s) const {
   if (cps_.empty()) return 0.0;
   if (!(s > 0.0)) return u_min();  // also maps NaN to the start
   if (s >= length()) return u_max();
-  const std::size_t k = std::upper_bound(span_len_.begin(), span_len_.end(), s) - span_len_.begin() - 1;
+  const std::vector<double>& span_len = lengths();
+  const std::size_t k = std::upper_bound(span_len.begin(), span_len.end(), s) - span_len.begin() - 1;
   const std::size_t kk = std::min(k, span_index_.size() - 1);
-  return solve_length_in_span(kk, span_u_[kk], span_len_[kk], s);
+  return solve_length_in_span(kk, span_u_[kk], span_len[kk], s);
 }
 
 std::vector<std::pair<double, Vec3>> Centerline::sample_by_arc_length(double spacing) const {
@@ -622,14 +634,15 @@ std::vector<std::pair<double, Vec3>> Centerline::sample_by_arc_length(double spa
   const double step = L / static_cast<double>(n);
   out.reserve(n + 1);
   out.emplace_back(0.0, position(u_min()));
+  const std::vector<double>& span_len = lengths();
   std::size_t k = 0;
   double u = u_min(), s_at_u = 0.0;
   for (std::size_t i = 1; i < n; ++i) {
     const double target = step * static_cast<double>(i);
-    while (k + 1 < span_index_.size() && target >= span_len_[k + 1]) {
+    while (k + 1 < span_index_.size() && target >= span_len[k + 1]) {
       ++k;
       u = span_u_[k];
-      s_at_u = span_len_[k];
+      s_at_u = span_len[k];
     }
     u = solve_length_in_span(k, u, s_at_u, target);
     s_at_u = target;

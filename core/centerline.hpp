@@ -5,7 +5,9 @@
 
 #include "core/geometry.hpp"
 
+#include <atomic>
 #include <cstddef>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -35,6 +37,58 @@ struct BendExtremum {
   double u = 0.0;       ///< curve parameter where it occurs
   double s = 0.0;       ///< arc length from the start where it occurs
 };
+
+namespace detail {
+/// A table built on first use, once, also when several threads ask at the same time (a
+/// copy takes the table if it is built, else builds its own when asked).
+class LazyTable {
+ public:
+  LazyTable() = default;
+  LazyTable(const LazyTable& o) { copy_from(o); }
+  LazyTable& operator=(const LazyTable& o) {
+    if (this != &o) copy_from(o);
+    return *this;
+  }
+  LazyTable(LazyTable&& o) noexcept { move_from(o); }
+  LazyTable& operator=(LazyTable&& o) noexcept {
+    if (this != &o) move_from(o);
+    return *this;
+  }
+  /// The table, from build() (returning std::vector<double>) the first time.
+  template <class Build>
+  const std::vector<double>& get(const Build& build) const {
+    if (!ready_.load(std::memory_order_acquire)) {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      if (!ready_.load(std::memory_order_relaxed)) {
+        values_ = build();
+        ready_.store(true, std::memory_order_release);
+      }
+    }
+    return values_;
+  }
+  /// Forgets the table (the next get() builds it again).
+  void reset() {
+    values_.clear();
+    ready_.store(false, std::memory_order_release);
+  }
+
+ private:
+  void copy_from(const LazyTable& o) {
+    const bool ready = o.ready_.load(std::memory_order_acquire);
+    values_ = ready ? o.values_ : std::vector<double>{};
+    ready_.store(ready, std::memory_order_release);
+  }
+  void move_from(LazyTable& o) noexcept {
+    const bool ready = o.ready_.load(std::memory_order_acquire);
+    values_ = ready ? std::move(o.values_) : std::vector<double>{};
+    ready_.store(ready, std::memory_order_release);
+    o.reset();
+  }
+  mutable std::vector<double> values_;
+  mutable std::atomic<bool> ready_{false};
+  mutable std::mutex mutex_;
+};
+}  // namespace detail
 
 /// A B-spline curve of degree p with a clamped knot vector.
 class Centerline {
@@ -77,7 +131,9 @@ class Centerline {
   /// Curvature κ(u) = |C'×C''|/|C'|³ (0 where C' = 0 or on straight runs).
   double curvature(double u) const;
 
-  /// Total arc length (Gauss–Legendre per knot span, accurate to ~1e-12 relative).
+  /// Total arc length (Gauss–Legendre per knot span, accurate to ~1e-12 relative). The
+  /// per-span lengths behind this and the arc-length functions below are computed on the
+  /// first call to any of them (thread-safe), not by the constructor.
   double length() const;
   /// Arc length from u_min() to u.
   double arc_length_at(double u) const;
@@ -112,7 +168,10 @@ class Centerline {
   std::vector<double> knots_;
   std::vector<Vec3> cps_;
   std::vector<double> key_params_;
-  std::vector<double> span_len_;  ///< cumulative arc length at each distinct knot
+  detail::LazyTable span_len_;    ///< cumulative arc length at each distinct knot (built on first use)
+  /// The cumulative arc lengths, built on first use.
+  const std::vector<double>& lengths() const;
+  std::vector<double> build_lengths() const;
   std::vector<double> span_u_;    ///< the distinct knot values (span boundaries)
   std::vector<int> span_index_;   ///< knot-span index of each non-empty span
   double typical_speed_ = 1.0;    ///< control-polygon length / parameter range

@@ -174,7 +174,6 @@ FairingResult fair_energy(const Centerline& interpolant, const FairingOptions& o
   const std::vector<Vec3>& P0 = interpolant.control_points();
 
   FairingResult res;
-  res.energy_before = bending_energy(interpolant);
   auto deviation_of = [&](const std::vector<Vec3>& D) {
     double dev = 0.0;
     for (int i = 0; i < nk; ++i) {
@@ -251,8 +250,12 @@ FairingResult fair_energy(const Centerline& interpolant, const FairingOptions& o
       interpolant.evaluate(kd.u[i], 3, rr, false);
       jump = std::max(jump, (rr[3] - l[3]).norm() / beta[i]);
     }
-    const double L = interpolant.length();
-    alpha = jump > 0.0 ? 2.0 * opt.tolerance / jump : L * L * L;
+    if (jump > 0.0) {
+      alpha = 2.0 * opt.tolerance / jump;
+    } else {  // no jump (a single cubic piece): the length cubed (its table is built only here)
+      const double L = interpolant.length();
+      alpha = L * L * L;
+    }
   }
 
   std::vector<Vec3> D, best;
@@ -300,7 +303,6 @@ FairingResult fair_energy(const Centerline& interpolant, const FairingOptions& o
     res.max_deviation = 0.0;
   }
   res.curve.set_key_parameters(interpolant.key_parameters());
-  res.energy_after = found ? bending_energy(res.curve) : res.energy_before;
   res.points.reserve(interpolant.key_parameters().size());
   for (double u : interpolant.key_parameters()) res.points.push_back(res.curve.position(u));
   if (found) {
@@ -371,7 +373,6 @@ FairingResult fair_selected_points(const std::vector<Vec3>& points, const Interp
   const int n = static_cast<int>(cur.size());
 
   FairingResult res;
-  res.energy_before = bending_energy(original);
   Centerline c = original;
   int revisions = 0;
   bool bad_left = false;
@@ -435,7 +436,6 @@ FairingResult fair_selected_points(const std::vector<Vec3>& points, const Interp
                : any_stuck                          ? FairingStatus::ToleranceLimit
                : revisions == 0                     ? FairingStatus::AlreadyFair
                                                     : FairingStatus::Faired;
-  res.energy_after = revisions == 0 ? res.energy_before : bending_energy(c);
   for (int i = 0; i < n; ++i) res.max_deviation = std::max(res.max_deviation, (cur[i] - orig[i]).norm());
   res.points.reserve(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) res.points.push_back(cur[kd.index_of[i]]);

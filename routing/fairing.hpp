@@ -36,14 +36,14 @@ struct FairingOptions {
   FairingEnds ends = FairingEnds::PositionAndTangent;
 };
 
-/// What a fairing produced.
+/// What a fairing produced. The bending energies ∫κ²ds before and after are not computed
+/// here (they cost about a third of a fairing and a routing pipeline does not read them):
+/// bending_energy(input curve) and bending_energy(result.curve) give them on demand.
 struct FairingResult {
   Centerline curve;              ///< the faired curve (same knots as the input for the energy method)
   FairingStatus status = FairingStatus::Faired;
   double alpha = 0.0;            ///< (energy) the α used; 0 for the interpolant / selected-point
   double max_deviation = 0.0;    ///< max ‖pᵢ − q(uᵢ)‖ over the key points, scene units
-  double energy_before = 0.0;    ///< ∫κ²ds of the input curve, 1/scene units
-  double energy_after = 0.0;     ///< ∫κ²ds of the faired curve
   int iterations = 0;            ///< α values tried / revisions made
   std::vector<Vec3> points;      ///< the faired key points qᵢ = q(uᵢ) (one per input key point)
 };

@@ -44,6 +44,12 @@ constexpr std::size_t kMaxRings = 1u << 22;
 constexpr double kMaxSpanFraction = 0.25;
 /// Attempts to shrink one step until the curvature inside it is consistent with its length.
 constexpr int kStepShrinkIterations = 4;
+/// Newton iterations of the step prediction (from above: each brings it closer to the step
+/// the extrapolated curvature allows).
+constexpr int kStepGuessNewtonIterations = 2;
+/// The predicted step is shortened by this fraction, so that the curvature's second-order
+/// change over a step (which the linear prediction leaves out) rarely makes the march retry.
+constexpr double kStepGuessMargin = 0.01;
 /// Smallest step as a fraction of the parameter range (a cusp's unbounded curvature must
 /// not stall the march; the ring limit below reports absurd tolerances instead).
 constexpr double kMinStepRel = 1e-9;
@@ -51,15 +57,18 @@ constexpr double kMinStepRel = 1e-9;
 constexpr double kStationaryRelSpeed = 1e-12;
 
 
-/// C, C', C'' at one parameter with |C'| and the curvature, each computed once.
+/// C, C', C'', C''' at one parameter with |C'| and the curvature, each computed once
+/// (C''' only where a step may start: the march leaves it unset at a step's middle).
 struct Sample {
-  Vec3 d[3];
+  Vec3 d[4];
+  Vec3 bend;           ///< C' × C'' (|bend| = κ|C'|³)
   double speed = 0.0;  ///< |C'|
   double kappa = 0.0;  ///< curvature (0 where |C'| ≤ the stationary threshold)
-  /// Fills speed and kappa from d.
+  /// Fills bend, speed and kappa from d.
   void finish(double min_speed) {
     speed = d[1].norm();
-    kappa = speed > min_speed ? d[1].cross(d[2]).norm() / (speed * speed * speed) : 0.0;
+    bend = d[1].cross(d[2]);
+    kappa = speed > min_speed ? bend.norm() / (speed * speed * speed) : 0.0;
   }
   /// Unit tangent from the first (or, at a stationary point, second) derivative.
   Vec3 tangent(double min_speed, const Vec3& fallback) const {
@@ -75,6 +84,43 @@ double axial_step(double kappa, double r, double tol) {
   const double k = kappa * (1.0 + r * kappa);
   if (!(k > 0.0)) return std::numeric_limits<double>::infinity();
   return std::sqrt(8.0 * tol / k);
+}
+
+/// Parameter step from the sample `d` (with C''') whose outer-fibre sagitta is predicted to
+/// stay within tol, at most du_max. The march accepts a step when κ(1 + rκ)·(|C'|Δu)²/8 ≤ tol
+/// with κ and |C'| the largest of their values at the step's start, middle and end; here
+/// both are extrapolated linearly from their derivatives at the start (only increases
+/// count, as in that maximum): κ' = (a·a')/(|a||C'|³) − 3κ|C'|'/|C'| with a = C'×C'',
+/// a' = C'×C''', and |C'|' = C'·C''/|C'|. F(Δu) = Δu²·v(Δu)²·k(Δu) is then a polynomial with
+/// non-negative coefficients (increasing, convex), so Newton from the constant-curvature
+/// step (too long) approaches its root F = 8·tol from above; the result is shortened by
+/// kStepGuessMargin for the second-order terms the extrapolation leaves out.
+double predicted_step(const Sample& d, double r, double tol, double du_max, double min_speed) {
+  const double v0 = d.speed;
+  if (!(v0 > min_speed)) return du_max;  // stationary point: no direction to extrapolate
+  const double dv = std::max(0.0, d.d[1].dot(d.d[2]) / v0);
+  const double v3 = v0 * v0 * v0;
+  const double bend_norm = d.kappa * v3;
+  const Vec3 bend_rate = d.d[1].cross(d.d[3]);
+  const double dk = std::max(0.0, bend_norm > 0.0 ? d.bend.dot(bend_rate) / (bend_norm * v3) - 3.0 * d.kappa * dv / v0
+                                                  : bend_rate.norm() / v3);
+  const double target = 8.0 * tol;
+  // F and dF/dΔu at du, with k(κ) = κ(1 + rκ), dk/dκ = 1 + 2rκ.
+  auto F = [&](double du, double& slope) {
+    const double v = v0 + dv * du, kap = d.kappa + dk * du;
+    const double k = kap * (1.0 + r * kap);
+    slope = 2.0 * du * v * v * k + 2.0 * du * du * v * dv * k + du * du * v * v * dk * (1.0 + 2.0 * r * kap);
+    return du * du * v * v * k;
+  };
+  double du = std::min(axial_step(d.kappa, r, tol) / v0, du_max);
+  double slope = 0.0;
+  double f = F(du, slope);
+  if (f <= target) return du;  // even the extrapolated curvature allows the longest step
+  for (int it = 0; it < kStepGuessNewtonIterations && slope > 0.0; ++it) {
+    du -= (f - target) / slope;
+    f = F(du, slope);
+  }
+  return (1.0 - kStepGuessMargin) * du;
 }
 
 /// Any unit vector perpendicular to unit t.
@@ -107,10 +153,11 @@ TurnAngle frame_turn(const Vec3& t0, const Vec3& b0, const Vec3& t1, const Vec3&
 }
 
 /// Cross-sections with rotation-minimising frames for any radius law (RadiusFn(s) returns
-/// {r, dr/ds}); `max_turn` receives the largest frame rotation between neighbours.
+/// {r, dr/ds}), written over `rings` (its storage reused); returns the largest frame
+/// rotation between neighbours (radians).
 template <class RadiusFn>
-std::vector<SweepSection> sections(const Centerline& c, const RadiusFn& radius_at, bool variable_radius,
-                                   const SweepOptions& opt, const char* who, double& max_turn) {
+double sections(const Centerline& c, const RadiusFn& radius_at, bool variable_radius, const SweepOptions& opt,
+                const char* who, std::vector<SweepSection>& rings) {
   if (c.empty()) throw std::invalid_argument(std::string(who) + ": empty centerline");
   if (!(opt.chord_tolerance > 0.0) || !std::isfinite(opt.chord_tolerance))
     throw std::invalid_argument(std::string(who) + ": chord_tolerance must be positive and finite");
@@ -131,8 +178,7 @@ std::vector<SweepSection> sections(const Centerline& c, const RadiusFn& radius_a
   };
 
   // --- rings along the curve ---------------------------------------------------------
-  std::vector<SweepSection> rings;
-  rings.reserve(64);
+  rings.clear();
   auto make_ring = [&](double u, double s, const Sample& d, const Vec3& fallback) {
     SweepSection g;
     g.u = u;
@@ -174,14 +220,24 @@ std::vector<SweepSection> sections(const Centerline& c, const RadiusFn& radius_a
     bn -= bn.dot(g.tangent) * g.tangent;  // remove rounding drift
     const double len = bn.norm();
     bn = len > 0.0 ? Vec3(bn / len) : any_perpendicular(g.tangent);
-    const TurnAngle turn = frame_turn(prev.tangent, b1, g.tangent, bn);
+    // Two reflections in planes with normals v1, v2 compose to a rotation by twice the angle
+    // α ∈ [0, π/2] between the planes: with X = |v1·v2|, Y = |v1×v2| (both scaled by
+    // |v1||v2|), sin 2α ∝ 2XY and cos 2α ∝ X² − Y². Otherwise (a reflection skipped, or the
+    // normal replaced) the frames themselves are compared.
+    TurnAngle turn;
+    if (c1 > 0.0 && c2 > 0.0 && len > 0.0) {
+      const double X = std::abs(v1.dot(v2)), Y = v1.cross(v2).norm();
+      turn = {2.0 * X * Y, X * X - Y * Y};
+    } else {
+      turn = frame_turn(prev.tangent, b1, g.tangent, bn);
+    }
     if (turn.exceeds(worst)) worst = turn;
     b1 = bn;
     g.normal = b1;
   };
 
   Sample d;  // at the current ring
-  c.evaluate(u0, 2, d.d);
+  c.evaluate(u0, 3, d.d);
   d.finish(min_speed);
   {
     Vec3 fb = Vec3::UnitX();
@@ -194,10 +250,10 @@ std::vector<SweepSection> sections(const Centerline& c, const RadiusFn& radius_a
   std::size_t bpi = 0;  // breakpoint interval holding u
   // The sample at x ∈ [u, u1] from the breakpoint interval evaluate() would use there (the
   // march knows where it is: no search).
-  auto sample_ahead = [&](double x, Sample& out) {
+  auto sample_ahead = [&](double x, Sample& out, int nder) {
     std::size_t k = bpi;
     while (k + 2 < bp.size() && x >= bp[k + 1]) ++k;
-    c.evaluate_in_interval(k, x, 2, out.d);
+    c.evaluate_in_interval(k, x, nder, out.d);
     out.finish(min_speed);
   };
   Sample dm, de;  // at the middle and the end of a step
@@ -207,20 +263,20 @@ std::vector<SweepSection> sections(const Centerline& c, const RadiusFn& radius_a
     const double speed0 = std::max(d.speed, min_speed);
     const double k0 = d.kappa;
     const double r0 = rings.back().radius;
-    double ds = axial_step(k0, r0, tol_axial);
+    double du = predicted_step(d, r0, tol_axial, kMaxSpanFraction * span_w, min_speed);
     if (variable_radius) {
       // Keep the linear interpolation of r between rings within tolerance too: |r''|Δs²/8.
-      const double h = 1e-3 * std::max(std::min(ds, L), 1e-12);
+      const double h = 1e-3 * std::max(std::min(axial_step(k0, r0, tol_axial), L), 1e-12);
       const double rpp = std::abs(radius_at(std::min(s + h, L)).first - 2.0 * radius_at(s).first +
                                   radius_at(std::max(s - h, 0.0)).first) /
                          (h * h);
-      if (rpp > 0.0) ds = std::min(ds, std::sqrt(8.0 * tol_axial / rpp));
+      if (rpp > 0.0) du = std::min(du, std::sqrt(8.0 * tol_axial / rpp) / speed0);
     }
-    double du = std::max(std::min(ds / speed0, kMaxSpanFraction * span_w), kMinStepRel * (u1 - u0));
+    du = std::max(du, kMinStepRel * (u1 - u0));
     for (int it = 0;; ++it) {
       du = std::min(du, u1 - u);
-      sample_ahead(u + 0.5 * du, dm);
-      sample_ahead(u + du, de);
+      sample_ahead(u + 0.5 * du, dm, 2);
+      sample_ahead(u + du, de, 3);
       const double vmax = std::max({d.speed, dm.speed, de.speed, min_speed});
       const double kmax = std::max({k0, dm.kappa, de.kappa});
       const double allowed = axial_step(kmax, r0, tol_axial) / vmax;
@@ -229,7 +285,7 @@ std::vector<SweepSection> sections(const Centerline& c, const RadiusFn& radius_a
     }
     // Simpson on |C'| (the three derivatives we have) advances s for the radius law.
     const double un = (u1 - (u + du) <= 1e-12 * (u1 - u0)) ? u1 : u + du;
-    if (un == u1 && un != u + du) sample_ahead(un, de);
+    if (un == u1 && un != u + du) sample_ahead(un, de, 3);
     s += (un - u) / 6.0 * (d.speed + 4.0 * dm.speed + de.speed);
     if (un == u1) s = L;
     u = un;
@@ -241,8 +297,7 @@ std::vector<SweepSection> sections(const Centerline& c, const RadiusFn& radius_a
                                   " needs more than " + std::to_string(kMaxRings) + " rings");
   }
 
-  max_turn = worst.radians();
-  return rings;
+  return worst.radians();
 }
 
 }  // namespace
@@ -263,14 +318,14 @@ namespace {
 
 using Tri = std::array<std::uint32_t, 3>;
 
-/// Triangle mesh of rings at the sections (n vertices each, odd rings rotated by π/n) with
-/// fan end caps. Sizes are known up front: vertices and triangles are written in place,
-/// indices by formula.
-SweepResult mesh_sections(const std::vector<SweepSection>& rings, const SweepOptions& opt, double max_turn) {
+/// Triangle mesh of out.sections' rings (n vertices each, odd rings rotated by π/n) with
+/// fan end caps, written over out.mesh (its storage reused). Sizes are known up front:
+/// vertices and triangles are written in place, indices by formula.
+void mesh_sections(const SweepOptions& opt, double max_turn, SweepResult& out) {
+  const std::vector<SweepSection>& rings = out.sections;
   double rmax = 0.0;
   for (const SweepSection& g : rings) rmax = std::max(rmax, g.radius);
   const int n = circumferential_resolution(rmax, kRingPolygonShare * opt.chord_tolerance);
-  SweepResult out;
   out.circumferential = n;
   out.rings = static_cast<int>(rings.size());
   out.max_frame_turn = max_turn;
@@ -287,7 +342,11 @@ SweepResult mesh_sections(const std::vector<SweepSection>& rings, const SweepOpt
       const double a = M_PI * static_cast<double>(2 * j + odd) / n;
       circle[odd * un + j] = Eigen::Vector2d(std::cos(a), std::sin(a));
     }
-  m.vertices.resize(ring_vertices + (opt.end_caps ? 2 : 0));
+  // Every element is written below: a reused array is resized in place (Vec3's default
+  // constructor writes nothing), one too small is emptied first (nothing stale is copied).
+  const std::size_t vertex_count = ring_vertices + (opt.end_caps ? 2 : 0);
+  if (m.vertices.capacity() < vertex_count) m.vertices.clear();
+  m.vertices.resize(vertex_count);
   Vec3* v = m.vertices.data();
   for (std::size_t i = 0; i < nr; ++i) {
     const SweepSection& g = rings[i];
@@ -306,8 +365,9 @@ SweepResult mesh_sections(const std::vector<SweepSection>& rings, const SweepOpt
   // Between ring i and i + 1 each vertex j contributes two triangles. Ring i is rotated by
   // (i mod 2)·π/n, so an even ring's vertex j + ½ step sits between the odd ring's j and
   // j + 1, and vice versa. A strip is its parity's index pattern (relative to ring i's
-  // first vertex) plus i·n: built in a small buffer and appended, so the big array is
-  // written once (no zero-fill) and the offset loop vectorises.
+  // first vertex) plus i·n (the offset loop vectorises). Into reused storage the strips are
+  // written in place; otherwise each is built in a small buffer and appended, so that the
+  // new array is written once (resizing would zero-fill it first).
   static_assert(sizeof(Tri) == 3 * sizeof(std::uint32_t), "Tri is three packed indices (as Embree reads it)");
   const auto N = static_cast<std::uint32_t>(n);
   std::vector<Tri> pattern(4 * un);  // even strip, then odd strip
@@ -318,39 +378,53 @@ SweepResult mesh_sections(const std::vector<SweepSection>& rings, const SweepOpt
     pattern[2 * un + 2 * j] = Tri{j, j1, N + j1};
     pattern[2 * un + 2 * j + 1] = Tri{j, N + j1, N + j};
   }
-  m.triangles.reserve(2 * (nr - 1) * un + (opt.end_caps ? 2 * un : 0));
-  std::vector<Tri> strip(2 * un);
-  std::uint32_t* flat = strip.data()->data();  // flat views of the packed indices
-  const std::size_t strip_indices = 6 * un;
-  for (std::size_t i = 0; i + 1 < nr; ++i) {
+  const std::size_t strip_triangles = 2 * un;
+  const std::size_t strips = nr - 1;
+  const std::size_t strip_total = strips * strip_triangles;
+  const std::size_t triangle_count = strip_total + (opt.end_caps ? 2 * un : 0);
+  const bool in_place = m.triangles.capacity() >= triangle_count;
+  std::vector<Tri> buffer;
+  if (in_place) {
+    m.triangles.resize(strip_total);
+  } else {
+    m.triangles.clear();
+    m.triangles.reserve(triangle_count);
+    buffer.resize(strip_triangles);
+  }
+  const std::size_t strip_indices = 3 * strip_triangles;
+  for (std::size_t i = 0; i < strips; ++i) {
     const std::uint32_t* pat = pattern.data()->data() + (i % 2) * strip_indices;
     const auto a = static_cast<std::uint32_t>(i * un);
-    for (std::size_t q = 0; q < strip_indices; ++q) flat[q] = pat[q] + a;
-    m.triangles.insert(m.triangles.end(), strip.begin(), strip.end());
+    // Flat views of the packed indices.
+    std::uint32_t* dst = in_place ? m.triangles.data()->data() + i * strip_indices : buffer.data()->data();
+    for (std::size_t q = 0; q < strip_indices; ++q) dst[q] = pat[q] + a;
+    if (!in_place) m.triangles.insert(m.triangles.end(), buffer.begin(), buffer.end());
   }
+  m.triangles.resize(triangle_count);  // the caps, written next
   if (opt.end_caps) {
     const auto c0 = static_cast<std::uint32_t>(ring_vertices), c1 = c0 + 1;
     const auto last = static_cast<std::uint32_t>((nr - 1) * un);
+    Tri* cap = m.triangles.data() + strips * strip_triangles;
     for (std::uint32_t j = 0; j < N; ++j) {
       const std::uint32_t j1 = j + 1 == N ? 0 : j + 1;
-      m.triangles.push_back(Tri{c0, j1, j});
-      m.triangles.push_back(Tri{c1, last + j, last + j1});
+      *cap++ = Tri{c0, j1, j};
+      *cap++ = Tri{c1, last + j, last + j1};
     }
   }
-  return out;
 }
 
-
-std::vector<SweepSection> tube_section_list(const Centerline& c, double radius, const SweepOptions& opt,
-                                            double& max_turn) {
+/// Tube sections of constant radius, written over `rings`; returns the largest frame turn.
+double tube_section_list(const Centerline& c, double radius, const SweepOptions& opt,
+                         std::vector<SweepSection>& rings) {
   if (!(radius > 0.0) || !std::isfinite(radius))
     throw std::invalid_argument("sweep_tube: radius must be positive and finite");
   return sections(
-      c, [radius](double) { return std::pair<double, double>(radius, 0.0); }, false, opt, "sweep_tube", max_turn);
+      c, [radius](double) { return std::pair<double, double>(radius, 0.0); }, false, opt, "sweep_tube", rings);
 }
 
-std::vector<SweepSection> canal_section_list(const Centerline& c, const std::function<double(double)>& radius_of_s,
-                                             const SweepOptions& opt, double& max_turn) {
+/// Canal sections of radius r(s), written over `rings`; returns the largest frame turn.
+double canal_section_list(const Centerline& c, const std::function<double(double)>& radius_of_s,
+                          const SweepOptions& opt, std::vector<SweepSection>& rings) {
   if (!radius_of_s) throw std::invalid_argument("sweep_canal: no radius function");
   const double L = c.empty() ? 0.0 : c.length();
   // Central difference for r'(s); one-sided at the ends.
@@ -361,33 +435,46 @@ std::vector<SweepSection> canal_section_list(const Centerline& c, const std::fun
     const double rs = b > a ? (radius_of_s(b) - radius_of_s(a)) / (b - a) : 0.0;
     return std::pair<double, double>(r, rs);
   };
-  return sections(c, law, true, opt, "sweep_canal", max_turn);
+  return sections(c, law, true, opt, "sweep_canal", rings);
 }
 
 }  // namespace
 
+void sweep_tube(const Centerline& c, double radius, const SweepOptions& opt, SweepResult& out) {
+  const double turn = tube_section_list(c, radius, opt, out.sections);
+  mesh_sections(opt, turn, out);
+}
+
+void sweep_canal(const Centerline& c, const std::function<double(double)>& radius_of_s, const SweepOptions& opt,
+                 SweepResult& out) {
+  const double turn = canal_section_list(c, radius_of_s, opt, out.sections);
+  mesh_sections(opt, turn, out);
+}
+
 SweepResult sweep_tube(const Centerline& c, double radius, const SweepOptions& opt) {
-  double turn = 0.0;
-  const auto sec = tube_section_list(c, radius, opt, turn);
-  return mesh_sections(sec, opt, turn);
+  SweepResult out;
+  sweep_tube(c, radius, opt, out);
+  return out;
 }
 
 SweepResult sweep_canal(const Centerline& c, const std::function<double(double)>& radius_of_s,
                         const SweepOptions& opt) {
-  double turn = 0.0;
-  const auto sec = canal_section_list(c, radius_of_s, opt, turn);
-  return mesh_sections(sec, opt, turn);
+  SweepResult out;
+  sweep_canal(c, radius_of_s, opt, out);
+  return out;
 }
 
 std::vector<SweepSection> tube_sections(const Centerline& c, double radius, const SweepOptions& opt) {
-  double turn = 0.0;
-  return tube_section_list(c, radius, opt, turn);
+  std::vector<SweepSection> rings;
+  tube_section_list(c, radius, opt, rings);
+  return rings;
 }
 
 std::vector<SweepSection> canal_sections(const Centerline& c, const std::function<double(double)>& radius_of_s,
                                          const SweepOptions& opt) {
-  double turn = 0.0;
-  return canal_section_list(c, radius_of_s, opt, turn);
+  std::vector<SweepSection> rings;
+  canal_section_list(c, radius_of_s, opt, rings);
+  return rings;
 }
 
 SweepResult sweep_junction(const Vec3& centre, double radius, const SweepOptions& opt) {

@@ -16,14 +16,6 @@ struct SweepOptions {
   bool end_caps = true;           ///< close both ends (watertight)
 };
 
-/// What sweeping produced and the resolution it chose.
-struct SweepResult {
-  Mesh mesh;
-  int circumferential = 0;  ///< vertices per ring
-  int rings = 0;            ///< rings along the curve
-  double max_frame_turn = 0.0;  ///< largest angle between adjacent frames (radians)
-};
-
 /// One cross-section of a sweep: a circle in the plane normal to `tangent` (world
 /// coordinates, scene units). Mesh ring i places vertex j at
 /// centre + radius·(cos φ · normal + sin φ · tangent × normal), φ = 2π(j + (i mod 2)/2)/n:
@@ -38,11 +30,30 @@ struct SweepSection {
   double radius = 0.0;  ///< circle radius R (eq. 8; = r for a tube)
 };
 
+/// What sweeping produced and the resolution it chose.
+struct SweepResult {
+  Mesh mesh;                 ///< the swept surface (world coordinates, scene units)
+  int circumferential = 0;  ///< vertices per ring
+  int rings = 0;            ///< rings along the curve
+  double max_frame_turn = 0.0;  ///< largest angle between adjacent frames (radians)
+  /// The cross-section of each ring, in order: ring i's vertices are
+  /// mesh.vertices[i·circumferential, (i + 1)·circumferential) (empty for a junction).
+  std::vector<SweepSection> sections;
+};
+
 /// Tube of constant radius r around the centerline.
 SweepResult sweep_tube(const Centerline& c, double radius, const SweepOptions& opt = {});
 /// Canal surface of radius r(s), s = arc length from the start.
 SweepResult sweep_canal(const Centerline& c, const std::function<double(double)>& radius_of_s,
                         const SweepOptions& opt = {});
+/// sweep_tube into `out`, which it overwrites (the same result as the returning form). The
+/// storage of out's vectors is reused: a caller that sweeps many cables through one
+/// SweepResult (one per thread) allocates, and page-faults, its mesh memory once, not once
+/// per cable. If it throws, out's contents are unspecified.
+void sweep_tube(const Centerline& c, double radius, const SweepOptions& opt, SweepResult& out);
+/// sweep_canal into `out`, reusing its storage as sweep_tube(c, radius, opt, out) does.
+void sweep_canal(const Centerline& c, const std::function<double(double)>& radius_of_s, const SweepOptions& opt,
+                 SweepResult& out);
 
 /// The cross-sections sweep_tube places (their spacing keeps the sagitta along the tube
 /// within half the chord tolerance), with rotation-minimising frames.

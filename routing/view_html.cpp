@@ -368,7 +368,7 @@ D.cables.forEach(function (c, i) {
   for (var k = 0; k < n; ++k) { var p = P(c.p, k); for (var a = 0; a < 3; ++a) { lo[a] = Math.min(lo[a], p[a]); hi[a] = Math.max(hi[a], p[a]); } }
   var center = n ? [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2] : null;
   var r = n ? Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) / 2 : 0;
-  addItem('cable', i, c.id + (n ? '' : ' (not routed)') + (c.color ? ' — ' + c.color : ''), center, r, palette[i]);
+  addItem('cable', i, c.id + (n ? '' : ' (not routed)') + (c.color ? ' (' + c.color + ' insulation)' : ''), center, r, palette[i]);
 });
 el('clash-count').textContent = items.clash.filter(Boolean).length;
 el('violation-count').textContent = items.violation.filter(Boolean).length;

@@ -17,6 +17,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <thread>
 
 using loom::Centerline;
 using loom::InterpolationOptions;
@@ -237,6 +238,31 @@ TEST(Centerline, ArcLengthMatchesOpenCascadeAndInverts) {
     EXPECT_EQ(c.parameter_at_length(-1.0), c.u_min());
     EXPECT_EQ(c.parameter_at_length(2.0 * c.length()), c.u_max());
   }
+}
+
+TEST(Centerline, ArcLengthTableIsBuiltOnceOnFirstUseAndTravelsWithCopies) {
+  // The arc-length table is built on first use: copies taken before and after it exists,
+  // moved-from and moved-to curves, and threads asking for it at the same time all see
+  // the same lengths as OpenCASCADE.
+  std::mt19937 rng(11);
+  const auto pts = random_walk(rng, 9, 1.0);
+  const Centerline c = Centerline::interpolate(pts);
+  GeomAdaptor_Curve ga(to_occt(c));
+  const double Locc = GCPnts_AbscissaPoint::Length(ga, c.u_min(), c.u_max(), 1e-13);
+  const Centerline before = c;  // copied while the table is not built
+  EXPECT_NEAR(c.length(), Locc, 1e-9 * Locc);
+  const Centerline after = c;  // copied with the table
+  Centerline moved_from = c;
+  const Centerline moved = std::move(moved_from);
+  for (const Centerline* k : {&before, &after, &moved}) EXPECT_EQ(k->length(), c.length());
+  const Centerline shared = Centerline::interpolate(pts);
+  std::vector<double> seen(8, 0.0);
+  std::vector<std::thread> threads;
+  for (std::size_t t = 0; t < seen.size(); ++t)
+    threads.emplace_back([&shared, &seen, t] { seen[t] = shared.arc_length_at(shared.u_max() * (t + 1) / 9.0); });
+  for (std::thread& t : threads) t.join();
+  for (std::size_t t = 0; t < seen.size(); ++t)
+    EXPECT_NEAR(seen[t], GCPnts_AbscissaPoint::Length(ga, c.u_min(), c.u_max() * (t + 1) / 9.0, 1e-13), 1e-9 * Locc);
 }
 
 TEST(Centerline, SamplesAtEqualArcSpacing) {

@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -260,6 +261,84 @@ TEST(Sweep, CanalSurfaceTouchesEveryMovingSphere) {
   EXPECT_THROW(loom::sweep_canal(c, [](double s) { return 1.0 + 2.0 * s; }, {tol, true}), std::invalid_argument);
   EXPECT_THROW(loom::sweep_canal(c, [](double) { return -1.0; }, {tol, true}), std::invalid_argument);
   EXPECT_THROW(loom::sweep_canal(c, nullptr, {tol, true}), std::invalid_argument);
+}
+
+namespace {
+/// Expects two sweep results to be the same, bit for bit.
+void expect_same_sweep(const loom::SweepResult& a, const loom::SweepResult& b) {
+  EXPECT_EQ(a.rings, b.rings);
+  EXPECT_EQ(a.circumferential, b.circumferential);
+  EXPECT_EQ(a.max_frame_turn, b.max_frame_turn);
+  EXPECT_EQ(a.mesh.vertices, b.mesh.vertices);
+  EXPECT_EQ(a.mesh.triangles, b.mesh.triangles);
+  ASSERT_EQ(a.sections.size(), b.sections.size());
+  for (std::size_t i = 0; i < a.sections.size(); ++i) {
+    EXPECT_EQ(a.sections[i].u, b.sections[i].u);
+    EXPECT_EQ(a.sections[i].normal, b.sections[i].normal);
+  }
+}
+}  // namespace
+
+TEST(Sweep, SweepIntoAReusedResultEqualsAFreshSweep) {
+  // One SweepResult swept into again and again (longer, shorter, longer cable; caps on and
+  // off; tube and canal) holds exactly what a new one would.
+  const Centerline big = s_curve();
+  const Centerline small = Centerline::interpolate({Vec3(0, 0, 0), Vec3(3, 1, 0), Vec3(6, 0, 2)});
+  auto r = [](double s) { return 0.5 + 0.1 * std::sin(s); };
+  loom::SweepResult reused;
+  for (int round = 0; round < 2; ++round)
+    for (const Centerline* c : {&big, &small, &big}) {
+      for (bool caps : {true, false}) {
+        const SweepOptions o{0.01, caps};
+        loom::sweep_tube(*c, 1.0, o, reused);
+        expect_same_sweep(reused, loom::sweep_tube(*c, 1.0, o));
+        EXPECT_EQ(loom::analyse_topology(reused.mesh).closed, caps);
+      }
+      loom::sweep_canal(*c, r, {0.02, true}, reused);
+      expect_same_sweep(reused, loom::sweep_canal(*c, r, {0.02, true}));
+    }
+  // The sections it reports are the ones tube_sections places, and ring i's vertices are
+  // at its section's radius around its centre.
+  loom::sweep_tube(big, 1.0, {0.01, true}, reused);
+  const auto sec = loom::tube_sections(big, 1.0, {0.01, true});
+  ASSERT_EQ(reused.sections.size(), sec.size());
+  for (std::size_t i = 0; i < sec.size(); ++i) {
+    EXPECT_EQ(reused.sections[i].point, sec[i].point);
+    for (int j = 0; j < reused.circumferential; ++j)
+      EXPECT_NEAR((reused.mesh.vertices[i * reused.circumferential + j] - sec[i].centre).norm(), 1.0, 1e-12);
+  }
+}
+
+TEST(Sweep, RingStepsMeetTheAxialToleranceAndUseMostOfIt) {
+  // Each step between rings keeps the outer-fibre sagitta κ(1 + rκ)(|C'|Δu)²/8 within half
+  // the chord tolerance, κ and |C'| taken as their largest at the step's start, middle and
+  // end (recomputed here from the curve) — and the step is not much shorter than that
+  // allows (the step prediction from the curvature's derivative is close, not timid).
+  const Centerline c = s_curve();
+  const double r = 1.0, tol = 0.01, tol_axial = 0.5 * tol;
+  const auto sec = loom::tube_sections(c, r, {tol, true});
+  ASSERT_GT(sec.size(), 10u);
+  std::vector<double> use;  // step / longest step allowed, curvature-limited steps only
+  for (std::size_t i = 0; i + 1 < sec.size(); ++i) {
+    const double a = sec[i].u, b = sec[i + 1].u, du = b - a;
+    double kmax = 0.0, vmax = 0.0;
+    for (double u : {a, 0.5 * (a + b), b}) {
+      const Vec3 d1 = c.derivative(u, 1), d2 = c.derivative(u, 2);
+      kmax = std::max(kmax, d1.cross(d2).norm() / std::pow(d1.norm(), 3));
+      vmax = std::max(vmax, d1.norm());
+    }
+    const double k = kmax * (1.0 + r * kmax);
+    const double sagitta = k * (vmax * du) * (vmax * du) / 8.0;
+    EXPECT_LE(sagitta, tol_axial * (1.0 + 1e-6)) << "step " << i;
+    const double allowed = std::sqrt(8.0 * tol_axial / k) / vmax;
+    // Steps are also capped at a quarter of their knot span (and the last one at the end).
+    const auto& bp = c.breakpoints();
+    const std::size_t span = std::min<std::size_t>(std::upper_bound(bp.begin(), bp.end(), a) - bp.begin(), bp.size() - 1);
+    if (i + 2 < sec.size() && allowed < 0.24 * (bp[span] - bp[span - 1])) use.push_back(du / allowed);
+  }
+  ASSERT_GT(use.size(), sec.size() / 2);
+  std::sort(use.begin(), use.end());
+  EXPECT_GT(use[use.size() / 10], 0.9);  // 90% of the steps use ≥ 90% of what is allowed
 }
 
 TEST(Sweep, DegenerateCentrelinesGiveClosedFiniteMeshes) {
