@@ -112,7 +112,7 @@ int main(int argc, char** argv) {
     double dim_pre;
   };
   std::vector<Set> sets;
-  // LOOM_BENCH_QUICK=1 skips the wing-section scene (its 14 STEP parts take minutes).
+  // LOOM_BENCH_QUICK=1 skips the wing-section scene (14 STEP parts: seconds to load and simplify).
   const bool quick = std::getenv("LOOM_BENCH_QUICK") != nullptr;
   if (!quick) try {
     const Scene wing = load_scene(fs::path(LOOM_SOURCE_DIR) / "examples" / "wing-section" / "scene.toml");

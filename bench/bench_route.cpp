@@ -159,7 +159,8 @@ int main(int argc, char** argv) {
     << "set multiplot layout 1,3 title 'Routing the wing-section harness (" << scene.harness.cables.size()
     << " cables): time budget per segment vs quality; α-SIM " << tri_before << "→" << tri_after << " triangles in "
     << static_cast<long>(simplify_ms) << " ms (seed " << kSeed << ")'\n"
-    << "set logscale x\nset xlabel 'time budget per segment (s)'\nset grid\nset key top right\n"
+    << "set logscale x\nset xrange [0.035:1.5]\nset xlabel 'time budget per segment (s)'\nset grid\n"
+    << "set key top left font ',9'\n"
     << "set ylabel 'total length / best known'\nplot ";
   for (std::size_t i = 0; i < series.size(); ++i)
     g << (i ? ", " : "") << "'" << dir << "route_" << series[i] << ".dat' using 1:2 with linespoints title '"
