@@ -40,6 +40,11 @@ struct IndexAccuracy {
   std::string description;  ///< e.g. "Embree float BVH, re-centred: ≤ 2e-5 mm"
 };
 
+/// A permutation of [0, points.size()) visiting the points along a Morton (Z-order) curve
+/// over their bounding box, so that consecutive queries touch nearby data; the identity for
+/// small batches and when all points are equal. Non-finite points come first.
+std::vector<std::size_t> coherent_order(const std::vector<Vec3>& points);
+
 /// The obstacle query interface. Every method is const and safe to call concurrently.
 class ObstacleIndex {
  public:

@@ -15,6 +15,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -79,6 +80,38 @@ TEST(EmbreeIndex, MatchesBruteForceOnRandomScene) {
       EXPECT_EQ(within[i] != 0, e.any_within(pts[i], 2.0));
     }
   }
+}
+
+TEST(EmbreeIndex, LargeBatchesInMortonOrderGiveTheSingleAnswers) {
+  const auto parts = mixed_scene(Vec3::Zero());
+  const EmbreeIndex e(parts);
+  std::mt19937_64 rng(11);
+  auto pts = random_points(rng, scene_box(parts), 10, 6000);  // above the reordering threshold
+  pts.push_back(Vec3(std::nan(""), 0, 0));                   // a non-finite point is answered too
+  const auto order = coherent_order(pts);
+  std::vector<char> seen(pts.size(), 0);
+  for (std::size_t i : order) {
+    ASSERT_LT(i, pts.size());
+    seen[i]++;
+  }
+  EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](char c) { return c == 1; })) << "not a permutation";
+  EXPECT_EQ(order.front(), pts.size() - 1) << "non-finite points come first";
+  const auto hits = e.closest_batch(pts, 5.0, 2);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const ClosestHit h = e.closest(pts[i], 5.0);
+    ASSERT_EQ(hits[i].found(), h.found()) << i;
+    if (h.found()) {
+      ASSERT_EQ(hits[i].distance, h.distance) << i;
+    }
+  }
+  // Degenerate batches: empty, and all points equal (the identity order).
+  EXPECT_TRUE(coherent_order({}).empty());
+  const std::vector<Vec3> same(5000, Vec3(1, 2, 3));
+  const auto id = coherent_order(same);
+  for (std::size_t i = 0; i < id.size(); ++i) ASSERT_EQ(id[i], i);
+  const auto same_hits = e.closest_batch(same, 50.0, 2);
+  const ClosestHit one = e.closest(Vec3(1, 2, 3), 50.0);
+  for (const auto& h : same_hits) ASSERT_EQ(h.distance, one.distance);
 }
 
 TEST(EmbreeIndex, AircraftSizedOffsetKeepsPrecision) {
