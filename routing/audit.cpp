@@ -5,12 +5,15 @@
 #include "core/harness_topology.hpp"
 #include "core/io/harness_xml.hpp"
 #include "core/io/scene_load.hpp"
+#include "index/brute_force_index.hpp"
 #include "index/embree_index.hpp"
 #include "routing/cable_geometry.hpp"
+#include "routing/path_planner.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <memory>
+#include <set>
 #include <stdexcept>
 
 namespace loom {
@@ -28,6 +31,40 @@ std::pair<std::string, std::string> use_nodes(const Harness& h, const SegmentUse
 }
 
 }  // namespace
+
+std::vector<std::string> attach_ports(const Harness& h, const std::vector<Part>& parts, double routing_clearance,
+                                      std::vector<CableInput>& inputs) {
+  std::set<std::pair<std::string, std::string>> said;
+  std::vector<std::string> notes;
+  for (CableInput& in : inputs) {
+    const int c = h.find_cable(in.id);
+    if (c < 0) continue;
+    const double len = in.curve.length();
+    // The port's straight exit (what the router gives it), at most half the cable.
+    const double exit = std::min(derived_stub_length(in.radius, in.min_bend_radius), 0.5 * len);
+    for (int end = 0; end < 2; ++end) {
+      const int p = h.find_port(h.cables[c].ports[end]);
+      if (p < 0) continue;
+      const Vec3 at = h.ports[p].position;
+      for (std::size_t q = 0; q < parts.size(); ++q) {
+        if (parts[q].role == PartRole::KeepOut) continue;  // never excused
+        const double reach = in.radius + routing_clearance + parts[q].clearance;
+        AABB box = parts[q].mesh.bounds();
+        box.min -= Vec3::Constant(reach);
+        box.max += Vec3::Constant(reach);
+        if (!box.contains(at)) continue;
+        const BruteForceIndex one({parts[q]});
+        if (!one.inside(at) && !one.closest(at, reach).found()) continue;
+        in.attachments.push_back({static_cast<int>(q), end == 0 ? 0.0 : len - exit, end == 0 ? exit : len,
+                                  h.ports[p].id});
+        if (said.insert({h.ports[p].id, parts[q].name}).second)
+          notes.push_back("port " + h.ports[p].id + " sits on part '" + parts[q].name +
+                          "': cables are not checked against it over their straight exit from the port");
+      }
+    }
+  }
+  return notes;
+}
 
 std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCable>& cables) {
   HarnessTopology topo(h);
@@ -107,6 +144,8 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
 
   ClashRequest req = opt.check;
   req.routing_clearance = scene.routing.clearance.value;
+  if (scene.has_harness)
+    for (auto& n : attach_ports(scene.harness, scene.parts, req.routing_clearance, inputs)) rep.notes.push_back(n);
   if (!req.progress) req.progress = opt.progress;
   std::unique_ptr<ObstacleIndex> owned;
   const ObstacleIndex* index = nullptr;

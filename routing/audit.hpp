@@ -68,6 +68,14 @@ std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCa
 /// Audits a loaded scene (its parts and harness). Builds the index unless the request is
 /// the brute-force baseline (use_index = false, discrete). Throws InputError for an
 /// inconsistent harness.
+/// Fills each cable's PartAttachment list: a part (not keep-out) whose surface is within the
+/// cable radius + required clearance of one of its ports, or that contains the port, is the
+/// connector or box the port sits on, and is excused over the port's straight exit
+/// (derived_stub_length: max(min bend radius, 2r), at most half the cable). Returns one note
+/// per (port, part) pair for the report.
+std::vector<std::string> attach_ports(const Harness& h, const std::vector<Part>& parts, double routing_clearance,
+                                      std::vector<CableInput>& inputs);
+
 AuditReport run_audit(const Scene& scene, const AuditOptions& opt);
 
 /// Loads the scene file (timed as timing_ms.load), applies --routes, and audits it.

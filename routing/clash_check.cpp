@@ -97,18 +97,34 @@ struct PartObservation {
   bool inside = false;
 };
 
+/// True if the cable is attached to `part` at arc length s (see PartAttachment).
+bool is_attached(const std::vector<PartAttachment>& attachments, int part, double s) {
+  return std::any_of(attachments.begin(), attachments.end(),
+                     [&](const PartAttachment& a) { return a.part == part && s >= a.s_begin && s <= a.s_end; });
+}
+
 /// Collects observations in s order. A part's band stretch (clearance < required) ends
 /// when a step no longer sees it; inside it, each contiguous contact stretch (clearance < 0)
 /// becomes one clash at its deepest point, and a band stretch without contact becomes one
 /// clearance violation at its smallest clearance.
 class StretchTracker {
  public:
-  StretchTracker(int cable, double radius, const std::vector<PartInfo>& parts)
-      : cable_(cable), radius_(radius), parts_(parts) {}
+  StretchTracker(int cable, double radius, const std::vector<PartInfo>& parts,
+                 const std::vector<PartAttachment>& attachments)
+      : cable_(cable), radius_(radius), parts_(parts), attachments_(attachments) {}
 
   /// One step along the cable (a chord, a sample or a free interval) seeing `obs` (parts
-  /// within their band), spanning arc lengths [s0, s1].
-  void step(const std::vector<PartObservation>& obs, double s0, double s1) {
+  /// within their band), spanning arc lengths [s0, s1]. Observations of a part the cable
+  /// is attached to, within the attachment's range, are not findings and are dropped.
+  void step(const std::vector<PartObservation>& all, double s0, double s1) {
+    const std::vector<PartObservation>* seen_obs = &all;
+    std::vector<PartObservation> kept;
+    if (!attachments_.empty()) {
+      for (const auto& o : all)
+        if (!is_attached(attachments_, o.part, o.s)) kept.push_back(o);
+      seen_obs = &kept;
+    }
+    const std::vector<PartObservation>& obs = *seen_obs;
     for (auto it = open_.begin(); it != open_.end();) {
       const bool seen = std::any_of(obs.begin(), obs.end(), [&](const PartObservation& o) { return o.part == it->first; });
       if (!seen) {
@@ -194,6 +210,7 @@ class StretchTracker {
   int cable_;
   double radius_;
   const std::vector<PartInfo>& parts_;
+  const std::vector<PartAttachment>& attachments_;
   std::map<int, Open> open_;
 };
 
@@ -295,7 +312,7 @@ bool excused(const CableInput& a, double s, const Vec3& p, const CableInput& b, 
 class StructureTracer {
  public:
   StructureTracer(Context& ctx, int cable)
-      : ctx_(ctx), cable_(cable), in_(ctx.cables[cable]), r_(in_.radius), tracker_(cable, r_, ctx.info) {
+      : ctx_(ctx), cable_(cable), in_(ctx.cables[cable]), r_(in_.radius), tracker_(cable, r_, ctx.info, in_.attachments) {
     L_ = in_.curve.length();
     margin_ = ctx.chord_error + ctx.abs_err;
     thr_ = r_ + ctx.band + margin_;
@@ -347,7 +364,7 @@ class StructureTracer {
     ++count_.distance_queries;
     const ClosestHit h = ctx_.index->closest(x.p, radius);
     x.d = h.found() ? std::max(0.0, h.distance - ctx_.abs_err) : std::max(0.0, radius - ctx_.abs_err);
-    if (h.found()) summary_min_ = std::min(summary_min_, h.distance - r_);
+    if (h.found() && !is_attached(in_.attachments, h.part, s)) summary_min_ = std::min(summary_min_, h.distance - r_);
     return x;
   }
 
@@ -1090,7 +1107,7 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
       sum.length = cables[c].curve.length();
       sum.min_clearance = kInf;
       if (request.check_structure && !parts.empty()) {
-        StretchTracker tr(static_cast<int>(c), cables[c].radius, ctx.info);
+        StretchTracker tr(static_cast<int>(c), cables[c].radius, ctx.info, cables[c].attachments);
         discrete_structure(ctx, static_cast<int>(c), ds[c], tr);
         per_clash[c] = std::move(tr.clashes);
         per_viol[c] = std::move(tr.violations);

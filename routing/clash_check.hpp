@@ -59,6 +59,16 @@ struct CableJunction {
   double radius = 0.0;  ///< contacts with both points within this distance of the node are excused
 };
 
+/// A part a cable end is attached to: the connector (or the box it is mounted on) that its
+/// port sits on. Contacts and clearance shortfalls with that part over the port's straight
+/// exit are the connector's own, not findings.
+struct PartAttachment {
+  int part = -1;         ///< index into the checked parts
+  double s_begin = 0.0;  ///< arc-length range of the cable over which the part is excused
+  double s_end = 0.0;
+  std::string port;      ///< the port id, for the report
+};
+
 /// One cable as the checker sees it.
 struct CableInput {
   std::string id;
@@ -71,6 +81,8 @@ struct CableInput {
   /// Empty: the whole `curve`. Where two harness segments meet at a branch point the wires
   /// splay inside the breakout, so the direction change there is not a bend of one cable.
   std::vector<std::pair<double, Centerline>> bend_pieces;
+  /// Parts its ports sit on (never keep-out parts): not checked against over the ranges given.
+  std::vector<PartAttachment> attachments;
 };
 
 /// Everything the checker needs to know. Tolerances are named, documented and derived

@@ -2,6 +2,7 @@
 // segment–segment distances), on scenes with known answers, adversarial scenes where the
 // paper's discrete method misses, and random scenes (rapidcheck).
 #include "routing/clash_check.hpp"
+#include "routing/audit.hpp"
 
 #include "core/mesh.hpp"
 #include "index/brute_force_index.hpp"
@@ -22,6 +23,7 @@
 #include <memory>
 #include <random>
 #include <sstream>
+#include <tuple>
 
 namespace loom {
 namespace {
@@ -350,6 +352,64 @@ TEST_P(ClashKnown, ClearanceAndKeepOut) {
   auto k = run({straight_cable("C", {-10, 5, 5}, {20, 5, 5}, kR)}, zone, ClashMethod::Certified, kTol, GetParam());
   ASSERT_EQ(k.clashes.size(), 1u);
   EXPECT_TRUE(k.clashes[0].keep_out);
+}
+
+TEST_P(ClashKnown, AttachedConnectorIsExcusedOverThePortExitOnly) {
+  // Port J1 sits on the +x face of a box (a connector on an avionics box); cable C leaves it
+  // along +x. A bracket 0.5 from C's surface within C's straight exit, a keep-out envelope
+  // around the port, and cable C2 passing 0.5 over the same box are all still findings.
+  const double clearance = 2.0;
+  const std::vector<Part> parts{box_part("box", {0, 0, 0}, {10, 10, 10}),
+                                box_part("bracket", {13, 6.5, 0}, {18, 9, 10}),
+                                box_part("envelope", {10, 3, 3}, {12, 7, 7}, PartRole::KeepOut)};
+  Harness h;
+  h.ports = {{"J1", Vec3(10, 5, 5), Vec3::UnitX(), 0}, {"J2", Vec3(60, 5, 5), -Vec3::UnitX(), 0},
+             {"J3", Vec3(-20, 5, 11.5), Vec3::UnitX(), 0}, {"J4", Vec3(30, 5, 11.5), -Vec3::UnitX(), 0}};
+  for (const auto& [id, a, b] : {std::tuple{"C", "J1", "J2"}, std::tuple{"C2", "J3", "J4"}}) {
+    Cable c;
+    c.id = id;
+    c.ports[0] = a;
+    c.ports[1] = b;
+    c.physical.diameter = 2 * kR;
+    c.physical.min_bend_radius = 10.0;
+    h.cables.push_back(c);
+  }
+  std::vector<CableInput> cables{straight_cable("C", {10, 5, 5}, {60, 5, 5}, kR),
+                                 straight_cable("C2", {-20, 5, 11.5}, {30, 5, 11.5}, kR)};
+  for (auto& c : cables) c.min_bend_radius = 10.0;
+  const auto notes = attach_ports(h, parts, clearance, cables);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("port J1 sits on part 'box'"), std::string::npos) << notes[0];
+  ASSERT_EQ(cables[0].attachments.size(), 1u) << "the keep-out envelope is never an attachment";
+  EXPECT_EQ(cables[0].attachments[0].part, 0);
+  EXPECT_DOUBLE_EQ(cables[0].attachments[0].s_end, 10.0);  // max(min bend radius, 2r)
+  EXPECT_TRUE(cables[1].attachments.empty());
+  for (ClashMethod m : {ClashMethod::Certified, ClashMethod::Discrete}) {
+    const auto r = run(cables, parts, m, kTol, GetParam(), clearance);
+    const std::string where = clash_method_name(m);
+    EXPECT_FALSE(has_structure_clash(r, 0, 0)) << where;
+    bool c_box = false, c_bracket = false, c2_box = false;
+    for (const auto& v : r.violations) {
+      if (v.kind != ViolationKind::Clearance) continue;
+      c_box |= v.cable == 0 && v.part == 0;
+      c_bracket |= v.cable == 0 && v.part == 1;
+      c2_box |= v.cable == 1 && v.part == 0;
+    }
+    EXPECT_FALSE(c_box) << where << ": the box C is attached to";
+    EXPECT_TRUE(c_bracket) << where << ": a bracket next to the exit is not the connector";
+    EXPECT_TRUE(c2_box) << where << ": another cable passing the box";
+    EXPECT_TRUE(has_structure_clash(r, 0, 2)) << where << ": keep-out is never excused";
+  }
+  // With the box alone, C has no finding and the box it is attached to does not set its
+  // minimum clearance (the rest of C is 50 mm of free space: clearance is that far).
+  const std::vector<Part> box_only{parts[0]};
+  const std::vector<CableInput> only_c{cables[0]};
+  for (ClashMethod m : {ClashMethod::Certified, ClashMethod::Discrete}) {
+    const auto r = run(only_c, box_only, m, kTol, GetParam(), clearance);
+    EXPECT_TRUE(r.clashes.empty()) << clash_method_name(m);
+    EXPECT_TRUE(r.violations.empty()) << clash_method_name(m);
+    EXPECT_GT(r.cables[0].min_clearance, clearance) << clash_method_name(m);
+  }
 }
 
 TEST_P(ClashKnown, TwoContactsInOneClearanceStretchAreTwoClashes) {
