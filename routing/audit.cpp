@@ -33,7 +33,7 @@ std::pair<std::string, std::string> use_nodes(const Harness& h, const SegmentUse
 }  // namespace
 
 std::vector<std::string> attach_ports(const Harness& h, const std::vector<Part>& parts, double routing_clearance,
-                                      std::vector<CableInput>& inputs) {
+                                      std::vector<CableInput>& inputs, const ObstacleIndex* index) {
   std::set<std::pair<std::string, std::string>> said;
   std::vector<std::string> notes;
   for (CableInput& in : inputs) {
@@ -53,8 +53,16 @@ std::vector<std::string> attach_ports(const Harness& h, const std::vector<Part>&
         box.min -= Vec3::Constant(reach);
         box.max += Vec3::Constant(reach);
         if (!box.contains(at)) continue;
-        const BruteForceIndex one({parts[q]});
-        if (!one.inside(at) && !one.closest(at, reach).found()) continue;
+        bool on = false;
+        if (index) {
+          int in_part = -1;
+          on = (index->inside(at, &in_part) && in_part == static_cast<int>(q)) ||
+               index->closest_on_part(at, static_cast<int>(q), reach).found();
+        } else {  // the brute-force baseline has no index: measure this one part directly
+          const BruteForceIndex one({parts[q]});
+          on = one.inside(at) || one.closest(at, reach).found();
+        }
+        if (!on) continue;
         in.attachments.push_back({static_cast<int>(q), end == 0 ? 0.0 : len - exit, end == 0 ? exit : len,
                                   h.ports[p].id});
         if (said.insert({h.ports[p].id, parts[q].name}).second)
@@ -144,8 +152,6 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
 
   ClashRequest req = opt.check;
   req.routing_clearance = scene.routing.clearance.value;
-  if (scene.has_harness)
-    for (auto& n : attach_ports(scene.harness, scene.parts, req.routing_clearance, inputs)) rep.notes.push_back(n);
   if (!req.progress) req.progress = opt.progress;
   std::unique_ptr<ObstacleIndex> owned;
   const ObstacleIndex* index = nullptr;
@@ -166,6 +172,8 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
     rep.index_name = "none";
     rep.index_accuracy = "brute force over every triangle (double precision)";
   }
+  if (scene.has_harness)
+    for (auto& n : attach_ports(scene.harness, scene.parts, req.routing_clearance, inputs, index)) rep.notes.push_back(n);
   const auto t1 = std::chrono::steady_clock::now();
   rep.result = check_clashes(inputs, scene.parts, index, req);
   rep.check_ms = ms_since(t1);

@@ -72,9 +72,10 @@ std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCa
 /// cable radius + required clearance of one of its ports, or that contains the port, is the
 /// connector or box the port sits on, and is excused over the port's straight exit
 /// (derived_stub_length: max(min bend radius, 2r), at most half the cable). Returns one note
-/// per (port, part) pair for the report.
+/// per (port, part) pair for the report. Distances through `index` (the audit's, indexing
+/// `parts`); null: measured on each candidate part directly.
 std::vector<std::string> attach_ports(const Harness& h, const std::vector<Part>& parts, double routing_clearance,
-                                      std::vector<CableInput>& inputs);
+                                      std::vector<CableInput>& inputs, const ObstacleIndex* index = nullptr);
 
 AuditReport run_audit(const Scene& scene, const AuditOptions& opt);
 

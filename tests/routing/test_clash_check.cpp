@@ -377,7 +377,12 @@ TEST_P(ClashKnown, AttachedConnectorIsExcusedOverThePortExitOnly) {
   std::vector<CableInput> cables{straight_cable("C", {10, 5, 5}, {60, 5, 5}, kR),
                                  straight_cable("C2", {-20, 5, 11.5}, {30, 5, 11.5}, kR)};
   for (auto& c : cables) c.min_bend_radius = 10.0;
+  // The same attachments through an index and measured directly on each part.
+  std::vector<CableInput> via_index = cables;
+  const EmbreeIndex idx(parts);
+  attach_ports(h, parts, clearance, via_index, &idx);
   const auto notes = attach_ports(h, parts, clearance, cables);
+  ASSERT_EQ(via_index[0].attachments.size(), cables[0].attachments.size());
   ASSERT_EQ(notes.size(), 1u);
   EXPECT_NE(notes[0].find("port J1 sits on part 'box'"), std::string::npos) << notes[0];
   ASSERT_EQ(cables[0].attachments.size(), 1u) << "the keep-out envelope is never an attachment";
