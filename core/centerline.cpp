@@ -2,6 +2,7 @@
 // fairing §II), evaluation by basis-function derivatives (Piegl & Tiller A2.3), arc length
 // by Gauss–Legendre quadrature per knot span, curvature and bend radius.
 #include "core/centerline.hpp"
+#include "core/gauss_legendre.hpp"
 
 #include "core/error.hpp"
 
@@ -48,13 +49,8 @@ constexpr double kFoldSampleAngle = 0.25 * M_PI;
 /// A tangent turn that survives bisection down to the parameter resolution is a fold.
 constexpr double kFoldAngle = 0.5 * M_PI;
 
-// 8-point Gauss–Legendre nodes and weights on [-1, 1].
-constexpr std::array<double, 8> kGLx = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290,
-                                        -0.1834346424956498, 0.1834346424956498,  0.5255324099163290,
-                                        0.7966664774136267,  0.9602898564975363};
-constexpr std::array<double, 8> kGLw = {0.1012285362903763, 0.2223810344533745, 0.3137066458778873,
-                                        0.3626837833783620, 0.3626837833783620, 0.3137066458778873,
-                                        0.2223810344533745, 0.1012285362903763};
+constexpr const auto& kGLx = gauss_legendre8::kNodes;
+constexpr const auto& kGLw = gauss_legendre8::kWeights;
 
 std::string describe(const Vec3& p) {
   std::ostringstream os;

@@ -12,7 +12,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -34,6 +36,21 @@ std::pair<std::string, std::string> use_nodes(const Harness& h, const SegmentUse
 
 std::vector<std::string> attach_ports(const Harness& h, const std::vector<Part>& parts, double routing_clearance,
                                       std::vector<CableInput>& inputs, const ObstacleIndex* index) {
+  // Part boxes once per audit (from the index when it keeps them: no pass over every
+  // triangle), and the part containing each port once per port (many cables share a port).
+  std::vector<AABB> boxes(parts.size());
+  for (std::size_t q = 0; q < parts.size(); ++q) {
+    const auto kept = index ? index->part_bounds(static_cast<int>(q)) : std::nullopt;
+    boxes[q] = kept ? *kept : parts[q].mesh.bounds();
+  }
+  std::map<int, int> containing;  // port -> part containing it (−1: none), when asked
+  auto part_containing = [&](int port) {
+    auto it = containing.find(port);
+    if (it != containing.end()) return it->second;
+    int part = -1;
+    if (!index->inside(h.ports[port].position, &part)) part = -1;  // only asked with an index
+    return containing[port] = part;
+  };
   std::set<std::pair<std::string, std::string>> said;
   std::vector<std::string> notes;
   for (CableInput& in : inputs) {
@@ -49,14 +66,13 @@ std::vector<std::string> attach_ports(const Harness& h, const std::vector<Part>&
       for (std::size_t q = 0; q < parts.size(); ++q) {
         if (parts[q].role == PartRole::KeepOut) continue;  // never excused
         const double reach = in.radius + routing_clearance + parts[q].clearance;
-        AABB box = parts[q].mesh.bounds();
+        AABB box = boxes[q];
         box.min -= Vec3::Constant(reach);
         box.max += Vec3::Constant(reach);
         if (!box.contains(at)) continue;
         bool on = false;
         if (index) {
-          int in_part = -1;
-          on = (index->inside(at, &in_part) && in_part == static_cast<int>(q)) ||
+          on = part_containing(p) == static_cast<int>(q) ||
                index->closest_on_part(at, static_cast<int>(q), reach).found();
         } else {  // the brute-force baseline has no index: measure this one part directly
           const BruteForceIndex one({parts[q]});

@@ -118,11 +118,11 @@ class StretchTracker {
   /// is attached to, within the attachment's range, are not findings and are dropped.
   void step(const std::vector<PartObservation>& all, double s0, double s1) {
     const std::vector<PartObservation>* seen_obs = &all;
-    std::vector<PartObservation> kept;
     if (!attachments_.empty()) {
+      kept_.clear();  // reused: steps are the checker's inner loop
       for (const auto& o : all)
-        if (!is_attached(attachments_, o.part, o.s)) kept.push_back(o);
-      seen_obs = &kept;
+        if (!is_attached(attachments_, o.part, o.s)) kept_.push_back(o);
+      seen_obs = &kept_;
     }
     const std::vector<PartObservation>& obs = *seen_obs;
     for (auto it = open_.begin(); it != open_.end();) {
@@ -211,6 +211,7 @@ class StretchTracker {
   double radius_;
   const std::vector<PartInfo>& parts_;
   const std::vector<PartAttachment>& attachments_;
+  std::vector<PartObservation> kept_;  ///< observations of one step minus attached parts
   std::map<int, Open> open_;
 };
 

@@ -3,6 +3,7 @@
 // of eq. 8 is ∫κ²ds, which for a parameter in chord-length units (|C'| ≈ 1) is ∫|C''|²du,
 // so the matrix here is Gᵢⱼ = ∫Nᵢ''Nⱼ''du.
 #include "routing/fairing.hpp"
+#include "core/gauss_legendre.hpp"
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -24,12 +25,8 @@ constexpr int kOrder = kDegree + 1;
 constexpr int kEnergySubdivisions = 2;
 /// Squared sine of the C'–C'' angle below which a point counts as straight (rounding).
 constexpr double kStraightSine2 = 1e-24;
-constexpr std::array<double, 8> kGLx = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290,
-                                        -0.1834346424956498, 0.1834346424956498,  0.5255324099163290,
-                                        0.7966664774136267,  0.9602898564975363};
-constexpr std::array<double, 8> kGLw = {0.1012285362903763, 0.2223810344533745, 0.3137066458778873,
-                                        0.3626837833783620, 0.3626837833783620, 0.3137066458778873,
-                                        0.2223810344533745, 0.1012285362903763};
+constexpr const auto& kGLx = gauss_legendre8::kNodes;
+constexpr const auto& kGLw = gauss_legendre8::kWeights;
 /// Doublings tried when the first α already meets ε (searching for the largest α that does).
 constexpr int kMaxAlphaDoublings = 8;
 /// A projected curvature smaller than this fraction of |C'||C''| has no sign (straight or

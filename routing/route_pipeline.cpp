@@ -190,18 +190,16 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
       continue;
     }
     const Vec3 a = *h.node_position(seg.from), b = *h.node_position(seg.to);
-    double min_bend = 0.0;
-    for (int c : topo.segment_cables(s)) min_bend = std::max(min_bend, h.cables[c].physical.min_bend_radius);
-    const double radius = 0.5 * topo.segment_diameter(s);
+    const double min_bend = ends[s].min_bend_radius;
+    const double radius = ends[s].radius;
     const double required = rep.clearance + part_extra + radius;
     // Each end leaves straight along its exit direction: a port along the connector axis
     // for derived_stub_length(); a branch point along its breakout direction for the
     // breakout length (shortened if something is in the way). The planner starts at the
     // stub ends.
     const EndFrame ea = end_frame(s, true), eb = end_frame(s, false);
-    const double port_stub = derived_stub_length(radius, min_bend);
     auto stub_for = [&](const EndFrame& e) {
-      return e.is_port ? port_stub : free_stub(plan_index, e.position, e.exit, breakout[e.node], required);
+      return e.is_port ? ends[s].port_stub : free_stub(plan_index, e.position, e.exit, breakout[e.node], required);
     };
     // Stubs heading towards each other may together cover at most kStubShare of the way
     // between the ends; longer ones would cross and force the route into a hairpin. A stub
@@ -338,15 +336,14 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
   // 5. Splines: bend-radius repair within half the clearance margin, written into the harness.
   auto build_curve = [&](int s) {
     SegmentGeometry& g = geom[s];
-    double min_bend = 0.0;
-    for (int c : topo.segment_cables(s)) min_bend = std::max(min_bend, h.cables[c].physical.min_bend_radius);
+    const double min_bend = ends[s].min_bend_radius;
     std::string status = "not checked";
     if (min_bend > 0.0) {
       // Round corners as far as the planning obstacles allow: try the budgets from generous
       // (a corner rounded to the full bend radius moves up to ~0.4 R) to tight, and keep the
       // first repaired curve whose samples stay clear of the (simplified) parts; the exact
       // audit that follows is the judge.
-      const double radius = 0.5 * topo.segment_diameter(s);
+      const double radius = ends[s].radius;
       const double need = radius + 0.5 * rep.clearance;
       const double step = std::max(radius, 0.25 * rep.clearance);
       BendRepairResult chosen;

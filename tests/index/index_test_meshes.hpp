@@ -13,6 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace loom::testmesh {
 
@@ -94,6 +95,34 @@ inline Part make_part(const std::string& name, Mesh mesh, bool closed) {
   p.mesh = std::move(mesh);
   p.closed = closed;
   return p;
+}
+
+/// Resolution and randomness of mixed_scene().
+struct MixedSceneDetail {
+  std::uint64_t seed = 42;       ///< seeds the soup
+  int soup = 300;                ///< random triangles in the open soup
+  int sphere_nu = 24, sphere_nv = 12;
+  int torus_nu = 32, torus_nv = 12;
+};
+
+/// The index tests' scene, shifted by `offset`: a sphere (r 10), a box and a torus (closed,
+/// outward) and an open soup of random triangles spread over [−40, 40]×[−40, 40]×[−20, 20].
+inline std::vector<Part> mixed_scene(const Vec3& offset, const MixedSceneDetail& d = {}) {
+  std::mt19937_64 rng(d.seed);
+  std::vector<Part> parts;
+  parts.push_back(make_part("sphere", uv_sphere(offset, 10, d.sphere_nu, d.sphere_nv), true));
+  parts.push_back(make_part("box", box(offset + Vec3(15, -5, -5), offset + Vec3(30, 5, 8)), true));
+  parts.push_back(make_part("torus", torus(offset + Vec3(-25, 10, 0), 10, 3, d.torus_nu, d.torus_nv), true));
+  parts.push_back(
+      make_part("soup", random_soup(rng, d.soup, offset + Vec3(-40, -40, -20), offset + Vec3(40, 40, 20), 4), false));
+  return parts;
+}
+
+/// Bounding box of all the parts' meshes.
+inline AABB bounds_of(const std::vector<Part>& parts) {
+  AABB b;
+  for (const auto& p : parts) b.extend(p.mesh.bounds());
+  return b;
 }
 
 /// Reads the v and f lines of an OBJ file (1-based or negative indices, polygons fanned).

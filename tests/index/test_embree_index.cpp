@@ -28,22 +28,6 @@ namespace {
 /// issue's 1e-5 relative bound, which is what we assert.
 constexpr double kEmbreeRel = 1e-5;
 
-std::vector<Part> mixed_scene(const Vec3& offset) {
-  std::mt19937_64 rng(42);
-  std::vector<Part> parts;
-  parts.push_back(make_part("sphere", uv_sphere(offset + Vec3(0, 0, 0), 10, 24, 12), true));
-  parts.push_back(make_part("box", box(offset + Vec3(15, -5, -5), offset + Vec3(30, 5, 8)), true));
-  parts.push_back(make_part("torus", torus(offset + Vec3(-25, 10, 0), 10, 3, 32, 12), true));
-  parts.push_back(make_part("soup", random_soup(rng, 300, offset + Vec3(-40, -40, -20), offset + Vec3(40, 40, 20), 4), false));
-  return parts;
-}
-
-AABB scene_box(const std::vector<Part>& parts) {
-  AABB b;
-  for (const auto& p : parts) b.extend(p.mesh.bounds());
-  return b;
-}
-
 }  // namespace
 
 TEST(TestMeshes, GeneratorsAreClosedAndOutward) {
@@ -59,9 +43,12 @@ TEST(EmbreeIndex, MatchesBruteForceOnRandomScene) {
   const EmbreeIndex e(parts);
   const BruteForceIndex b(parts);
   EXPECT_EQ(e.part_count(), 4);
-  EXPECT_EQ(e.triangle_count(), b.part_count() > 0 ? e.triangle_count() : 0u);
+  std::size_t total = 0;
+  for (const auto& p : parts) total += p.mesh.triangle_count();
+  EXPECT_EQ(e.triangle_count(), total);
+  EXPECT_EQ(b.part_count(), 4);
   std::mt19937_64 rng(5);
-  const AABB box = scene_box(parts);
+  const AABB box = bounds_of(parts);
   const auto pts = random_points(rng, box, 10, 400);
   expect_distances_match(e, b, pts, kEmbreeRel, 1e-3);
   expect_rays_match(e, b, pts, kEmbreeRel, 1e-3);
@@ -86,7 +73,7 @@ TEST(EmbreeIndex, LargeBatchesInMortonOrderGiveTheSingleAnswers) {
   const auto parts = mixed_scene(Vec3::Zero());
   const EmbreeIndex e(parts);
   std::mt19937_64 rng(11);
-  auto pts = random_points(rng, scene_box(parts), 10, 6000);  // above the reordering threshold
+  auto pts = random_points(rng, bounds_of(parts), 10, 6000);  // above the reordering threshold
   pts.push_back(Vec3(std::nan(""), 0, 0));                   // a non-finite point is answered too
   const auto order = coherent_order(pts);
   std::vector<char> seen(pts.size(), 0);
@@ -122,7 +109,7 @@ TEST(EmbreeIndex, AircraftSizedOffsetKeepsPrecision) {
   const EmbreeIndex e(parts);
   const BruteForceIndex b(parts);
   std::mt19937_64 rng(6);
-  const auto pts = random_points(rng, scene_box(parts), 5, 200);
+  const auto pts = random_points(rng, bounds_of(parts), 5, 200);
   for (const Vec3& p : pts) {
     const ClosestHit he = e.closest(p), hb = b.closest(p);
     ASSERT_TRUE(he.found());
@@ -138,7 +125,7 @@ TEST(EmbreeIndex, InsideAgreesWithWindingNumberNearEdgesAndVertices) {
   const EmbreeIndex e(parts);
   const BruteForceIndex b(parts);
   std::mt19937_64 rng(8);
-  std::vector<Vec3> pts = random_points(rng, scene_box(parts), 2, 2000);
+  std::vector<Vec3> pts = random_points(rng, bounds_of(parts), 2, 2000);
   // Points just off vertices and edge midpoints of the closed parts (the rays from these
   // pass near edges and vertices), at offsets down to 1e-4 of the part size.
   std::normal_distribution<double> n01;
@@ -241,7 +228,7 @@ TEST(EmbreeIndex, DegenerateMeshes) {
   EXPECT_THROW(e.closest_on_part(Vec3(0, 0, 0), 3), std::out_of_range);
   EXPECT_FALSE(e.inside(Vec3(0.2, 0.2, 3)));
   std::mt19937_64 rng(9);
-  const auto pts = random_points(rng, scene_box(parts), 2, 200);
+  const auto pts = random_points(rng, bounds_of(parts), 2, 200);
   expect_distances_match(e, b, pts, kEmbreeRel, 1e-3);
 
   // Empty scene: nothing found, nothing inside, no hits.
@@ -263,7 +250,7 @@ TEST(EmbreeIndex, ConcurrentFirstUseOfPartScenes) {
   const EmbreeIndex e(parts);
   const BruteForceIndex b(parts);
   std::mt19937_64 rng(24);
-  const auto pts = random_points(rng, scene_box(parts), 5, 2000);
+  const auto pts = random_points(rng, bounds_of(parts), 5, 2000);
   std::vector<double> got(pts.size(), -1.0);
   tbb::parallel_for(std::size_t(0), pts.size(), [&](std::size_t i) {
     const ClosestHit h = e.closest_on_part(pts[i], static_cast<int>(i % parts.size()));
@@ -284,7 +271,7 @@ TEST(EmbreeIndex, BoundedClosestOnPartMatchesBruteForce) {
   const double small = 0.02 * e.half_extent();  // below the filtered-search threshold
   // Half the points among all parts, half within ~1.5 small radii of a vertex of the part
   // queried (so the bounded search finds something there as often as not).
-  auto pts = random_points(rng, scene_box(parts), 5, 300);
+  auto pts = random_points(rng, bounds_of(parts), 5, 300);
   std::uniform_real_distribution<double> u(-1.5 * small, 1.5 * small);
   for (std::size_t i = pts.size(); i < 600; ++i) {
     const Mesh& m = parts[i % parts.size()].mesh;
@@ -327,7 +314,7 @@ TEST(EmbreeIndex, EveryBuildQualityMatchesBruteForce) {
   const auto parts = mixed_scene(Vec3(0.5, 0.25, -1));
   const BruteForceIndex b(parts);
   std::mt19937_64 rng(57);
-  const auto pts = random_points(rng, scene_box(parts), 8, 200);
+  const auto pts = random_points(rng, bounds_of(parts), 8, 200);
   for (int quality : {0, 1, 2}) {
     EmbreeOptions o;
     o.build_quality = quality;

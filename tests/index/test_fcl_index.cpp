@@ -21,21 +21,18 @@ namespace {
 
 constexpr double kExactRel = 1e-9;
 
+/// The mixed scene at a coarser resolution (FCL builds are slower than Embree's).
 std::vector<Part> scene(const Vec3& offset) {
-  std::mt19937_64 rng(43);
-  std::vector<Part> parts;
-  parts.push_back(make_part("sphere", uv_sphere(offset, 10, 20, 10), true));
-  parts.push_back(make_part("box", box(offset + Vec3(15, -5, -5), offset + Vec3(30, 5, 8)), true));
-  parts.push_back(make_part("torus", torus(offset + Vec3(-25, 10, 0), 10, 3, 24, 10), true));
-  parts.push_back(make_part("soup", random_soup(rng, 200, offset + Vec3(-40, -40, -20), offset + Vec3(40, 40, 20), 4), false));
-  return parts;
+  MixedSceneDetail d;
+  d.seed = 43;
+  d.soup = 200;
+  d.sphere_nu = 20;
+  d.sphere_nv = 10;
+  d.torus_nu = 24;
+  d.torus_nv = 10;
+  return mixed_scene(offset, d);
 }
 
-AABB scene_box(const std::vector<Part>& parts) {
-  AABB b;
-  for (const auto& p : parts) b.extend(p.mesh.bounds());
-  return b;
-}
 
 }  // namespace
 
@@ -45,7 +42,7 @@ TEST(FclIndex, MatchesBruteForce) {
   const BruteForceIndex b(parts);
   EXPECT_EQ(f.direct_triangle_count(), 0u);
   std::mt19937_64 rng(12);
-  const auto pts = random_points(rng, scene_box(parts), 10, 250);
+  const auto pts = random_points(rng, bounds_of(parts), 10, 250);
   expect_distances_match(f, b, pts, kExactRel, 1e-9);
   expect_rays_match(f, b, pts, kExactRel, 1e-9);
   for (const Vec3& p : pts) EXPECT_EQ(f.inside(p), b.inside(p));
@@ -57,7 +54,7 @@ TEST(FclIndex, FarFromOriginMatchesBruteForce) {
   const FclIndex f(parts);
   const BruteForceIndex b(parts);
   std::mt19937_64 rng(13);
-  const auto pts = random_points(rng, scene_box(parts), 5, 120);
+  const auto pts = random_points(rng, bounds_of(parts), 5, 120);
   expect_distances_match(f, b, pts, kExactRel, 1e-9);
 }
 
@@ -109,7 +106,7 @@ TEST(FclIndex, DegenerateAndTinyTriangles) {
   EXPECT_NEAR(f.closest(Vec3(5, 5, 6)).distance, 1.0, 1e-14);
   EXPECT_NEAR(f.closest(Vec3(0, 3, 1)).distance, b.closest(Vec3(0, 3, 1)).distance, 1e-14);
   std::mt19937_64 rng(14);
-  const auto pts = random_points(rng, scene_box(parts), 2, 200);
+  const auto pts = random_points(rng, bounds_of(parts), 2, 200);
   expect_distances_match(f, b, pts, kExactRel, 1e-12);
   EXPECT_TRUE(f.inside(Vec3(0, 3, 0)));
   const FclIndex empty(std::vector<Part>{});
@@ -126,7 +123,7 @@ TEST(FclIndex, SmallTrianglesJustAboveTheThresholdStayInFcl) {
   const BruteForceIndex b(parts);
   EXPECT_EQ(f.direct_triangle_count(), 0u);
   std::mt19937_64 rng(15);
-  const auto pts = random_points(rng, scene_box(parts), 2e-3, 300);
+  const auto pts = random_points(rng, bounds_of(parts), 2e-3, 300);
   expect_distances_match(f, b, pts, kExactRel, 1e-12);
 }
 

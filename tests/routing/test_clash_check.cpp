@@ -2,6 +2,7 @@
 // segment–segment distances), on scenes with known answers, adversarial scenes where the
 // paper's discrete method misses, and random scenes (rapidcheck).
 #include "routing/clash_check.hpp"
+#include "index/index_test_meshes.hpp"
 #include "routing/audit.hpp"
 
 #include "core/mesh.hpp"
@@ -31,21 +32,10 @@ namespace {
 // ---------------------------------------------------------------------------------------
 // Scene building.
 
-/// Closed box [lo, hi] with outward counter-clockwise triangles.
-Mesh box_mesh(const Vec3& lo, const Vec3& hi) {
-  Mesh m;
-  for (int i = 0; i < 8; ++i)
-    m.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
-  const std::uint32_t f[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                                  {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  for (const auto& t : f) m.triangles.push_back({t[0], t[1], t[2]});
-  return m;
-}
-
 Part box_part(const std::string& name, const Vec3& lo, const Vec3& hi, PartRole role = PartRole::Structure) {
   Part p;
   p.name = name;
-  p.mesh = box_mesh(lo, hi);
+  p.mesh = testmesh::box(lo, hi);
   p.role = role;
   p.closed = analyse_topology(p.mesh).closed;
   return p;

@@ -1,6 +1,7 @@
 // render.png (issue 9): the camera's projection against the closed-form look-at/perspective
 // matrices, the picture against a brute-force ray/triangle oracle, clash markers where the
 // report puts them, and the PNG file.
+#include "index/index_test_meshes.hpp"
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
 #include "core/io/harness_xml.hpp"
@@ -19,15 +20,6 @@
 
 namespace loom {
 namespace {
-
-Mesh box(const Vec3& lo, const Vec3& hi) {
-  Mesh m;
-  for (int k = 0; k < 8; ++k)
-    m.vertices.push_back(Vec3(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(), k & 4 ? hi.z() : lo.z()));
-  m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  return m;
-}
 
 const char* kHarness = R"(<harness name="H" units="mm">
   <attributes>
@@ -49,11 +41,11 @@ Scene small_scene() {
   s.has_harness = true;
   Part a;
   a.name = "block";
-  a.mesh = box(Vec3(-30, -30, -20), Vec3(30, 30, 5));
+  a.mesh = testmesh::box(Vec3(-30, -30, -20), Vec3(30, 30, 5));
   Part b;
   b.name = "zone";
   b.role = PartRole::KeepOut;
-  b.mesh = box(Vec3(40, -40, -20), Vec3(70, -10, 0));
+  b.mesh = testmesh::box(Vec3(40, -40, -20), Vec3(70, -10, 0));
   s.parts = {a, b};
   return s;
 }

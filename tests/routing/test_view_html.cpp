@@ -1,6 +1,7 @@
 // view.html (issue 9): decimation invariants, the page's data against the scene and report,
 // and the page itself opened in headless Chromium as a person would (WebGL pixels, the clash
 // list, a click selecting a clash, a screenshot).
+#include "index/index_test_meshes.hpp"
 #include "core/io/harness_xml.hpp"
 #include "routing/view_assets.hpp"
 #include "routing/view_html.hpp"
@@ -44,15 +45,6 @@ Mesh sphere_mesh(const Vec3& c, double r, int rings, int segs) {
   return m;
 }
 
-Mesh box_mesh(const Vec3& lo, const Vec3& hi) {
-  Mesh m;
-  for (int k = 0; k < 8; ++k)
-    m.vertices.push_back(Vec3(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(), k & 4 ? hi.z() : lo.z()));
-  m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  return m;
-}
-
 // ---------------------------------------------------------------------------------------------
 TEST(ViewAssets, InlinedThreeJsIsTheInstalledFile) {
   // Oracle: the Debian files the build step read.
@@ -84,7 +76,7 @@ RC_GTEST_PROP(Decimate, StaysWithinBudgetAndBox, ()) {
 
 TEST(Decimate, DegenerateInputs) {
   EXPECT_TRUE(decimate_vertex_clustering(Mesh{}, 0).empty());
-  EXPECT_TRUE(decimate_vertex_clustering(box_mesh(Vec3::Zero(), Vec3::Ones()), 0).empty());
+  EXPECT_TRUE(decimate_vertex_clustering(testmesh::box(Vec3::Zero(), Vec3::Ones()), 0).empty());
   Mesh point;  // every vertex in one place
   point.vertices = {Vec3(1, 1, 1), Vec3(1, 1, 1), Vec3(1, 1, 1)};
   point.triangles = {{0, 1, 2}, {0, 2, 1}};
@@ -132,14 +124,14 @@ Fixture small_scene() {
   f.scene.has_harness = true;
   Part box;
   box.name = "block";
-  box.mesh = box_mesh(Vec3(-20, -20, -40), Vec3(20, 20, 2));
+  box.mesh = testmesh::box(Vec3(-20, -20, -40), Vec3(20, 20, 2));
   Part ball;
   ball.name = "ball";
   ball.mesh = sphere_mesh(Vec3(40, 60, 0), 15.0, 40, 60);  // 4800 triangles
   Part zone;
   zone.name = "zone";
   zone.role = PartRole::KeepOut;
-  zone.mesh = box_mesh(Vec3(-60, 50, -10), Vec3(-30, 80, 20));
+  zone.mesh = testmesh::box(Vec3(-60, 50, -10), Vec3(-30, 80, 20));
   f.scene.parts = {box, ball, zone};
   f.report = nlohmann::json::parse(R"({
     "clashes": [
