@@ -50,32 +50,37 @@ struct BucketGrid {
   int cx(double x) const { return std::clamp(static_cast<int>(std::floor((x - origin.x()) / cell)), 0, nx - 1); }
   int cy(double y) const { return std::clamp(static_cast<int>(std::floor((y - origin.y()) / cell)), 0, ny - 1); }
 
-  /// Builds the grid over `boxes` (min, max per item) covering `lo`..`hi`.
-  void build(const std::vector<std::array<Vec2, 2>>& boxes, const Vec2& lo, const Vec2& hi) {
+  /// Builds the grid over `boxes` (min, max per item) covering `lo`..`hi`, with about
+  /// `boxes_per_cell` boxes per cell of the bounding box (more cells when smaller).
+  void build(const std::vector<std::array<Vec2, 2>>& boxes, const Vec2& lo, const Vec2& hi, double boxes_per_cell) {
     start.clear();
     items.clear();
     nx = ny = 0;
     if (boxes.empty()) return;
     const Vec2 ext = (hi - lo).cwiseMax(Vec2::Constant(1e-300));
-    // About two items per cell, at most 2^22 cells.
-    const double target = std::clamp(static_cast<double>(boxes.size()) / 2.0, 1.0, 4194304.0);
+    // At most 2^22 cells.
+    const double target = std::clamp(static_cast<double>(boxes.size()) / boxes_per_cell, 1.0, 4194304.0);
     cell = std::sqrt(ext.x() * ext.y() / target);
     if (!(cell > 0.0) || !std::isfinite(cell)) cell = std::max(ext.x(), ext.y());
     cell = std::max(cell, std::max(ext.x(), ext.y()) / 2048.0);
     origin = lo;
     nx = std::max(1, static_cast<int>(std::ceil(ext.x() / cell)));
     ny = std::max(1, static_cast<int>(std::ceil(ext.y() / cell)));
+    // Cell ranges of the boxes, computed once for both passes.
+    std::vector<std::array<int, 4>> range(boxes.size());
+    for (std::size_t k = 0; k < boxes.size(); ++k)
+      range[k] = {cx(boxes[k][0].x()), cx(boxes[k][1].x()), cy(boxes[k][0].y()), cy(boxes[k][1].y())};
     std::vector<std::uint32_t> count(static_cast<std::size_t>(nx) * ny + 1, 0);
-    for (const auto& b : boxes)
-      for (int y = cy(b[0].y()); y <= cy(b[1].y()); ++y)
-        for (int x = cx(b[0].x()); x <= cx(b[1].x()); ++x) ++count[static_cast<std::size_t>(y) * nx + x + 1];
+    for (const auto& g : range)
+      for (int y = g[2]; y <= g[3]; ++y)
+        for (int x = g[0]; x <= g[1]; ++x) ++count[static_cast<std::size_t>(y) * nx + x + 1];
     for (std::size_t i = 1; i < count.size(); ++i) count[i] += count[i - 1];
     start = count;
     items.resize(count.back());
     for (std::uint32_t k = 0; k < boxes.size(); ++k) {
-      const auto& b = boxes[k];
-      for (int y = cy(b[0].y()); y <= cy(b[1].y()); ++y)
-        for (int x = cx(b[0].x()); x <= cx(b[1].x()); ++x) items[count[static_cast<std::size_t>(y) * nx + x]++] = k;
+      const auto& g = range[k];
+      for (int y = g[2]; y <= g[3]; ++y)
+        for (int x = g[0]; x <= g[1]; ++x) items[count[static_cast<std::size_t>(y) * nx + x]++] = k;
     }
   }
   template <class F>
@@ -85,7 +90,37 @@ struct BucketGrid {
   }
 };
 
+/// Membership fast path for the kept region R (the union of the closed kept triangles), on
+/// a uniform grid of its own (cells of a few kept triangles, not the bucket grids' sizes).
+/// A closed cell that no boundary segment touches lies wholly in the interior of R or
+/// wholly outside R: the cell is connected, and a path from a point of R to a point
+/// outside R crosses the topological boundary of R, which lies on the boundary segments
+/// (edges between a kept and a non-kept or infinite face). One test of its centre thus
+/// classifies the whole cell; the cells found inside are flagged, and a query that falls
+/// in one is answered without a point location.
+struct FlagGrid {
+  Vec2 origin = Vec2::Zero();
+  double cell = 1.0;
+  int nx = 0, ny = 0;
+  std::vector<char> inside_cell;  // row-major, 1 = all of the closed cell is in R
+
+  /// True if p falls in a flagged cell. A point within rounding of a cell's border may be
+  /// assigned to the neighbouring cell: boundary segments are marked with a pad far above
+  /// that rounding (build_flags), so a flagged cell lies at least the pad inside R.
+  bool inside(const Vec2& p) const {
+    if (nx == 0) return false;
+    const double fx = (p.x() - origin.x()) / cell, fy = (p.y() - origin.y()) / cell;
+    if (!(fx >= 0.0 && fy >= 0.0 && fx < nx && fy < ny)) return false;  // also NaN
+    return inside_cell[static_cast<std::size_t>(fy) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(fx)] != 0;
+  }
+};
+
 }  // namespace
+
+// Bucket densities: a point location scans the triangles listed in its cell, each box
+// covering several cells (lists of ~4 boxes per cell at 0.5); a distance query scans rings of cells.
+constexpr double kTriangleBoxesPerCell = 0.5;
+constexpr double kSegmentBoxesPerCell = 2.0;
 
 struct AlphaShape2D::Impl {
   double alpha = 0.0;
@@ -100,6 +135,7 @@ struct AlphaShape2D::Impl {
   std::vector<std::array<Vec2, 2>> segments;  // boundary edges, kept side on the left
   std::vector<std::array<int, 2>> segment_edge;  // (face id, edge index)
   BucketGrid tri_grid, seg_grid;
+  FlagGrid flags;
   double area = 0.0;
 
   /// Numbers the finite faces and keeps those of the α rule (circumradius < α or longest
@@ -135,11 +171,19 @@ struct AlphaShape2D::Impl {
         seg_boxes.push_back({a.cwiseMin(b), a.cwiseMax(b)});
       }
     }
-    tri_grid.build(tri_boxes, lo, hi);
-    seg_grid.build(seg_boxes, lo, hi);
+    tri_grid.build(tri_boxes, lo, hi, kTriangleBoxesPerCell);
+    seg_grid.build(seg_boxes, lo, hi, kSegmentBoxesPerCell);
+    build_flags(lo, hi);
   }
 
-  bool in_kept_triangle(const Vec2& p) const {
+  /// Fills `flags` over lo..hi (the kept triangles' bounding box); see FlagGrid.
+  void build_flags(const Vec2& lo, const Vec2& hi);
+
+  /// True if p lies in a closed kept triangle (relative slack 1e-12), answered in O(1)
+  /// for points of an all-inside flag cell.
+  bool in_kept_triangle(const Vec2& p) const { return flags.inside(p) || in_kept_triangle_slow(p); }
+
+  bool in_kept_triangle_slow(const Vec2& p) const {
     if (tri_grid.empty()) return false;
     const double slack = 1e-12 * tri_grid.cell;
     if (p.x() < tri_grid.origin.x() - slack || p.y() < tri_grid.origin.y() - slack ||
@@ -190,6 +234,66 @@ struct AlphaShape2D::Impl {
   }
 };
 
+void AlphaShape2D::Impl::build_flags(const Vec2& lo, const Vec2& hi) {
+  // About this many kept triangles (of the mean area) per flag cell: most queries are
+  // samples deep inside, and the cells along the boundary stay few (~ perimeter / cell).
+  constexpr double kTrianglesPerFlagCell = 2.0;
+  // At most this many cells along an axis (≤ 2^22 cells, one byte each).
+  constexpr double kMaxFlagCellsPerAxis = 2048.0;
+  // Pads of the boundary marking: relative to the cell, and in ulps of the coordinates
+  // (the rounding of the cell index and of the segment clipping below is a few ulps).
+  constexpr double kPadPerCell = 1e-9;
+  constexpr double kPadUlps = 64.0;
+  flags = FlagGrid();
+  if (kept_list.empty() || segments.empty()) return;
+  const Vec2 ext = hi - lo;
+  double cell = std::max(std::sqrt(kTrianglesPerFlagCell * area / static_cast<double>(kept_list.size())),
+                         std::max(ext.x(), ext.y()) / kMaxFlagCellsPerAxis);
+  if (!(cell > 0.0) || !std::isfinite(cell)) return;  // degenerate region: slow path only
+  FlagGrid g;
+  g.origin = lo;
+  g.cell = cell;
+  g.nx = std::max(1, static_cast<int>(std::ceil(ext.x() / cell)));
+  g.ny = std::max(1, static_cast<int>(std::ceil(ext.y() / cell)));
+  const double eps = std::numeric_limits<double>::epsilon();
+  const double magnitude = lo.cwiseAbs().cwiseMax(hi.cwiseAbs()).maxCoeff() + cell;
+  const double pad = kPadPerCell * cell + kPadUlps * eps * magnitude;
+  auto index = [&](double v, double o, int n) {
+    return std::clamp(static_cast<int>(std::floor((v - o) / cell)), 0, n - 1);
+  };
+  // Cells within pad of a boundary segment: for each row crossed, the x-range of the
+  // segment's part inside the row's padded slab, widened by its rounding error and pad.
+  std::vector<char> touched(static_cast<std::size_t>(g.nx) * g.ny, 0);
+  for (const auto& sgm : segments) {
+    const Vec2 a = sgm[0], b = sgm[1];
+    const double ymin = std::min(a.y(), b.y()), ymax = std::max(a.y(), b.y());
+    const double xmin = std::min(a.x(), b.x()), xmax = std::max(a.x(), b.x());
+    const double dx = b.x() - a.x(), dy = b.y() - a.y();
+    const int j0 = index(ymin - pad, g.origin.y(), g.ny), j1 = index(ymax + pad, g.origin.y(), g.ny);
+    for (int j = j0; j <= j1; ++j) {
+      const double s0 = std::clamp(g.origin.y() + j * cell - pad, ymin, ymax);
+      const double s1 = std::clamp(g.origin.y() + (j + 1) * cell + pad, ymin, ymax);
+      double xl = xmin, xr = xmax;
+      if (s0 > ymin || s1 < ymax) {  // the slab cuts the segment: interpolate
+        const double xa = a.x() + dx * ((s0 - a.y()) / dy), xb = a.x() + dx * ((s1 - a.y()) / dy);
+        const double err = std::abs(dx) * 4.0 * eps * magnitude / std::abs(dy) + 4.0 * eps * magnitude;
+        xl = std::max(xmin, std::min(xa, xb) - err);
+        xr = std::min(xmax, std::max(xa, xb) + err);
+      }
+      const int i0 = index(xl - pad, g.origin.x(), g.nx), i1 = index(xr + pad, g.origin.x(), g.nx);
+      std::fill(touched.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(j) * g.nx + i0),
+                touched.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(j) * g.nx + i1 + 1), 1);
+    }
+  }
+  g.inside_cell.assign(touched.size(), 0);
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      const std::size_t c = static_cast<std::size_t>(j) * g.nx + i;
+      if (!touched[c]) g.inside_cell[c] = in_kept_triangle_slow(g.origin + Vec2(i + 0.5, j + 0.5) * cell) ? 1 : 0;
+    }
+  flags = std::move(g);
+}
+
 AlphaShape2D::AlphaShape2D(const std::vector<Vec2>& points, double alpha, double short_edge)
     : impl_(std::make_unique<Impl>()) {
   impl_->alpha = alpha;
@@ -229,10 +333,9 @@ std::size_t AlphaShape2D::refine(const std::vector<Vec2>& points, double tol) {
   for (const auto& p : points)
     if (!contains(p, tol)) add.emplace_back(p.x(), p.y());
   if (add.empty()) return 0;
-  const std::size_t before = m.dt.number_of_vertices();
   m.dt.insert(add.begin(), add.end());
   m.classify();
-  return m.dt.number_of_vertices() - before;
+  return add.size();
 }
 
 AlphaShape2D::~AlphaShape2D() = default;
@@ -351,6 +454,23 @@ double AlphaShape2D::cover(const std::vector<Vec2>& points, double tol, std::siz
 bool AlphaShape2D::contains(const Vec2& p, double tol) const {
   if (impl_->in_kept_triangle(p)) return true;
   return tol > 0.0 && impl_->boundary_distance(p, tol) <= tol;
+}
+
+bool AlphaShape2D::contains_unaccelerated(const Vec2& p, double tol) const {
+  if (impl_->in_kept_triangle_slow(p)) return true;
+  return tol > 0.0 && impl_->boundary_distance(p, tol) <= tol;
+}
+
+AlphaShape2D::InsideGrid AlphaShape2D::inside_grid() const {
+  const FlagGrid& f = impl_->flags;
+  InsideGrid g;
+  if (f.nx == 0) return g;
+  g.origin = f.origin;
+  g.cell = f.cell;
+  g.nx = f.nx;
+  g.ny = f.ny;
+  g.inside_cells = static_cast<std::size_t>(std::count(f.inside_cell.begin(), f.inside_cell.end(), 1));
+  return g;
 }
 
 double AlphaShape2D::signed_distance(const Vec2& p) const {

@@ -53,7 +53,9 @@ class AlphaShape2D {
   /// is farther than tol from the region as a triangulation vertex and re-applies the α rule
   /// to all triangles (earlier cover()/keep_all() changes are dropped: call it first).
   /// A notch that a boundary chord cuts into a sliver of the projection then closes with
-  /// small triangles instead of the large ones cover() would add. Returns points inserted.
+  /// small triangles instead of the large ones cover() would add. Returns the number of
+  /// points that were farther than tol (and inserted); 0: the region is unchanged and holds
+  /// every point within tol, so cover() of the same points would only add vertex triangles.
   std::size_t refine(const std::vector<Vec2>& points, double tol);
   /// Keeps every finite Delaunay triangle: the region becomes the convex hull.
   void keep_all();
@@ -64,8 +66,20 @@ class AlphaShape2D {
   /// Returns the area added (scene units²).
   double cover(const std::vector<Vec2>& points, double tol, std::size_t* uncovered = nullptr);
 
-  /// True if p lies in the region or within tol of it.
+  /// True if p lies in the region or within tol of it. Points deep inside are answered in
+  /// O(1) from a grid of cells known to lie wholly inside the region.
   bool contains(const Vec2& p, double tol = 0.0) const;
+  /// Same answer as contains(), by point location only (without that grid): its oracle.
+  bool contains_unaccelerated(const Vec2& p, double tol = 0.0) const;
+  /// That grid: cell (i, j) is [origin + (i, j)·cell, origin + (i + 1, j + 1)·cell].
+  struct InsideGrid {
+    Vec2 origin = Vec2::Zero();  ///< lower corner (scene units)
+    double cell = 0.0;           ///< cell side (scene units); 0: no grid
+    int nx = 0, ny = 0;          ///< cells per axis
+    std::size_t inside_cells = 0;  ///< cells that lie wholly inside the region
+  };
+  /// The grid of the O(1) inside answers of contains() (rebuilt when the region changes).
+  InsideGrid inside_grid() const;
   /// Signed distance to the region's boundary: negative inside, +inf if the region is empty.
   double signed_distance(const Vec2& p) const;
   /// Boundary loops grouped per connected piece (outer CCW, holes CW), in deterministic order.

@@ -1,13 +1,8 @@
 #include "index/alpha_sim.hpp"
 
 #include "core/error.hpp"
+#include "index/embree_index.hpp"
 
-#include <CGAL/AABB_face_graph_triangle_primitive.h>
-#include <CGAL/AABB_traits.h>
-#include <CGAL/AABB_tree.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Side_of_triangle_mesh.h>
-#include <CGAL/Surface_mesh.h>
 
 #include <BRepAlgoAPI_Common.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
@@ -32,9 +27,11 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <random>
 #include <stdexcept>
@@ -169,22 +166,8 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> unique_edges(const Mesh& me
   return edges;
 }
 
-/// The paper's point cloud (step 1), sampled directly in one projection plane (step 2):
-/// the projected vertices, the projected edges subdivided to pieces ≤ L_max, and the nodes
-/// of a lattice of spacing L_max (aligned to the plane origin, so that overlapping
-/// triangles share nodes) inside each projected triangle. The projected surface is then
-/// sampled about as densely as by a 3D subdivision of edge ≤ L_max (projection only
-/// shortens distances), but a face seen edge-on costs only its silhouette and a long
-/// sliver triangle only its area, not (longest edge / L_max)². Checks (points the α-shape
-/// must cover) are the sub-edge midpoints, the centres of the lattice cells inside each
-/// triangle and its centroid.
-/// Coordinates are snapped to the grid `snap`; points and checks are sorted and unique.
-struct PlaneSamples {
-  std::vector<Vec2> points, checks;
-};
-
-/// Calls emit for each lattice node (offset 0) or cell centre (offset 0.5) of spacing h in
-/// the closed triangle abc (boundary within rounding).
+/// Calls emit(i, j) for each lattice point ((i + offset)·h, (j + offset)·h) of spacing h
+/// (offset 0: nodes, 0.5: cell centres) in the closed triangle abc (boundary within rounding).
 template <class F>
 void lattice_in_triangle(const Vec2& a, const Vec2& b, const Vec2& c, double h, double offset, F&& emit) {
   const double ymin = std::min({a.y(), b.y(), c.y()}), ymax = std::max({a.y(), b.y(), c.y()});
@@ -208,7 +191,7 @@ void lattice_in_triangle(const Vec2& a, const Vec2& b, const Vec2& c, double h, 
     }
     if (!(xl <= xr)) continue;
     const long i0 = static_cast<long>(std::ceil(xl / h - offset)), i1 = static_cast<long>(std::floor(xr / h - offset));
-    for (long i = i0; i <= i1; ++i) emit(Vec2((static_cast<double>(i) + offset) * h, y));
+    for (long i = i0; i <= i1; ++i) emit(i, j);
   }
 }
 
@@ -229,37 +212,141 @@ double plane_sample_estimate(const Mesh& mesh, const std::vector<std::pair<std::
   return n;
 }
 
-PlaneSamples sample_projection(const Mesh& mesh, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges,
-                               const AlphaSimPrism& pr, double l_max, double snap) {
-  PlaneSamples s;
+/// The lattice points of one offset met by the triangles of a projection, deduplicated on
+/// a bitmap over their index box (overlapping triangles, front and back faces, meet the
+/// same nodes many times) instead of sorting every copy. Lattice points are exact
+/// multiples of the spacing, so equal points have equal indices.
+class LatticeBitmap {
+ public:
+  /// Bitmap over the lattice indices of the box lo..hi (plane coordinates), if it has at
+  /// most max_bits bits; otherwise active() is false and the caller sorts the points.
+  LatticeBitmap(const Vec2& lo, const Vec2& hi, double h, double offset, std::size_t max_bits) : h_(h), offset_(offset) {
+    // One index of margin: rounding in lattice_in_triangle cannot move a point further.
+    const double i0 = std::floor(lo.x() / h - offset) - 1.0, j0 = std::floor(lo.y() / h - offset) - 1.0;
+    const double nx = std::ceil(hi.x() / h - offset) + 2.0 - i0, ny = std::ceil(hi.y() / h - offset) + 2.0 - j0;
+    // Indices far beyond the bitmap's reach (or not finite): sort instead.
+    constexpr double kMaxIndex = 1e15;
+    if (!(std::abs(i0) < kMaxIndex && std::abs(j0) < kMaxIndex && nx * ny <= static_cast<double>(max_bits))) return;
+    i0_ = static_cast<long>(i0);
+    j0_ = static_cast<long>(j0);
+    nx_ = static_cast<long>(nx);
+    ny_ = static_cast<long>(ny);
+    bits_.assign((static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_) + 63) / 64, 0);
+  }
+  bool active() const { return !bits_.empty(); }
+  /// Marks (i, j); false if it lies outside the box (the caller keeps the point itself).
+  bool set(long i, long j) {
+    const long x = i - i0_, y = j - j0_;
+    if (x < 0 || y < 0 || x >= nx_ || y >= ny_) return false;
+    const std::size_t k = static_cast<std::size_t>(x) * static_cast<std::size_t>(ny_) + static_cast<std::size_t>(y);
+    bits_[k / 64] |= std::uint64_t(1) << (k % 64);
+    return true;
+  }
+  /// The marked points, mapped by `point(i, j)`, in increasing (i, j), which is
+  /// increasing (x, y) since the mapping is monotone in each index.
+  template <class F>
+  std::vector<Vec2> points(F&& point) const {
+    std::vector<Vec2> out;
+    for (std::size_t w = 0; w < bits_.size(); ++w)
+      for (std::uint64_t word = bits_[w]; word != 0; word &= word - 1) {
+        const std::size_t k = w * 64 + static_cast<std::size_t>(__builtin_ctzll(word));
+        out.push_back(point(i0_ + static_cast<long>(k / static_cast<std::size_t>(ny_)),
+                            j0_ + static_cast<long>(k % static_cast<std::size_t>(ny_))));
+      }
+    return out;
+  }
+  /// Lattice point (i, j) (unsnapped).
+  Vec2 at(long i, long j) const {
+    return Vec2((static_cast<double>(i) + offset_) * h_, (static_cast<double>(j) + offset_) * h_);
+  }
+
+ private:
+  double h_, offset_;
+  long i0_ = 0, j0_ = 0, nx_ = 0, ny_ = 0;
+  std::vector<std::uint64_t> bits_;
+};
+
+/// Most bits of one lattice bitmap (8 MiB; two per plane, planes in parallel). A larger
+/// index box (a huge sparse projection) falls back to sorting the lattice points.
+constexpr std::size_t kMaxLatticeBitmapBits = std::size_t(1) << 26;
+
+/// Lexicographic order (x, then y) of plane points.
+struct Vec2Less {
+  bool operator()(const Vec2& p, const Vec2& q) const { return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y()); }
+};
+
+void sort_unique(std::vector<Vec2>& v) {
+  std::sort(v.begin(), v.end(), Vec2Less());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+}
+
+/// sorted ∪ more (both sorted and unique) → sorted, unique.
+void merge_unique(std::vector<Vec2>& sorted, const std::vector<Vec2>& more) {
+  std::vector<Vec2> out;
+  out.reserve(sorted.size() + more.size());
+  std::merge(sorted.begin(), sorted.end(), more.begin(), more.end(), std::back_inserter(out), Vec2Less());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  sorted = std::move(out);
+}
+
+/// The paper's point cloud (step 1), sampled directly in one projection plane (step 2):
+/// the projected vertices, the projected edges subdivided to pieces ≤ L_max, and the nodes
+/// of a lattice of spacing L_max (aligned to the plane origin, so that overlapping
+/// triangles share nodes) inside each projected triangle. The projected surface is then
+/// sampled about as densely as by a 3D subdivision of edge ≤ L_max (projection only
+/// shortens distances), but a face seen edge-on costs only its silhouette and a long
+/// sliver triangle only its area, not (longest edge / L_max)². Checks (points the α-shape
+/// must cover) are the sub-edge midpoints, the centres of the lattice cells inside each
+/// triangle and its centroid.
+/// Coordinates are snapped to the grid `snap`; points and checks are sorted and unique.
+/// lattice_bitmap = false sorts every point (no LatticeBitmap): the same sets, slower.
+AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
+                                       const std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges,
+                                       const AlphaSimPrism& pr, double l_max, double snap, bool lattice_bitmap) {
+  AlphaSimPlaneSamples s;
   auto snapped = [snap](const Vec2& q) { return Vec2(std::round(q.x() / snap) * snap, std::round(q.y() / snap) * snap); };
   std::vector<Vec2> proj(mesh.vertices.size());
   std::vector<char> used(mesh.vertices.size(), 0);
   for (const auto& f : mesh.triangles)
     for (auto i : f) used[i] = 1;
+  Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
     proj[i] = pr.project(mesh.vertices[i]);
-    if (used[i]) s.points.push_back(snapped(proj[i]));
+    if (!used[i]) continue;
+    s.points.push_back(snapped(proj[i]));
+    lo = lo.cwiseMin(proj[i]);
+    hi = hi.cwiseMax(proj[i]);
   }
-  for (const auto& [a, b] : edges) {
-    const Vec2 pa = proj[a], pb = proj[b];
+  // Edges with the same projected ends in the same direction (front and back faces of a
+  // plate seen edge-on) give the same points: each is subdivided once.
+  std::vector<std::array<double, 4>> ends;
+  ends.reserve(edges.size());
+  for (const auto& [a, b] : edges) ends.push_back({proj[a].x(), proj[a].y(), proj[b].x(), proj[b].y()});
+  std::sort(ends.begin(), ends.end());
+  ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+  for (const auto& e : ends) {
+    const Vec2 pa(e[0], e[1]), pb(e[2], e[3]);
     const int n = std::max(1, static_cast<int>(std::ceil((pb - pa).norm() / l_max)));
     for (int k = 1; k < n; ++k) s.points.push_back(snapped(pa + (pb - pa) * (static_cast<double>(k) / n)));
     for (int k = 0; k < n; ++k) s.checks.push_back(snapped(pa + (pb - pa) * ((k + 0.5) / n)));
   }
+  const std::size_t max_bits = lattice_bitmap ? kMaxLatticeBitmapBits : 0;
+  LatticeBitmap nodes(lo, hi, l_max, 0.0, max_bits), centres(lo, hi, l_max, 0.5, max_bits);
   for (const auto& f : mesh.triangles) {
     const Vec2 a = proj[f[0]], b = proj[f[1]], c = proj[f[2]];
-    lattice_in_triangle(a, b, c, l_max, 0.0, [&](const Vec2& q) { s.points.push_back(snapped(q)); });
-    lattice_in_triangle(a, b, c, l_max, 0.5, [&](const Vec2& q) { s.checks.push_back(snapped(q)); });
+    lattice_in_triangle(a, b, c, l_max, 0.0, [&](long i, long j) {
+      if (!nodes.active() || !nodes.set(i, j)) s.points.push_back(snapped(nodes.at(i, j)));
+    });
+    lattice_in_triangle(a, b, c, l_max, 0.5, [&](long i, long j) {
+      if (!centres.active() || !centres.set(i, j)) s.checks.push_back(snapped(centres.at(i, j)));
+    });
     s.checks.push_back(snapped((a + b + c) / 3.0));
   }
-  auto sort_unique = [](std::vector<Vec2>& v) {
-    std::sort(v.begin(), v.end(),
-              [](const Vec2& p, const Vec2& q) { return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y()); });
-    v.erase(std::unique(v.begin(), v.end()), v.end());
-  };
   sort_unique(s.points);
   sort_unique(s.checks);
+  if (nodes.active()) merge_unique(s.points, nodes.points([&](long i, long j) { return snapped(nodes.at(i, j)); }));
+  if (centres.active())
+    merge_unique(s.checks, centres.points([&](long i, long j) { return snapped(centres.at(i, j)); }));
   return s;
 }
 
@@ -302,46 +389,27 @@ std::vector<PlaneSpec> planes_for(const AlphaSimOptions& opt) {
   return out;
 }
 
-// --- CGAL mesh queries ----------------------------------------------------------------
-using K3 = CGAL::Exact_predicates_inexact_constructions_kernel;
-using SM = CGAL::Surface_mesh<K3::Point_3>;
-using Prim = CGAL::AABB_face_graph_triangle_primitive<SM>;
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K3, Prim>>;
+// --- Mesh queries for the measures (Embree) ---------------------------------------------
 
-/// A triangle mesh with an AABB tree for distance and inside queries (CGAL).
-struct MeshQuery {
-  SM sm;
-  std::unique_ptr<Tree> tree;
-  explicit MeshQuery(const Mesh& m) {
-    // A triangle soup (own corners per face): prism intersections can touch along an
-    // edge (non-manifold), which a half-edge structure rejects; the AABB tree and the
-    // ray-parity inside test need only the triangles.
-    for (const auto& f : m.triangles) {
-      SM::Vertex_index c[3];
-      for (int k = 0; k < 3; ++k) {
-        const Vec3& v = m.vertices[f[k]];
-        c[k] = sm.add_vertex(K3::Point_3(v.x(), v.y(), v.z()));
-      }
-      sm.add_face(c[0], c[1], c[2]);
-    }
-    tree = std::make_unique<Tree>(faces(sm).first, faces(sm).second, sm);
-    tree->build();
-    tree->accelerate_distance_queries();
-  }
-  double distance(const Vec3& p) const { return std::sqrt(tree->squared_distance(K3::Point_3(p.x(), p.y(), p.z()))); }
-};
+/// One closed or open mesh as a one-part EmbreeIndex: exact (double) distances and
+/// ray-parity inside tests (DESIGN §9: Embree for BVH queries).
+EmbreeIndex mesh_index(const Mesh& m, bool closed) {
+  Part p;
+  p.name = "alpha-sim";
+  p.mesh = m;
+  p.closed = closed;
+  return EmbreeIndex({p});
+}
 
-/// Fraction of `samples` inside or within tol of the closed mesh q (parallel).
-std::size_t count_contained_mesh(const MeshQuery& q, const std::vector<Vec3>& samples, double tol) {
+/// Number of `samples` inside or within tol of the closed mesh indexed by q (parallel).
+/// The distance test comes first: a sample within tol of the surface is "on" it, and one
+/// farther away is clear of the surface by tol, where the ray-parity test is robust.
+std::size_t count_contained_mesh(const EmbreeIndex& q, const std::vector<Vec3>& samples, double tol) {
   return tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, samples.size(), 1024), std::size_t(0),
       [&](const tbb::blocked_range<std::size_t>& r, std::size_t acc) {
-        CGAL::Side_of_triangle_mesh<SM, K3, CGAL::Default, Tree> side(*q.tree);
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-          const auto& p = samples[i];
-          const K3::Point_3 cp(p.x(), p.y(), p.z());
-          if (side(cp) != CGAL::ON_UNBOUNDED_SIDE || q.tree->squared_distance(cp) <= tol * tol) ++acc;
-        }
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+          if (q.closest(samples[i], tol).found() || q.inside(samples[i])) ++acc;
         return acc;
       },
       std::plus<std::size_t>());
@@ -388,21 +456,27 @@ TopoDS_Shape prism_shape(const AlphaSimPrism& pr, const std::vector<PolygonWithH
 }
 
 TopoDS_Shape common(const TopoDS_Shape& a, const TopoDS_Shape& b, double fuzzy) {
-  BRepAlgoAPI_Common op(a, b);
-  // Constructor builds; set fuzzy and rebuild only if it failed.
-  if (!op.IsDone() || op.HasErrors()) {
-    TopTools_ListOfShape args, tools;
-    args.Append(a);
-    tools.Append(b);
-    BRepAlgoAPI_Common op2;
-    op2.SetArguments(args);
-    op2.SetTools(tools);
-    op2.SetFuzzyValue(fuzzy);
-    op2.Build();
-    if (!op2.IsDone() || op2.HasErrors()) throw std::runtime_error("Boolean common failed");
-    return op2.Shape();
-  }
-  return op.Shape();
+  TopTools_ListOfShape args, tools;
+  args.Append(a);
+  tools.Append(b);
+  // Serial (parts are simplified in parallel already); no check of the inputs for
+  // inverted solids (prisms of valid faces never are) and no history (only the result is
+  // used). With the fuzzy value (tol) only if the exact run fails.
+  auto run = [&](double fuzzy_value) {
+    BRepAlgoAPI_Common op;
+    op.SetArguments(args);
+    op.SetTools(tools);
+    op.SetRunParallel(false);
+    op.SetCheckInverted(false);
+    op.SetToFillHistory(false);
+    if (fuzzy_value > 0.0) op.SetFuzzyValue(fuzzy_value);
+    op.Build();
+    return op.IsDone() && !op.HasErrors() ? op.Shape() : TopoDS_Shape();
+  };
+  TopoDS_Shape out = run(0.0);
+  if (out.IsNull()) out = run(fuzzy);
+  if (out.IsNull()) throw std::runtime_error("Boolean common failed");
+  return out;
 }
 
 Mesh mesh_shape(const TopoDS_Shape& shape, double deflection, int* face_count) {
@@ -469,6 +543,12 @@ void keep_original(AlphaSimPart& out, const Part& part, AlphaSimStatus status, c
 }
 
 }  // namespace
+
+AlphaSimPlaneSamples alpha_sim_plane_samples(const Mesh& mesh, const AlphaSimPrism& frame, double l_max, double snap,
+                                             bool lattice_bitmap) {
+  if (!(l_max > 0.0 && snap > 0.0)) throw std::invalid_argument("alpha-sim: l_max and snap must be > 0");
+  return sample_projection(mesh, unique_edges(mesh), frame, l_max, snap, lattice_bitmap);
+}
 
 // ---------------------------------------------------------------------------------------
 
@@ -553,7 +633,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
   std::vector<std::shared_ptr<AlphaShape2D>> shapes(specs.size());
   r.projections.resize(specs.size());
   std::atomic<bool> degenerate{false};
-  std::vector<PlaneSamples> plane_samples(specs.size());
+  std::vector<AlphaSimPlaneSamples> plane_samples(specs.size());
   // Snap projections to a grid of snap ≤ tol/4 and drop duplicates: points that are
   // equal up to rounding (the same 3D edge subdivided from either end, front and back
   // faces) would otherwise give sliver triangles and spurious boundary loops.
@@ -572,8 +652,8 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
         pr.depth_min = std::min(pr.depth_min, d);
         pr.depth_max = std::max(pr.depth_max, d);
       }
-    PlaneSamples& smp = plane_samples[k];
-    smp = sample_projection(part.mesh, edges, pr, r.l_max, snap);
+    AlphaSimPlaneSamples& smp = plane_samples[k];
+    smp = sample_projection(part.mesh, edges, pr, r.l_max, snap, true);
     const std::vector<Vec2>& pts = smp.points;
     rep.points = pts.size();
     auto shape = std::make_shared<AlphaShape2D>(pts, r.alpha, std::min(opt.short_edge_factor * r.l_max, r.alpha));
@@ -587,8 +667,11 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
     } else {
       smp.checks.reserve(smp.checks.size() + cover_samples.size());
       for (const auto& p : cover_samples) smp.checks.push_back(pr.project(p));
-      shape->refine(smp.checks, tol);
-      const double added = shape->cover(smp.checks, tol);
+      // When refine inserts nothing, every check is within tol of the region already:
+      // cover() then only has to attach isolated vertices (skips the same checks again).
+      const bool changed = shape->refine(smp.checks, tol) > 0;
+      const std::vector<Vec2> none;
+      const double added = shape->cover(changed ? smp.checks : none, tol);
       if (added > opt.torn_fraction * shape->area()) {
         rep.status = ProjectionStatus::Torn;
         shape->keep_all();
@@ -652,8 +735,9 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
       } else if (round < kRefineRounds) {
         auto& checks = plane_samples[k].checks;
         checks.insert(checks.end(), missed[k].begin(), missed[k].end());
-        shapes[k]->refine(checks, tol);
-        const double added = shapes[k]->cover(checks, tol);
+        const bool changed = shapes[k]->refine(checks, tol) > 0;
+        const std::vector<Vec2> none;
+        const double added = shapes[k]->cover(changed ? checks : none, tol);
         if (added > opt.torn_fraction * shapes[k]->area()) {
           rep.status = ProjectionStatus::Torn;
           shapes[k]->keep_all();
@@ -797,7 +881,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
   const auto t_measure = Clock::now();
   if (opt.measure) {
     // Containment of the original surface in the output mesh (what indices will use).
-    MeshQuery simplified(out.mesh);
+    const EmbreeIndex simplified = mesh_index(out.mesh, true);
     const std::size_t in = count_contained_mesh(simplified, samples, tol);
     r.containment = samples.empty() ? 1.0 : static_cast<double>(in) / samples.size();
     if (in != samples.size()) {
@@ -808,15 +892,11 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
       return finish();
     }
     // One-sided Hausdorff distance: output surface → original surface.
-    MeshQuery original(part.mesh);
+    const EmbreeIndex original = mesh_index(part.mesh, r.closed_before);
     const auto surf = dense_surface_samples(out.mesh, r.l_max, 1.0, 200000, opt.seed + 1);
-    r.hausdorff = tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, surf.size(), 1024), 0.0,
-        [&](const auto& rg, double acc) {
-          for (std::size_t i = rg.begin(); i != rg.end(); ++i) acc = std::max(acc, original.distance(surf[i]));
-          return acc;
-        },
-        [](double a, double b) { return std::max(a, b); });
+    r.hausdorff = 0.0;
+    for (const ClosestHit& h : original.closest_batch(surf, std::numeric_limits<double>::infinity()))
+      r.hausdorff = std::max(r.hausdorff, h.distance);
 
     // Lost space (blocked projections): largest ball inside the simplified solid and
     // outside the original, probed on a grid.
@@ -833,17 +913,18 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
       r.lost_space_radius = tbb::parallel_reduce(
           tbb::blocked_range<std::size_t>(0, total, 256), 0.0,
           [&](const auto& rg, double acc) {
-            CGAL::Side_of_triangle_mesh<SM, K3, CGAL::Default, Tree> side(*original.tree);
             for (std::size_t i = rg.begin(); i != rg.end(); ++i) {
               const std::size_t ix = i % nx, iy = (i / nx) % ny, iz = i / (static_cast<std::size_t>(nx) * ny);
               const Vec3 p = box.min + Vec3((ix + 0.5) * ext.x() / nx, (iy + 0.5) * ext.y() / ny,
                                             (iz + 0.5) * ext.z() / nz);
+              // Outside the solid (or on it) the depth is ≤ 0 ≤ acc: skip the distances.
+              if (!solid->contains(p)) continue;
               const double depth = -solid->distance_bound(p);  // exact inside the intersection
               if (depth <= acc) continue;
-              const double d = original.distance(p);
+              const double d = original.closest(p).distance;
               const double ball = std::min(depth, d);
               if (ball <= acc) continue;
-              if (side(K3::Point_3(p.x(), p.y(), p.z())) == CGAL::ON_UNBOUNDED_SIDE) acc = ball;
+              if (!original.inside(p)) acc = ball;
             }
             return acc;
           },

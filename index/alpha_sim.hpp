@@ -183,6 +183,21 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt);
 std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimOptions& opt,
                                  std::vector<AlphaSimResult>* results);
 
+/// The samples of one projection plane (α-SIM steps 1–2), plane coordinates (p·u, p·v),
+/// snapped, each set sorted (x, then y) and unique.
+struct AlphaSimPlaneSamples {
+  std::vector<Vec2> points;  ///< the point cloud the α-shape is built on
+  std::vector<Vec2> checks;  ///< points between them that the α-shape must cover
+};
+
+/// The samples simplify_part takes in the plane of `frame` (u, v; world frame, scene units)
+/// at spacing l_max, snapped to the grid `snap`: projected vertices, edges subdivided to
+/// ≤ l_max, and the nodes (points) and cell centres (checks) of the lattice of spacing
+/// l_max inside each projected triangle, plus sub-edge midpoints and centroids (checks).
+/// lattice_bitmap = false deduplicates by sorting every point (the reference; same sets).
+AlphaSimPlaneSamples alpha_sim_plane_samples(const Mesh& mesh, const AlphaSimPrism& frame, double l_max, double snap,
+                                             bool lattice_bitmap = true);
+
 /// Dense samples of a mesh surface: vertices, edge midpoints, centroids and random points
 /// (≈ density per spacing² of area, at least two per triangle), capped at max_samples
 /// random ones; deterministic for a seed. World frame.

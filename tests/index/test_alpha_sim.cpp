@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -196,6 +197,90 @@ TEST(AlphaShape2D, CollinearPointsAreDegenerate) {
   AlphaShape2D s(pts, 5.0);
   EXPECT_TRUE(s.degenerate());
   EXPECT_EQ(s.delaunay_triangle_count(), 0u);
+}
+
+namespace {
+
+/// contains() answers points of the inside grid's flagged cells without point location:
+/// it must agree with contains_unaccelerated() (point location only, the oracle) on random
+/// points (fixed seed) and on the hard cases: points exactly on the grid's cell borders and
+/// corners, the triangulation points, and points on the region's boundary.
+void expect_inside_grid_agrees(const AlphaShape2D& s, const std::vector<Vec2>& pts, std::uint64_t seed) {
+  const auto g = s.inside_grid();
+  ASSERT_GT(g.cell, 0.0);
+  ASSERT_GT(g.inside_cells, 0u);  // the fast path is exercised
+  std::mt19937_64 rng(seed);
+  std::vector<Vec2> probes = pts;
+  const Vec2 hi = g.origin + Vec2(g.nx, g.ny) * g.cell;
+  std::uniform_real_distribution<double> ux(g.origin.x() - g.cell, hi.x() + g.cell),
+      uy(g.origin.y() - g.cell, hi.y() + g.cell), unit(0.0, 1.0);
+  for (int k = 0; k < 20000; ++k) probes.emplace_back(ux(rng), uy(rng));
+  for (int i = 0; i <= g.nx; ++i)
+    for (int j = 0; j <= g.ny; ++j) {
+      const Vec2 corner = g.origin + Vec2(i, j) * g.cell;
+      probes.push_back(corner);
+      probes.push_back(corner + Vec2(unit(rng) * g.cell, 0.0));  // on a horizontal border
+      probes.push_back(corner + Vec2(0.0, unit(rng) * g.cell));  // on a vertical border
+    }
+  for (const auto& poly : s.polygons()) {
+    auto add_ring = [&](const std::vector<Vec2>& ring) {
+      for (std::size_t i = 0; i < ring.size(); ++i) {
+        const Vec2 a = ring[i], b = ring[(i + 1) % ring.size()];
+        probes.push_back(a);
+        probes.push_back(a + 0.5 * (b - a));
+        probes.push_back(a + unit(rng) * (b - a));
+      }
+    };
+    add_ring(poly.outer);
+    for (const auto& h : poly.holes) add_ring(h);
+  }
+  std::size_t inside = 0;
+  for (const auto& p : probes)
+    for (const double tol : {0.0, 1e-9 * g.cell, 0.3 * g.cell}) {
+      const bool fast = s.contains(p, tol);
+      ASSERT_EQ(fast, s.contains_unaccelerated(p, tol)) << p.transpose() << " tol " << tol;
+      inside += fast ? 1 : 0;
+    }
+  EXPECT_GT(inside, 0u);
+}
+
+}  // namespace
+
+TEST(AlphaShape2D, InsideGridAgreesWithPointLocation) {
+  // Annulus on a grid: the inside grid's cells fall on the sample lattice, so boundary
+  // edges and samples lie exactly on cell borders.
+  std::vector<Vec2> annulus;
+  for (const auto& p : grid_points(0, 0, 20, 20, 0.5))
+    if (!(p.x() > 6 && p.x() < 14 && p.y() > 6 && p.y() < 14)) annulus.push_back(p);
+  AlphaShape2D grid_shape(annulus, 0.95);
+  expect_inside_grid_agrees(grid_shape, annulus, 11);
+
+  // Random cloud with two empty discs: a ragged boundary with holes and islands.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-10.0, 10.0);
+  std::vector<Vec2> cloud;
+  while (cloud.size() < 6000) {
+    const Vec2 p(u(rng), u(rng));
+    if ((p - Vec2(3, 3)).norm() > 2.5 && (p - Vec2(-4, -2)).norm() > 1.5) cloud.push_back(p);
+  }
+  AlphaShape2D ragged(cloud, 0.3);
+  expect_inside_grid_agrees(ragged, cloud, 12);
+  // After refine and cover (the grid is rebuilt with the region), then the convex hull.
+  const std::vector<Vec2> extra = {{3.0, 3.0}, {3.5, 2.0}, {-4.0, -2.0}, {9.99, -9.99}};
+  ragged.refine(extra, 1e-9);
+  ragged.cover(extra, 1e-9);
+  for (const auto& p : extra) EXPECT_TRUE(ragged.contains(p, 1e-9));
+  expect_inside_grid_agrees(ragged, cloud, 13);
+  ragged.keep_all();
+  expect_inside_grid_agrees(ragged, cloud, 14);
+
+  // A real projection (motor.stl seen along z), as simplify_part samples it.
+  const Mesh motor = read_mesh_file(std::filesystem::path(LOOM_SHARED_DATA) / "occt/motor.stl");
+  const double l_max = 0.015 * motor.bounds().diagonal();
+  AlphaSimPrism xy;
+  const auto smp = alpha_sim_plane_samples(motor, xy, l_max, std::exp2(-20.0));
+  AlphaShape2D proj(smp.points, 1.9 * l_max, l_max);
+  expect_inside_grid_agrees(proj, smp.checks, 15);
 }
 
 TEST(AlphaShape2D, MergeCollinearKeepsCorners) {
@@ -564,6 +649,35 @@ INSTANTIATE_TEST_SUITE_P(SharedData, AlphaSimReal,
                                            std::make_pair("occt/shape.stl", 0.03),
                                            std::make_pair("trimesh/tube.obj", 0.05),
                                            std::make_pair("trimesh/bunny.ply", 0.04)));
+
+TEST(AlphaSim, LatticeBitmapGivesTheSortedSampleSets) {
+  // The lattice nodes and cell centres are deduplicated on a bitmap; the reference sorts
+  // every point (lattice_bitmap = false). Same sets, sorted and unique, on real parts.
+  for (const char* name : {"occt/motor.stl", "trimesh/featuretype.STL", "fcl/env.obj"}) {
+    const Mesh m = read_mesh_file(std::filesystem::path(LOOM_SHARED_DATA) / name);
+    AlphaSimPrism xy, xz, yz, tilted;
+    xz.u = Vec3::UnitX(); xz.v = Vec3::UnitZ(); xz.n = -Vec3::UnitY();
+    yz.u = Vec3::UnitY(); yz.v = Vec3::UnitZ(); yz.n = Vec3::UnitX();
+    tilted.n = Vec3(1, 2, 3).normalized();
+    tilted.u = tilted.n.cross(Vec3::UnitX()).normalized();
+    tilted.v = tilted.n.cross(tilted.u);
+    const double diag = m.bounds().diagonal();
+    const double snap = std::exp2(std::floor(std::log2(1e-6 * diag / 4.0)));
+    for (const double l_max : {0.01 * diag, 0.037 * diag})
+      for (const auto* pr : {&xy, &xz, &yz, &tilted}) {
+        const auto fast = alpha_sim_plane_samples(m, *pr, l_max, snap, true);
+        const auto ref = alpha_sim_plane_samples(m, *pr, l_max, snap, false);
+        ASSERT_EQ(fast.points.size(), ref.points.size()) << name;
+        ASSERT_EQ(fast.checks.size(), ref.checks.size()) << name;
+        EXPECT_TRUE(fast.points == ref.points) << name;
+        EXPECT_TRUE(fast.checks == ref.checks) << name;
+        auto less = [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); };
+        EXPECT_TRUE(std::adjacent_find(fast.points.begin(), fast.points.end(),
+                                       [&](const Vec2& a, const Vec2& b) { return !less(a, b); }) == fast.points.end());
+        EXPECT_GT(fast.points.size(), m.vertices.size() / 8);
+      }
+  }
+}
 
 // ---------------------------------------------------------- determinism, indices
 
