@@ -8,15 +8,18 @@
 // Writes bench/results/audit*.csv and charts (gnuplot). Fixed seeds.
 //
 //   bench_audit [--quick]      (--quick: smaller scenes, for a smoke run)
-//   bench_audit --probe TRIS_PER_PART [THREADS]   (one audit of the triangle-scaling scene)
+//   bench_audit --probe TRIS_PER_PART [THREADS [BUILD_QUALITY]]   (one audit of the
+//                triangle-scaling scene; BUILD_QUALITY as EmbreeOptions, -1 = automatic)
 #include "index/embree_index.hpp"
 #include "routing/clash_check.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <ctime>
+#include <optional>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -192,16 +195,112 @@ void gnuplot(const std::string& script) {
   std::filesystem::remove(path);
 }
 
+/// Forwards every query to an index and adds up, per method, the calls and the thread CPU
+/// time spent in them (single-threaded probes only: the sums are not synchronised).
+class SplitIndex : public ObstacleIndex {
+ public:
+  /// The methods timed, in report order.
+  enum Kind { kClosest, kSegmentClosest, kClosestOnPart, kInside, kOther, kKinds };
+  explicit SplitIndex(const ObstacleIndex& inner) : inner_(inner) {}
+  std::string name() const override { return inner_.name(); }
+  IndexAccuracy accuracy() const override { return inner_.accuracy(); }
+  int part_count() const override { return inner_.part_count(); }
+  std::optional<AABB> part_bounds(int part) const override { return inner_.part_bounds(part); }
+  ClosestHit closest(const Vec3& p, double r) const override {
+    return timed(kClosest, [&] { return inner_.closest(p, r); });
+  }
+  ClosestHit closest_on_part(const Vec3& p, int part, double r) const override {
+    return timed(kClosestOnPart, [&] { return inner_.closest_on_part(p, part, r); });
+  }
+  bool inside(const Vec3& p, int* part) const override {
+    return timed(kInside, [&] { return inner_.inside(p, part); });
+  }
+  RayHit ray(const Vec3& o, const Vec3& d, double t) const override {
+    return timed(kOther, [&] { return inner_.ray(o, d, t); });
+  }
+  bool any_within(const Vec3& p, double r) const override {
+    return timed(kOther, [&] { return inner_.any_within(p, r); });
+  }
+  bool segment_within(const Vec3& a, const Vec3& b, double r) const override {
+    return timed(kOther, [&] { return inner_.segment_within(a, b, r); });
+  }
+  ClosestHit segment_closest(const Vec3& a, const Vec3& b, double r, double* t) const override {
+    return timed(kSegmentClosest, [&] { return inner_.segment_closest(a, b, r, t); });
+  }
+  /// Prints calls and CPU ms per method.
+  void print() const {
+    const char* names[kKinds] = {"closest", "segment_closest", "closest_on_part", "inside", "other"};
+    for (int k = 0; k < kKinds; ++k)
+      if (calls_[k] > 0)
+        std::printf("  %-16s %7lld calls %8.1f cpu ms %6.2f us/call\n", names[k], calls_[k], ms_[k],
+                    1000.0 * ms_[k] / static_cast<double>(calls_[k]));
+  }
+
+ private:
+  static double thread_ms() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
+  }
+  template <class F>
+  auto timed(Kind k, const F& f) const -> decltype(f()) {
+    const double t0 = thread_ms();
+    auto out = f();
+    ms_[k] += thread_ms() - t0;
+    ++calls_[k];
+    return out;
+  }
+  const ObstacleIndex& inner_;
+  mutable double ms_[kKinds] = {};
+  mutable long long calls_[kKinds] = {};
+};
+
+/// FNV-1a over everything an audit reports (clashes, violations, per-cable summaries,
+/// counters), bit for bit: two runs with the same digest gave the same report.
+std::uint64_t result_digest(const ClashResult& r) {
+  std::uint64_t h = 1469598103934665603ull;
+  auto add = [&](const void* p, std::size_t n) {
+    for (std::size_t i = 0; i < n; ++i) h = (h ^ static_cast<const unsigned char*>(p)[i]) * 1099511628211ull;
+  };
+  auto num = [&](double v) { add(&v, sizeof v); };
+  auto vec = [&](const Vec3& v) { num(v.x()), num(v.y()), num(v.z()); };
+  for (const auto& e : r.clashes) {
+    const int ints[] = {static_cast<int>(e.kind), e.cable, e.part, e.other, e.keep_out, e.inside};
+    add(ints, sizeof ints);
+    for (double v : {e.clearance, e.s, e.s_other, e.s_begin, e.s_end}) num(v);
+    vec(e.point);
+  }
+  for (const auto& v : r.violations) {
+    const int ints[] = {static_cast<int>(v.kind), v.cable, v.part};
+    add(ints, sizeof ints);
+    for (double x : {v.value, v.limit, v.s}) num(x);
+    vec(v.point);
+  }
+  for (const auto& c : r.cables) {
+    for (double x : {c.length, c.min_clearance, c.min_bend_radius, c.min_bend_s}) num(x);
+    const int e = c.min_clearance_exact;
+    add(&e, sizeof e);
+  }
+  const std::int64_t cnt[] = {r.counters.distance_queries, r.counters.inside_queries, r.counters.pair_tests,
+                              r.counters.samples};
+  add(cnt, sizeof cnt);
+  return h;
+}
+
 /// One certified audit of the triangle-scaling scene (seed 7: the same 200 parts and 100
 /// cables at every size, only the tessellation changes) with `tris_per_part` triangles per
 /// part, for CPU time and instruction counts: `valgrind --tool=callgrind bench_audit --probe
 /// N`, then the inclusive count of loom::check_clashes in callgrind_annotate --inclusive=yes
 /// (a --toggle-collect on it would be toggled off again by its own nested lambdas). The
-/// audit runs twice: the first run pays for anything the index builds lazily.
-int probe(int tris_per_part, int threads) {
+/// audit runs twice: the first run pays for anything the index builds lazily. A third,
+/// single-threaded run through SplitIndex prints CPU time per index method. The digest
+/// identifies the whole report (it must not change when only the speed does).
+int probe(int tris_per_part, int threads, int build_quality) {
   const BenchScene sc = make_scene(200, tris_per_part, 100, 1.0, 7);
   const double b0 = cpu_ms();
-  const EmbreeIndex idx(sc.parts);
+  EmbreeOptions eo;
+  eo.build_quality = build_quality;
+  const EmbreeIndex idx(sc.parts, eo);
   const double index_cpu = cpu_ms() - b0;
   ClashRequest req;
   req.routing_clearance = 3.0;
@@ -212,10 +311,17 @@ int probe(int tris_per_part, int threads) {
   const double c1 = cpu_ms();
   check_clashes(sc.cables, sc.parts, &idx, req);  // again: what is left once the index is warm
   std::printf("probe: %zu triangles, %d threads: index cpu %.1f ms, audit cpu %.1f ms (again %.1f ms), %lld distance queries, %lld inside queries, %lld samples, "
-              "%zu clashes, %zu violations\n",
+              "%zu clashes, %zu violations, digest %016llx\n",
               sc.triangles, threads, index_cpu, first, cpu_ms() - c1, static_cast<long long>(r.counters.distance_queries),
               static_cast<long long>(r.counters.inside_queries), static_cast<long long>(r.counters.samples),
-              r.clashes.size(), r.violations.size());
+              r.clashes.size(), r.violations.size(), static_cast<unsigned long long>(result_digest(r)));
+  const SplitIndex split(idx);
+  req.threads = 1;
+  const double c2 = cpu_ms();
+  const ClashResult rs = check_clashes(sc.cables, sc.parts, &split, req);
+  std::printf("split (1 thread, timer overhead included): audit cpu %.1f ms, digest %016llx\n", cpu_ms() - c2,
+              static_cast<unsigned long long>(result_digest(rs)));
+  split.print();
   return 0;
 }
 
@@ -227,7 +333,8 @@ int main(int argc, char** argv) {
   std::filesystem::create_directories(dir);
   const int base_parts = quick ? 40 : 200, base_cables = quick ? 20 : 100, tris = 7500;
 
-  if (argc > 2 && std::string(argv[1]) == "--probe") return probe(std::atoi(argv[2]), argc > 3 ? std::atoi(argv[3]) : 1);
+  if (argc > 2 && std::string(argv[1]) == "--probe")
+    return probe(std::atoi(argv[2]), argc > 3 ? std::atoi(argv[3]) : 1, argc > 4 ? std::atoi(argv[4]) : -1);
   const bool breakdown_only = argc > 1 && std::string(argv[1]) == "--breakdown";
   {
     // Where the certified time goes (each check kind alone), paper-scale scene.

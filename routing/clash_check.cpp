@@ -42,6 +42,10 @@ constexpr std::size_t kBlock = 8;
 /// Arc-length slack (relative to the cable length) when deciding that two chord or sample
 /// intervals touch.
 constexpr double kTouchRel = 1e-9;
+/// A sphere-tracing query cut short at the distance a decision needs stops this much
+/// (relative to the largest query radius) beyond it, so that rounding does not leave the
+/// bound a hair short of the decision.
+constexpr double kCutMarginRel = 1e-9;
 
 std::int64_t as_i64(std::size_t v) { return static_cast<std::int64_t>(v); }
 
@@ -320,22 +324,33 @@ class StructureTracer {
     leaf_ = std::max(kLeafRadii * r_, 4.0 * ctx.tol);
     max_step_ = ctx.req.max_step > 0.0 ? ctx.req.max_step : kDefaultMaxStepRadii * r_;
     max_step_ = std::max(max_step_, leaf_);
+    cut_margin_ = ctx.abs_err + kCutMarginRel * (thr_ + max_step_);
   }
 
   void run() {
     const ObstacleIndex& idx = *ctx_.index;
+    const double cap = thr_ + max_step_;  // the largest query radius
     // Inside status at the start; it can only change where the trace is not proven clear.
-    Sample s0 = sample(0.0, thr_ + max_step_);
+    Sample s0 = sample(0.0, cap, thr_ + 0.5 * max_step_ + cut_margin_);
     inside_part_ = -1;
     ++count_.inside_queries;
     if (!idx.inside(s0.p, &inside_part_)) inside_part_ = -1;
     Sample a = s0;
     double s_prev = 0.0;
     while (s_prev < L_) {
+      // A cut-short sample's bound gives the same step and radius once they reach their
+      // caps (both grow with d); otherwise a higher bound, or its value, is needed now.
+      const double reach_cap = cap - std::min(L_ - s_prev, max_step_);  // a.d that caps the radius
+      refresh(a);
+      tighten(a, std::max(thr_ + 0.5 * max_step_, reach_cap));
+      if (a.pending >= 0 && (2.0 * (a.d - thr_) < max_step_ || a.d + std::min(L_ - s_prev, max_step_) < cap))
+        resolve(a);
       const double rho = a.d - thr_;
       const double step = std::clamp(2.0 * rho, leaf_, max_step_);
       const double s_next = std::min(L_, s_prev + step);
-      Sample b = sample(s_next, std::min(a.d + (s_next - s_prev), thr_ + max_step_));
+      // Enough for b: its own step and radius at their caps, and [a, b] proven clear.
+      const double enough = std::max(thr_ + 0.5 * max_step_, 2.0 * thr_ + (s_next - s_prev) - a.d) + cut_margin_;
+      Sample b = sample(s_next, std::min(a.d + (s_next - s_prev), cap), enough);
       refine(a, b);
       a = b;
       s_prev = s_next;
@@ -343,6 +358,7 @@ class StructureTracer {
     flush_free();
     tracker_.flush();
     summary_min_ = std::min(summary_min_, tracker_.min_key);
+    settle_pending();
     ctx_.counters.add(count_);
   }
 
@@ -353,25 +369,137 @@ class StructureTracer {
  private:
   struct Sample {
     double s = 0.0;
-    double d = 0.0;  ///< lower bound on the distance to any part surface (≤ its query radius)
+    /// Lower bound on the distance to any part surface (≤ its query radius): the query's
+    /// own value, or, while `pending` ≥ 0, a bound on it (the query was cut short).
+    double d = 0.0;
     Vec3 p = Vec3::Zero();
+    int pending = -1;  ///< index into pending_ while d is only a bound on the query's value
   };
 
-  Sample sample(double s, double radius) {
+  /// A sample whose closest-point query stopped at `reach` (no surface that close): its
+  /// full query (radius `radius`) is run only if a decision needs its value (resolve()).
+  struct Pending {
+    double s = 0.0;
+    Vec3 p = Vec3::Zero();
+    double radius = 0.0;  ///< radius of the full query
+    double reach = 0.0;   ///< no surface within this distance
+    bool resolved = false;
+    double d = 0.0;       ///< the sample's d once resolved
+  };
+
+  /// Sample at arc length s with a closest-point query of the given radius (the Lipschitz
+  /// upper bound). When the caller can go on with any d ≥ `enough` − abs_err, the query
+  /// stops at `enough`: far from every surface that costs a few BVH nodes instead of the
+  /// leaves around the nearest one, and the value is computed later only if needed. Every
+  /// decision taken on a bound is the one the value would give (all grow with d), so the
+  /// audit's results do not change; the sample counts as one distance query either way.
+  Sample sample(double s, double radius, double enough) {
     Sample x;
     x.s = s;
     x.p = in_.curve.position(in_.curve.parameter_at_length(s));
     ++count_.samples;
     ++count_.distance_queries;
-    const ClosestHit h = ctx_.index->closest(x.p, radius);
-    x.d = h.found() ? std::max(0.0, h.distance - ctx_.abs_err) : std::max(0.0, radius - ctx_.abs_err);
-    if (h.found() && !is_attached(in_.attachments, h.part, s)) summary_min_ = std::min(summary_min_, h.distance - r_);
+    if (ctx_.req.cut_short_queries && enough < radius) {
+      // Found within `enough`: the nearest surface, so the full query's very answer.
+      const ClosestHit h = ctx_.index->closest(x.p, enough);
+      if (!h.found()) {
+        pending_.push_back({s, x.p, radius, enough, false, 0.0});
+        x.pending = static_cast<int>(pending_.size()) - 1;
+        x.d = std::max(0.0, enough - ctx_.abs_err);
+        return x;
+      }
+      x.d = take(h, s, radius);
+      return x;
+    }
+    x.d = take(ctx_.index->closest(x.p, radius), s, radius);
     return x;
   }
 
+  /// The d of a sample at s whose query of the given radius answered h; counts h towards
+  /// the cable's smallest sampled clearance.
+  double take(const ClosestHit& h, double s, double radius) {
+    if (h.found() && !is_attached(in_.attachments, h.part, s)) summary_min_ = std::min(summary_min_, h.distance - r_);
+    return h.found() ? std::max(0.0, h.distance - ctx_.abs_err) : std::max(0.0, radius - ctx_.abs_err);
+  }
+
+  /// Brings a copy of a sample up to date with what is known of its query since.
+  void refresh(Sample& x) const {
+    if (x.pending < 0) return;
+    const Pending& pd = pending_[x.pending];
+    if (pd.resolved) {
+      x.d = pd.d;
+      x.pending = -1;
+    } else {
+      x.d = std::max(x.d, std::max(0.0, pd.reach - ctx_.abs_err));
+    }
+  }
+
+  /// Raises a cut-short sample's bound to `need` (d units) with a query cut short there,
+  /// or finds its value on the way (the nearest surface is then within the cut).
+  void tighten(Sample& x, double need) {
+    if (x.pending < 0 || x.d >= need) return;
+    Pending& pd = pending_[x.pending];
+    const double reach = need + cut_margin_;
+    if (!(reach < pd.radius)) {
+      resolve(x);
+      return;
+    }
+    const ClosestHit h = ctx_.index->closest(pd.p, reach);
+    if (h.found()) {
+      pd.d = take(h, pd.s, pd.radius);
+      pd.resolved = true;
+      x.d = pd.d;
+      x.pending = -1;
+      return;
+    }
+    pd.reach = reach;
+    x.d = std::max(0.0, reach - ctx_.abs_err);
+  }
+
+  /// Replaces a cut-short sample's bound with its query's value (run once per sample).
+  void resolve(Sample& x) {
+    if (x.pending < 0) return;
+    Pending& pd = pending_[x.pending];
+    if (!pd.resolved) {
+      pd.d = take(ctx_.index->closest(pd.p, pd.radius), pd.s, pd.radius);
+      pd.resolved = true;
+    }
+    x.d = pd.d;
+    x.pending = -1;
+  }
+
+  /// The cut-short samples never resolved count towards the smallest sampled clearance only
+  /// if they can lower it: their distance exceeds `reach`, and a query bounded by the
+  /// current minimum (+ margin, which covers rounding) finds the same nearest surface as
+  /// their full query whenever it is below that bound.
+  void settle_pending() {
+    for (Pending& pd : pending_) {
+      if (pd.resolved || pd.reach - r_ >= summary_min_) continue;
+      const double bound = std::min(pd.radius, summary_min_ + r_ + margin_);
+      const ClosestHit h = ctx_.index->closest(pd.p, bound);
+      if (h.found() && !is_attached(in_.attachments, h.part, pd.s)) summary_min_ = std::min(summary_min_, h.distance - r_);
+    }
+    pending_.clear();
+  }
+
   /// Lipschitz bisection of [a, b]: clear, or a leaf handed to the exact measurement.
-  void refine(const Sample& a, const Sample& b) {
+  void refine(Sample a, Sample b) {
+    refresh(a);
+    refresh(b);
     const double h = b.s - a.s;
+    if (0.5 * (a.d + b.d - h) >= thr_) {  // also when a bound stands for d: d only adds
+      free_.push_back(a);
+      return;
+    }
+    // Bounds too low for this decision: raise them to what it needs first.
+    tighten(a, 2.0 * thr_ + h - b.d);
+    tighten(b, 2.0 * thr_ + h - a.d);
+    if (0.5 * (a.d + b.d - h) >= thr_) {
+      free_.push_back(a);
+      return;
+    }
+    resolve(a);
+    resolve(b);
     const double lb = 0.5 * (a.d + b.d - h);
     if (lb >= thr_) {
       free_.push_back(a);
@@ -382,7 +510,9 @@ class StructureTracer {
       return;
     }
     const double sm = 0.5 * (a.s + b.s);
-    const Sample m = sample(sm, std::min(std::min(a.d, b.d) + 0.5 * h, thr_ + max_step_));
+    const double dmin = std::min(a.d, b.d);
+    // Enough for m: both halves proven clear at once.
+    const Sample m = sample(sm, std::min(dmin + 0.5 * h, thr_ + max_step_), 2.0 * thr_ + 0.5 * h - dmin + cut_margin_);
     refine(a, m);
     refine(m, b);
   }
@@ -392,7 +522,9 @@ class StructureTracer {
   void flush_free() {
     // Free samples only matter while the trace is inside a closed part.
     if (inside_part_ >= 0) {
-      for (const Sample& f : free_) {
+      for (Sample& f : free_) {
+        refresh(f);
+        resolve(f);
         PartObservation o;
         o.part = inside_part_;
         o.key = -r_ - f.d;
@@ -525,8 +657,10 @@ class StructureTracer {
   double r_;
   StretchTracker tracker_;
   double L_ = 0.0, thr_ = 0.0, leaf_ = 0.0, max_step_ = 0.0, margin_ = 0.0;
+  double cut_margin_ = 0.0;  ///< added to a cut-short query's radius: d = max(0, hit − abs_err) and rounding
   int inside_part_ = -1;
   std::vector<Sample> free_;
+  std::vector<Pending> pending_;  ///< cut-short samples of this cable
   double summary_min_ = kInf;
   ClashCounters count_;
 };

@@ -508,6 +508,22 @@ struct MissCount {
 };
 MissCount g_miss;
 
+/// Cable "C<i>": a cubic through n random control points in [0, extent], radius 0.5–2
+/// (coordinates drawn x, y, z in sequence: the same scene whatever the compiler's argument order).
+CableInput random_cable(std::mt19937& rng, int i, int n, const Vec3& extent) {
+  std::uniform_real_distribution<double> U(0, 1);
+  std::vector<Vec3> pts;
+  for (int k = 0; k < n; ++k) {
+    const double x = extent.x() * U(rng), y = extent.y() * U(rng), z = extent.z() * U(rng);
+    pts.emplace_back(x, y, z);
+  }
+  CableInput c;
+  c.id = "C" + std::to_string(i);
+  c.radius = 0.5 + 1.5 * U(rng);
+  c.curve = cubic_from_controls(pts);
+  return c;
+}
+
 /// Returns a description of every disagreement with the oracle (empty: none).
 std::string random_scene_check(std::uint32_t seed) {
   std::string fail;
@@ -527,15 +543,7 @@ std::string random_scene_check(std::uint32_t seed) {
   if (parts.empty()) parts.push_back(box_part("p0", {5, 5, 5}, {8, 8, 8}));
   std::vector<CableInput> cables;
   const int nc = 2 + static_cast<int>(U(rng) * 2);
-  for (int i = 0; i < nc; ++i) {
-    std::vector<Vec3> pts;
-    for (int k = 0; k < 5; ++k) pts.emplace_back(60 * U(rng), 60 * U(rng), 20 * U(rng));
-    CableInput c;
-    c.id = "C" + std::to_string(i);
-    c.radius = 0.5 + 1.5 * U(rng);
-    c.curve = cubic_from_controls(pts);
-    cables.push_back(c);
-  }
+  for (int i = 0; i < nc; ++i) cables.push_back(random_cable(rng, i, 5, Vec3(60, 60, 20)));
   const double tol = 0.02;
   auto cert = run(cables, parts, ClashMethod::Certified, tol, IndexKind::Embree);
   auto disc = run(cables, parts, ClashMethod::Discrete, tol, IndexKind::Embree);
@@ -591,6 +599,99 @@ TEST(ClashRandom, DiscreteMissesAreCounted) {
   std::printf("random scenes: %d true clashes, discrete missed %d\n", g_miss.truth_clashes, g_miss.discrete_missed);
   EXPECT_GT(g_miss.truth_clashes, 0);
   EXPECT_GT(g_miss.discrete_missed, 0) << "the discrete method is expected to miss some clashes";
+}
+
+// ---------------------------------------------------------------------------------------
+// Cut-short sphere-tracing queries: the same report, bit for bit, as full queries.
+
+/// Every field of two reports, compared exactly ("" when identical).
+std::string report_difference(const ClashResult& x, const ClashResult& y) {
+  if (x.clashes.size() != y.clashes.size()) return "clash count";
+  for (std::size_t i = 0; i < x.clashes.size(); ++i) {
+    const ClashEntry &a = x.clashes[i], &b = y.clashes[i];
+    if (a.kind != b.kind || a.cable != b.cable || a.part != b.part || a.other != b.other ||
+        a.clearance != b.clearance || a.point != b.point || a.s != b.s || a.s_other != b.s_other ||
+        a.s_begin != b.s_begin || a.s_end != b.s_end || a.keep_out != b.keep_out || a.inside != b.inside)
+      return "clash " + std::to_string(i);
+  }
+  if (x.violations.size() != y.violations.size()) return "violation count";
+  for (std::size_t i = 0; i < x.violations.size(); ++i) {
+    const Violation &a = x.violations[i], &b = y.violations[i];
+    if (a.kind != b.kind || a.cable != b.cable || a.part != b.part || a.value != b.value || a.limit != b.limit ||
+        a.s != b.s || a.point != b.point)
+      return "violation " + std::to_string(i);
+  }
+  if (x.cables.size() != y.cables.size()) return "cable count";
+  for (std::size_t i = 0; i < x.cables.size(); ++i) {
+    const CableCheckSummary &a = x.cables[i], &b = y.cables[i];
+    if (a.length != b.length || a.min_clearance != b.min_clearance || a.min_clearance_exact != b.min_clearance_exact ||
+        a.min_bend_radius != b.min_bend_radius || a.min_bend_s != b.min_bend_s)
+      return "cable summary " + std::to_string(i);
+  }
+  const ClashCounters &a = x.counters, &b = y.counters;
+  if (a.distance_queries != b.distance_queries || a.inside_queries != b.inside_queries ||
+      a.pair_tests != b.pair_tests || a.samples != b.samples)
+    return "counters";
+  return "";
+}
+
+/// The certified audit with and without cut-short queries (same index, one thread).
+std::string cut_short_difference(const std::vector<CableInput>& cables, const std::vector<Part>& parts,
+                                 double clearance) {
+  const EmbreeIndex index(parts);
+  ClashRequest req;
+  req.tolerance = kTol;
+  req.routing_clearance = clearance;
+  req.threads = 1;
+  const ClashResult cut = check_clashes(cables, parts, &index, req);
+  req.cut_short_queries = false;
+  const ClashResult full = check_clashes(cables, parts, &index, req);
+  return report_difference(cut, full);
+}
+
+TEST(ClashCutShort, FarCableKeepsItsSmallestSampledClearance) {
+  // Every sample is farther from the box than its cut (thr + max_step / 2 ≈ 26): the
+  // smallest sampled clearance comes from samples whose full query is run only at the end.
+  const std::vector<Part> parts{box_part("box", {0, 0, 0}, {10, 10, 10})};
+  const std::vector<CableInput> cables{straight_cable("C", {-300, 5, 60}, {300, 5, 60}, kR)};
+  EXPECT_EQ(cut_short_difference(cables, parts, 0.0), "");
+  const ClashResult r = run(cables, parts, ClashMethod::Certified, kTol);
+  ASSERT_EQ(r.cables.size(), 1u);
+  // Oracle: the exact clearance is 50 − r; samples are at most max_step = 50 r apart, so
+  // the smallest sampled one is within 25 r (Lipschitz) of it along the cable.
+  const double truth = oracle_structure(dense(cables[0].curve, 0.5), kR, parts[0]);
+  EXPECT_NEAR(truth, 50.0 - kR, 1e-9);
+  EXPECT_GE(r.cables[0].min_clearance, truth - kTol);
+  EXPECT_LE(r.cables[0].min_clearance, std::hypot(50.0, 25.0 * kR) - kR + kTol);
+  EXPECT_FALSE(r.cables[0].min_clearance_exact);
+}
+
+TEST(ClashCutShort, InsideAHullAndAlongPartsTheReportIsUnchanged) {
+  // Free stretches inside a closed part (their depth needs the full queries), a wall crossed,
+  // parts passed at a distance within and beyond the clearance band.
+  const std::vector<Part> parts{box_part("hull", {-100, -100, -100}, {100, 100, 100}),
+                                box_part("wall", {150, -50, -50}, {154, 50, 50}),
+                                box_part("near", {200, 4, -5}, {260, 10, 5}),
+                                box_part("far", {300, 40, -5}, {360, 50, 5})};
+  const std::vector<CableInput> cables{straight_cable("A", {-60, 0, 0}, {400, 0, 0}, kR),
+                                       straight_cable("B", {-300, 20, 0}, {500, 20, 0}, 2 * kR)};
+  for (double clearance : {0.0, 3.0}) EXPECT_EQ(cut_short_difference(cables, parts, clearance), "") << clearance;
+}
+
+TEST(ClashCutShort, RandomScenesGiveTheSameReport) {
+  // Boxes in a 200 × 200 × 60 volume and wandering cubic cables (fixed seeds).
+  for (std::uint32_t seed = 1; seed <= 20; ++seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> U(0, 1);
+    std::vector<Part> parts;
+    for (int i = 0; i < 8; ++i) {
+      const Vec3 lo(200 * U(rng), 200 * U(rng), 60 * U(rng));
+      parts.push_back(box_part("p" + std::to_string(i), lo, lo + Vec3(2 + 20 * U(rng), 2 + 20 * U(rng), 2 + 20 * U(rng))));
+    }
+    std::vector<CableInput> cables;
+    for (int i = 0; i < 3; ++i) cables.push_back(random_cable(rng, i, 6, Vec3(200, 200, 60)));
+    EXPECT_EQ(cut_short_difference(cables, parts, seed % 2 == 0 ? 2.0 : 0.0), "") << "seed " << seed;
+  }
 }
 
 // ---------------------------------------------------------------------------------------
