@@ -151,19 +151,51 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
+/// One edge of a mesh (a < b) and the third corners of the triangles that share it.
+struct MeshEdge {
+  std::uint32_t a = 0, b = 0;
+  std::array<std::uint32_t, 2> opposite{};  ///< valid for the first min(triangles, 2)
+  std::uint32_t triangles = 0;              ///< triangles sharing the edge
+};
+
 /// Unique edges of a mesh's triangles (a < b), sorted: shared edges are subdivided once.
-std::vector<std::pair<std::uint32_t, std::uint32_t>> unique_edges(const Mesh& mesh) {
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
-  edges.reserve(mesh.triangles.size() * 3);
+std::vector<MeshEdge> unique_edges(const Mesh& mesh) {
+  std::vector<std::array<std::uint32_t, 3>> half;  // (a, b, opposite corner)
+  half.reserve(mesh.triangles.size() * 3);
   for (const auto& f : mesh.triangles)
     for (int k = 0; k < 3; ++k) {
       auto a = f[k], b = f[(k + 1) % 3];
       if (a > b) std::swap(a, b);
-      edges.emplace_back(a, b);
+      half.push_back({a, b, f[(k + 2) % 3]});
     }
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  std::sort(half.begin(), half.end());
+  std::vector<MeshEdge> edges;
+  for (const auto& h : half) {
+    if (edges.empty() || edges.back().a != h[0] || edges.back().b != h[1]) edges.push_back({h[0], h[1], {}, 0});
+    MeshEdge& e = edges.back();
+    if (e.triangles < 2) e.opposite[e.triangles] = h[2];
+    ++e.triangles;
+  }
   return edges;
+}
+
+/// True if the projected edge pa–pb lies inside the projection of its two triangles:
+/// exactly two share it and their third corners project strictly to opposite sides.
+/// Such an edge is no part of the projection's outline, and the lattice nodes of the two
+/// triangles already sample the area around it; every other edge (an outline or fold
+/// seen in this plane, a border of an open mesh, a non-manifold or an edge-on one) is
+/// subdivided.
+bool interior_in_projection(const MeshEdge& e, const std::vector<Vec2>& proj) {
+  if (e.triangles != 2) return false;
+  const Vec2 pa = proj[e.a], pb = proj[e.b], ab = pb - pa;
+  auto side = [&](std::uint32_t c) {
+    const Vec2 ac = proj[c] - pa;
+    const double o = ab.x() * ac.y() - ab.y() * ac.x();
+    // Orientation well above its rounding error, or "on the line" (0).
+    const double scale = (std::abs(ab.x()) + std::abs(ab.y())) * (std::abs(ac.x()) + std::abs(ac.y()));
+    return o > 1e-12 * scale ? 1 : o < -1e-12 * scale ? -1 : 0;
+  };
+  return side(e.opposite[0]) * side(e.opposite[1]) < 0;
 }
 
 /// Calls emit(i, j) for each lattice point ((i + offset)·h, (j + offset)·h) of spacing h
@@ -196,11 +228,11 @@ void lattice_in_triangle(const Vec2& a, const Vec2& b, const Vec2& c, double h, 
 }
 
 /// Upper bound on the samples of one plane (before removing duplicates).
-double plane_sample_estimate(const Mesh& mesh, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges,
+double plane_sample_estimate(const Mesh& mesh, const std::vector<MeshEdge>& edges,
                              const AlphaSimPrism& pr, double l_max) {
   double n = static_cast<double>(mesh.vertices.size());
-  for (const auto& [a, b] : edges)
-    n += std::ceil((pr.project(mesh.vertices[a]) - pr.project(mesh.vertices[b])).norm() / l_max);
+  for (const auto& e : edges)
+    n += std::ceil((pr.project(mesh.vertices[e.a]) - pr.project(mesh.vertices[e.b])).norm() / l_max);
   for (const auto& f : mesh.triangles) {
     const Vec2 a = pr.project(mesh.vertices[f[0]]), b = pr.project(mesh.vertices[f[1]]),
                c = pr.project(mesh.vertices[f[2]]);
@@ -290,7 +322,8 @@ void merge_unique(std::vector<Vec2>& sorted, const std::vector<Vec2>& more) {
 }
 
 /// The paper's point cloud (step 1), sampled directly in one projection plane (step 2):
-/// the projected vertices, the projected edges subdivided to pieces ≤ L_max, and the nodes
+/// the projected vertices, the projected outline edges subdivided to pieces ≤ L_max (an
+/// edge inside the projection of its two triangles is not: the lattice covers it), and the nodes
 /// of a lattice of spacing L_max (aligned to the plane origin, so that overlapping
 /// triangles share nodes) inside each projected triangle. The projected surface is then
 /// sampled about as densely as by a 3D subdivision of edge ≤ L_max (projection only
@@ -301,7 +334,7 @@ void merge_unique(std::vector<Vec2>& sorted, const std::vector<Vec2>& more) {
 /// Coordinates are snapped to the grid `snap`; points and checks are sorted and unique.
 /// lattice_bitmap = false sorts every point (no LatticeBitmap): the same sets, slower.
 AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
-                                       const std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges,
+                                       const std::vector<MeshEdge>& edges,
                                        const AlphaSimPrism& pr, double l_max, double snap, bool lattice_bitmap) {
   AlphaSimPlaneSamples s;
   auto snapped = [snap](const Vec2& q) { return Vec2(std::round(q.x() / snap) * snap, std::round(q.y() / snap) * snap); };
@@ -319,15 +352,21 @@ AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
   }
   // Edges with the same projected ends in the same direction (front and back faces of a
   // plate seen edge-on) give the same points: each is subdivided once.
-  std::vector<std::array<double, 4>> ends;
+  // The fifth entry is 1 when the edge is to be subdivided (see interior_in_projection);
+  // sorted after the ends, the last of equal ends says whether any of them is.
+  std::vector<std::array<double, 5>> ends;
   ends.reserve(edges.size());
-  for (const auto& [a, b] : edges) ends.push_back({proj[a].x(), proj[a].y(), proj[b].x(), proj[b].y()});
+  for (const auto& e : edges)
+    ends.push_back({proj[e.a].x(), proj[e.a].y(), proj[e.b].x(), proj[e.b].y(),
+                    interior_in_projection(e, proj) ? 0.0 : 1.0});
   std::sort(ends.begin(), ends.end());
-  ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
-  for (const auto& e : ends) {
+  for (std::size_t i = 0; i < ends.size(); ++i) {
+    const auto& e = ends[i];
+    if (i + 1 < ends.size() && std::equal(e.begin(), e.begin() + 4, ends[i + 1].begin())) continue;
     const Vec2 pa(e[0], e[1]), pb(e[2], e[3]);
     const int n = std::max(1, static_cast<int>(std::ceil((pb - pa).norm() / l_max)));
-    for (int k = 1; k < n; ++k) s.points.push_back(snapped(pa + (pb - pa) * (static_cast<double>(k) / n)));
+    if (e[4] != 0.0)
+      for (int k = 1; k < n; ++k) s.points.push_back(snapped(pa + (pb - pa) * (static_cast<double>(k) / n)));
     for (int k = 0; k < n; ++k) s.checks.push_back(snapped(pa + (pb - pa) * ((k + 0.5) / n)));
   }
   const std::size_t max_bits = lattice_bitmap ? kMaxLatticeBitmapBits : 0;

@@ -191,8 +191,9 @@ struct AlphaSimPlaneSamples {
 };
 
 /// The samples simplify_part takes in the plane of `frame` (u, v; world frame, scene units)
-/// at spacing l_max, snapped to the grid `snap`: projected vertices, edges subdivided to
-/// ≤ l_max, and the nodes (points) and cell centres (checks) of the lattice of spacing
+/// at spacing l_max, snapped to the grid `snap`: projected vertices, outline edges (all but
+/// those inside the projection of their two triangles) subdivided to ≤ l_max, and the
+/// nodes (points) and cell centres (checks) of the lattice of spacing
 /// l_max inside each projected triangle, plus sub-edge midpoints and centroids (checks).
 /// lattice_bitmap = false deduplicates by sorting every point (the reference; same sets).
 AlphaSimPlaneSamples alpha_sim_plane_samples(const Mesh& mesh, const AlphaSimPrism& frame, double l_max, double snap,

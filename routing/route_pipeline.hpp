@@ -24,8 +24,8 @@ struct RouteOptions {
   long seed = -1;            ///< < 0: scene.routing.seed
   int threads = 0;           ///< audit threads (≤ 0: all cores)
   /// Plan among α-simplified obstacles (false: the exact parts). Off by default: on the
-  /// bundled wing section α-SIM costs ~1.2 s and brings no reliable gain on a ~0.3 s planning
-  /// time (−30% to +25%, bench/results/route.csv): Embree on the exact 147k triangles is
+  /// bundled wing section α-SIM costs ~1.1 s and brings no reliable gain on a ~0.3 s planning
+  /// time (−28% to +25%, bench/results/route.csv): Embree on the exact 147k triangles is
   /// already fast. Turn it on for scenes whose detail (threads, rivets) slows the planner
   /// more than simplifying costs.
   bool simplify = false;

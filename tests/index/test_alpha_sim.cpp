@@ -679,6 +679,47 @@ TEST(AlphaSim, LatticeBitmapGivesTheSortedSampleSets) {
   }
 }
 
+TEST(AlphaSim, OnlyOutlineEdgesAreSubdivided) {
+  // A 10 × 5 rectangle of two triangles in the XY plane, placed so that no lattice node
+  // (spacing 1) lies on its diagonal: the diagonal is interior to the projection (its two
+  // triangles lie on either side) and gets no subdivision points — the lattice nodes of
+  // the two triangles sample the area around it — while the four sides are subdivided to
+  // ≤ L_max. Seen edge-on (XZ) every edge is an outline and is subdivided.
+  Mesh m;
+  m.vertices = {{0.3, 0.3, 0}, {10.3, 0.3, 0}, {10.3, 5.3, 0}, {0.3, 5.3, 0}};
+  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  const double l_max = 1.0, snap = std::exp2(-30.0);
+  AlphaSimPrism xy;
+  const auto smp = alpha_sim_plane_samples(m, xy, l_max, snap);
+  auto on_lattice = [](const Vec2& p) {
+    return std::abs(p.x() - std::round(p.x())) < 1e-9 && std::abs(p.y() - std::round(p.y())) < 1e-9;
+  };
+  auto on_outline = [](const Vec2& p) {
+    return std::abs(p.x() - 0.3) < 1e-9 || std::abs(p.x() - 10.3) < 1e-9 || std::abs(p.y() - 0.3) < 1e-9 ||
+           std::abs(p.y() - 5.3) < 1e-9;
+  };
+  std::size_t outline = 0, lattice = 0;
+  for (const Vec2& p : smp.points) {
+    EXPECT_TRUE(on_lattice(p) || on_outline(p)) << "a point off the lattice inside the rectangle: " << p.transpose();
+    outline += on_outline(p) ? 1 : 0;
+    lattice += on_lattice(p) ? 1 : 0;
+  }
+  EXPECT_EQ(outline, 4u + 2u * 9u + 2u * 4u);  // corners + 9 and 4 inner points per side pair
+  EXPECT_EQ(lattice, 10u * 5u);                // nodes (1..10) × (1..5)
+  // The checks still hold the diagonal's sub-edge midpoints.
+  std::size_t diagonal_checks = 0;
+  for (const Vec2& c : smp.checks)
+    if (std::abs((c.y() - 0.3) - 0.5 * (c.x() - 0.3)) < 1e-9 && !on_outline(c)) ++diagonal_checks;
+  EXPECT_EQ(diagonal_checks, 12u);  // ⌈√125 / 1⌉ = 12 pieces of the diagonal
+  // Edge-on, the outline is the whole projection: every edge is subdivided.
+  AlphaSimPrism xz;
+  xz.u = Vec3::UnitX(); xz.v = Vec3::UnitZ(); xz.n = -Vec3::UnitY();
+  const auto edge_on = alpha_sim_plane_samples(m, xz, l_max, snap);
+  std::size_t off_lattice = 0;
+  for (const Vec2& p : edge_on.points) off_lattice += on_lattice(p) ? 0 : 1;
+  EXPECT_GE(off_lattice, 10u);  // the diagonal's and sides' subdivision points along the line
+}
+
 // ---------------------------------------------------------- determinism, indices
 
 TEST(AlphaSim, DeterministicAcrossRuns) {
