@@ -12,6 +12,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -25,7 +26,8 @@ namespace {
 
 struct SimplifyCommandOptions {
   std::string scene;
-  double dim_pre = std::nan("");  ///< NaN: the scene's [simplify] dim_pre
+  double dim_pre = 0.0;         ///< used when dim_pre_given
+  bool dim_pre_given = false;   ///< --dim-pre was on the command line (else the scene's value)
   std::string out = "simplify-out";
   bool quiet = false;
   bool step = false;
@@ -50,7 +52,7 @@ int run_simplify(const SimplifyCommandOptions& o) {
   SceneLoadOptions lo;
   lo.progress = bar.fn();
   Scene scene = load_scene(o.scene, lo);
-  const bool given = !std::isnan(o.dim_pre);
+  const bool given = o.dim_pre_given;
   const double dim_pre = given ? o.dim_pre : scene.simplify.dim_pre.value;
   if (!(std::isfinite(dim_pre) && dim_pre > 0.0))
     throw InputError({given ? "--dim-pre" : o.scene, 0, given ? "" : "simplify.dim_pre"},
@@ -62,9 +64,14 @@ int run_simplify(const SimplifyCommandOptions& o) {
   opt.scene_size = scene.bounds().diagonal();
   if (o.step) opt.step_dir = out_dir;
   opt.progress = bar.fn();
+  const double tolerance = opt.containment_tolerance_factor * opt.scene_size;
   if (!o.quiet)
-    std::fprintf(stderr, "loom simplify: %zu parts, dim_pre %g %s (%s)\n", scene.parts.size(), dim_pre,
-                 unit_name(scene.units), given ? "--dim-pre" : scene.simplify.dim_pre.source.c_str());
+    std::fprintf(stderr,
+                 "loom simplify: %zu parts, dim_pre %g %s (%s): alpha %g, L_max %g, containment tolerance %.3g %s\n",
+                 scene.parts.size(), dim_pre, unit_name(scene.units),
+                 given ? "--dim-pre" : scene.simplify.dim_pre.source.c_str(), opt.alpha_factor * dim_pre,
+                 opt.sampling_factor * dim_pre, tolerance, unit_name(scene.units));
+  const auto t_start = std::chrono::steady_clock::now();
   std::vector<AlphaSimResult> results;
   const std::vector<Part> simple = simplify_parts(scene.parts, opt, &results);
 
@@ -105,10 +112,16 @@ int run_simplify(const SimplifyCommandOptions& o) {
                      {"reason", r.reason},
                      {"copy_of", r.copy_of},
                      {"projections", projections}});
-    if (!o.quiet)
-      std::fprintf(stderr, "  %-24s %8zu -> %6zu triangles  hausdorff %-10.4g %-13s %s\n", r.name.c_str(),
-                   r.triangles_before, r.triangles_after, r.hausdorff, alpha_sim_status_name(r.status),
-                   r.reason.c_str());
+    if (!o.quiet) {
+      // Below the containment tolerance a distance is rounding (a part kept as it was).
+      const double hausdorff = r.hausdorff < tolerance ? 0.0 : r.hausdorff;
+      const std::string when = r.copy_of.empty() ? std::to_string(static_cast<long long>(std::lround(r.time_ms))) + " ms"
+                                                 : "copy of " + r.copy_of;
+      const double pct = r.triangles_before > 0 ? 100.0 * r.triangles_after / r.triangles_before : 0.0;
+      std::fprintf(stderr, "  %-20s %8zu -> %6zu triangles (%5.1f%%)  hausdorff %-8.4g %-18s %s%s%s\n",
+                   r.name.c_str(), r.triangles_before, r.triangles_after, pct, hausdorff, when.c_str(),
+                   alpha_sim_status_name(r.status), r.reason.empty() ? "" : ": ", r.reason.c_str());
+    }
   }
   std::size_t before = 0, after = 0;
   for (const auto& r : results) {
@@ -127,7 +140,9 @@ int run_simplify(const SimplifyCommandOptions& o) {
             {"parts", parts}};
   write_file_atomic(out_dir / "simplify.json", j.dump(2) + "\n");
   if (!o.quiet)
-    std::fprintf(stderr, "loom simplify: %zu -> %zu triangles; wrote %s\n", before, after,
+    std::fprintf(stderr, "loom simplify: %zu -> %zu triangles (%.1f%%) in %.2f s; wrote %s\n", before, after,
+                 before > 0 ? 100.0 * after / before : 0.0,
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count(),
                  (out_dir / "simplify.json").string().c_str());
   return 0;
 }
@@ -138,11 +153,15 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("simplify", "α-SIM: simplify every part to the level of detail a cable needs");
   auto o = std::make_shared<SimplifyCommandOptions>();
   cmd->add_option("SCENE", o->scene, "Scene file (TOML)")->required();
-  cmd->add_option("--dim-pre", o->dim_pre, "Features smaller than this vanish (default: the scene's dim_pre)");
+  auto* dim = cmd->add_option("--dim-pre", o->dim_pre, "Features smaller than this vanish (default: the scene's dim_pre)");
   cmd->add_option("--out", o->out, "Output directory (DIR/<part>.stl, DIR/simplify.json)");
   cmd->add_flag("--step", o->step, "Also write DIR/<part>.step (OpenCASCADE)");
   cmd->add_flag("--quiet", o->quiet, "Print nothing");
-  cmd->callback([o, &exit_code]() { exit_code = run_simplify(*o); });
+  cmd->callback([o, dim, &exit_code]() {
+    // Whether the option was given, not a sentinel value: `--dim-pre nan` is an error.
+    o->dim_pre_given = dim->count() > 0;
+    exit_code = run_simplify(*o);
+  });
 }
 
 }  // namespace loom::app

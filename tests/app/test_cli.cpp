@@ -283,4 +283,51 @@ TEST(CliRenderSize, BadValueIsExitTwoBeforeAnyWork) {
   }
 }
 
+TEST(CliSimplify, WritesEachPartAndTheReport) {
+  const auto out = fresh_dir("simplify");
+  const auto r = loom("simplify " + kRouteData + "/around.toml --dim-pre 2 --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("containment tolerance"), std::string::npos) << r.out;  // what was used
+  EXPECT_NE(r.out.find("12 -> 12 triangles"), std::string::npos) << r.out;     // a box stays a box
+  EXPECT_TRUE(std::filesystem::exists(out / "box.stl"));
+  const std::string rep = slurp(out / "simplify.json");
+  for (const char* key : {"\"dim_pre\": 2.0", "\"dim_pre_source\": \"--dim-pre\"", "\"triangles_before\": 12",
+                          "\"triangles_after\": 12", "\"containment\": 1.0", "\"status\": \"ok\"", "\"hausdorff\"",
+                          "\"tolerance\""})
+    EXPECT_NE(rep.find(key), std::string::npos) << key << "\n" << rep;
+  for (const auto& e : std::filesystem::directory_iterator(out))
+    EXPECT_TRUE(e.path().extension() == ".json" || e.path().extension() == ".stl") << e.path();  // no temp files
+}
+
+TEST(CliSimplify, BadDimPreIsExitTwoAndWritesNothing) {
+  const auto out = fresh_dir("simplify_bad");
+  for (const char* v : {"0", "-1", "nan", "inf", "abc"}) {
+    const auto r = loom("simplify " + kRouteData + "/around.toml --dim-pre " + v + " --out " + out.string());
+    EXPECT_EQ(r.status, 2) << v << "\n" << r.out;
+    EXPECT_NE(r.out.find("--dim-pre"), std::string::npos) << v << "\n" << r.out;
+    EXPECT_FALSE(std::filesystem::exists(out / "simplify.json")) << v;
+  }
+}
+
+// Regressions (2026-11-21): options whose "not given" value was a sentinel inside the
+// option (NaN, < 0, 0) took a bad given value for "use the scene's": `simplify --dim-pre
+// nan`, `route --time-limit nan|-1`, `route --seed -5`, `audit --spacing 0` and
+// `audit --tolerance 0` ran with defaults and exit 0. Each must be exit 2 naming the option.
+TEST(CliRegression, GivenOptionValuesAreCheckedNotTakenForDefaults) {
+  const auto out = fresh_dir("sentinels");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"simplify " + kRouteData + "/around.toml --dim-pre nan", "--dim-pre"},
+      {"route " + kRouteData + "/around.toml --time-limit nan", "--time-limit"},
+      {"route " + kRouteData + "/around.toml --time-limit -1", "--time-limit"},
+      {"route " + kRouteData + "/around.toml --seed -5", "--seed"},
+      {"audit " + kAuditData + "/clean.toml --spacing 0", "--spacing"},
+      {"audit " + kAuditData + "/clean.toml --tolerance 0", "--tolerance"},
+      {"audit " + kAuditData + "/clean.toml --tolerance nan", "--tolerance"}};
+  for (const auto& [cmd, option] : cases) {
+    const auto r = loom(cmd + " --out " + out.string());
+    EXPECT_EQ(r.status, 2) << cmd << "\n" << r.out;
+    EXPECT_NE(r.out.find(option), std::string::npos) << cmd << "\n" << r.out;
+  }
+}
+
 }  // namespace

@@ -1,5 +1,7 @@
 // One test per bug found, with the inputs that exposed it written out in full so that the
 // case replays without the generator or seed that found it. Name: area, what broke.
+// Bugs of the command line are replayed where the command runs: tests/app/test_cli.cpp,
+// CliRegression.* (e.g. given option values taken for "use the default").
 #include <gtest/gtest.h>
 
 #include <cmath>
