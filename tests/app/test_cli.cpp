@@ -312,7 +312,8 @@ TEST(CliSimplify, BadDimPreIsExitTwoAndWritesNothing) {
 // Regressions (2026-11-21): options whose "not given" value was a sentinel inside the
 // option (NaN, < 0, 0) took a bad given value for "use the scene's": `simplify --dim-pre
 // nan`, `route --time-limit nan|-1`, `route --seed -5`, `audit --spacing 0` and
-// `audit --tolerance 0` ran with defaults and exit 0. Each must be exit 2 naming the option.
+// `audit --tolerance 0` ran with defaults and exit 0 (`scan --diameter nan` passed CLI11's
+// PositiveNumber check and was estimated). Each must be exit 2 naming the option.
 TEST(CliRegression, GivenOptionValuesAreCheckedNotTakenForDefaults) {
   const auto out = fresh_dir("sentinels");
   const std::vector<std::pair<std::string, std::string>> cases = {
@@ -322,7 +323,11 @@ TEST(CliRegression, GivenOptionValuesAreCheckedNotTakenForDefaults) {
       {"route " + kRouteData + "/around.toml --seed -5", "--seed"},
       {"audit " + kAuditData + "/clean.toml --spacing 0", "--spacing"},
       {"audit " + kAuditData + "/clean.toml --tolerance 0", "--tolerance"},
-      {"audit " + kAuditData + "/clean.toml --tolerance nan", "--tolerance"}};
+      {"audit " + kAuditData + "/clean.toml --tolerance nan", "--tolerance"},
+      {"scan " + std::string(LOOM_SHARED_DATA) + "/pcl/table_scene_mug_stereo_textured.pcd --diameter nan",
+       "--diameter"},
+      {"scan " + std::string(LOOM_SHARED_DATA) + "/pcl/table_scene_mug_stereo_textured.pcd --diameter 0",
+       "--diameter"}};
   for (const auto& [cmd, option] : cases) {
     const auto r = loom(cmd + " --out " + out.string());
     EXPECT_EQ(r.status, 2) << cmd << "\n" << r.out;
