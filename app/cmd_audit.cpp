@@ -3,6 +3,7 @@
 // bend and clearance audit of a harness in its scene; writes DIR/report.json (DESIGN §4),
 // DIR/view.html and DIR/render.png. Progress bars on stderr when it is a terminal.
 #include "app/commands.hpp"
+#include "app/option_checks.hpp"
 
 #include "core/error.hpp"
 #include "core/progress.hpp"
@@ -31,9 +32,8 @@ struct AuditFlags {
   std::string method = "certified";
   bool method_given = false;
   bool no_index = false;
-  double spacing = 0.0;    ///< used when spacing_given
-  double tolerance = 0.0;  ///< used when tolerance_given
-  bool spacing_given = false, tolerance_given = false;
+  double spacing = 0.0;    ///< 0: the default (a given value is > 0, checked on the option)
+  double tolerance = 0.0;  ///< 0: the default (a given value is > 0, checked on the option)
   int threads = 0;
   std::string out = "loom-audit";
   std::string render_size = default_render_size();
@@ -100,11 +100,6 @@ int run_audit_command(const AuditFlags& f) {
     opt.check.method = ClashMethod::Discrete;
     opt.check.use_index = false;
   }
-  // 0 stands for "the default" inside the options, so a given 0 is refused here.
-  if (f.spacing_given && !(std::isfinite(f.spacing) && f.spacing > 0.0))
-    throw InputError({"", 0, "--spacing"}, "must be a finite length > 0, got " + full_precision(f.spacing));
-  if (f.tolerance_given && !(std::isfinite(f.tolerance) && f.tolerance > 0.0))
-    throw InputError({"", 0, "--tolerance"}, "must be a finite length > 0, got " + full_precision(f.tolerance));
   opt.check.spacing = f.spacing;
   opt.check.tolerance = f.tolerance;
   opt.check.threads = f.threads;
@@ -138,17 +133,17 @@ void add_audit_command(CLI::App& app, int& exit_code) {
                 ->check(CLI::IsMember({"certified", "discrete"}))
                 ->capture_default_str();
   cmd->add_flag("--no-index", f->no_index, "Brute-force discrete baseline: every sample against every triangle");
-  auto* spacing = cmd->add_option("--spacing", f->spacing, "Discrete sample spacing (default: each cable's diameter)");
-  auto* tolerance = cmd->add_option("--tolerance", f->tolerance, "Certified accuracy (default: smallest cable radius / 100)");
+  cmd->add_option("--spacing", f->spacing, "Discrete sample spacing (default: each cable's diameter)")
+      ->check(finite_number(0.0, false));
+  cmd->add_option("--tolerance", f->tolerance, "Certified accuracy (default: smallest cable radius / 100)")
+      ->check(finite_number(0.0, false));
   cmd->add_option("--threads", f->threads, "Worker threads (default: all cores)");
   cmd->add_option("--out", f->out, "Output directory for report.json")->capture_default_str();
   cmd->add_option("--render-size", f->render_size, "Size of render.png, WIDTHxHEIGHT")->capture_default_str();
   cmd->add_flag("--json", f->json, "Print the report as JSON instead of the summary");
   cmd->add_flag("--quiet", f->quiet, "Print nothing (exit status and report only)");
-  cmd->callback([f, m, spacing, tolerance, &exit_code]() {
+  cmd->callback([f, m, &exit_code]() {
     f->method_given = m->count() > 0;
-    f->spacing_given = spacing->count() > 0;
-    f->tolerance_given = tolerance->count() > 0;
     exit_code = run_audit_command(*f);
   });
 }

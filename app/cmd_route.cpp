@@ -2,6 +2,7 @@
 // report.json, cables.ply, view.html and render.png (--render-size WxH). Progress bars on
 // stderr when it is a terminal.
 #include "app/commands.hpp"
+#include "app/option_checks.hpp"
 
 #include "core/error.hpp"
 #include "core/io/scene_load.hpp"
@@ -12,7 +13,6 @@
 
 #include <CLI/CLI.hpp>
 
-#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -96,23 +96,16 @@ void add_route_command(CLI::App& app, int& exit_code) {
   cmd->add_option("SCENE", *scene, "Scene file (TOML)")->required();
   cmd->add_option("--out", o->out, "Output directory (routed.xml, report.json, cables.ply)")->capture_default_str();
   cmd->add_option("--planner", o->planner, "OMPL planner (rrtconnect, rrtstar, bitstar, prmstar, lazyprmstar, ...)");
-  auto* time_limit = cmd->add_option("--time-limit", o->time_limit, "Planning seconds per segment (default: scene [routing])");
-  auto* seed = cmd->add_option("--seed", o->seed, "Random seed (default: scene [routing])");
+  // Checked here: the options' "use the scene's" values (< 0) must not swallow a bad one.
+  cmd->add_option("--time-limit", o->time_limit, "Planning seconds per segment (default: scene [routing])")
+      ->check(finite_number(0.0, true));
+  cmd->add_option("--seed", o->seed, "Random seed (default: scene [routing])")->check(finite_number(0.0, true));
   cmd->add_option("--threads", o->threads, "Audit threads (default: all cores)");
   cmd->add_option("--render-size", o->render_size, "Size of render.png, WIDTHxHEIGHT")->capture_default_str();
   cmd->add_flag("--simplify", o->simplify, "Plan among α-simplified parts instead of the exact ones (α-SIM, DESIGN §6)");
   cmd->add_flag("--json", o->json, "Print the report as JSON");
   cmd->add_flag("--quiet", o->quiet, "Print nothing (exit status only)");
-  cmd->callback([scene, o, time_limit, seed, &exit_code]() {
-    // A given value is checked here: the options' "use the scene's" sentinels (< 0) must
-    // not swallow a bad one (`--time-limit nan`, `--seed -5`).
-    if (time_limit->count() > 0 && !(std::isfinite(o->time_limit) && o->time_limit >= 0.0))
-      throw InputError({"", 0, "--time-limit"}, "must be a finite number of seconds >= 0, got " +
-                                                    full_precision(o->time_limit));
-    if (seed->count() > 0 && o->seed < 0)
-      throw InputError({"", 0, "--seed"}, "must be >= 0, got " + std::to_string(o->seed));
-    exit_code = run_route(*scene, *o);
-  });
+  cmd->callback([scene, o, &exit_code]() { exit_code = run_route(*scene, *o); });
 }
 
 }  // namespace loom::app

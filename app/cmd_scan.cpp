@@ -2,6 +2,7 @@
 // --cable ID] [--quiet]`: centerline of a scanned cable (DESIGN §4, issue 8) →
 // DIR/centerline.xml (a harness with one routed segment), DIR/tube.ply, DIR/report.json.
 #include "app/commands.hpp"
+#include "app/option_checks.hpp"
 
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
@@ -220,7 +221,8 @@ void add_scan_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("scan", "Centerline and tube of a scanned cable (PLY/XYZ/PCD point cloud)");
   auto o = std::make_shared<ScanCommandOptions>();
   cmd->add_option("CLOUD", o->cloud, "Point cloud of one cable (PLY, XYZ text, PCD)")->required();
-  auto* dia = cmd->add_option("--diameter", o->diameter, "Nominal cable diameter (default: estimated from the cloud)");
+  cmd->add_option("--diameter", o->diameter, "Nominal cable diameter (default: estimated from the cloud)")
+      ->check(finite_number(0.0, false));
   cmd->add_option("--out", o->out, "Output directory")->capture_default_str();
   cmd->add_option("--method", o->method, "graph (blocks along the cable, robust) or axis (the paper's slabs)")
       ->check(CLI::IsMember({"graph", "axis"}))
@@ -230,12 +232,7 @@ void add_scan_command(CLI::App& app, int& exit_code) {
   cmp->needs(cab);
   cab->needs(cmp);
   cmd->add_flag("--quiet", o->quiet, "Print nothing");
-  cmd->callback([o, dia, &exit_code]() {
-    // 0 stands for "estimate" inside the options: a given value must be a real diameter.
-    if (dia->count() > 0 && !(std::isfinite(o->diameter) && o->diameter > 0.0))
-      throw InputError({"", 0, "--diameter"}, "must be a finite length > 0, got " + full_precision(o->diameter));
-    exit_code = run_scan(*o);
-  });
+  cmd->callback([o, &exit_code]() { exit_code = run_scan(*o); });
 }
 
 }  // namespace loom::app

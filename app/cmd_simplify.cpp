@@ -1,6 +1,7 @@
 // `loom simplify SCENE [--dim-pre X] [--out DIR] [--quiet]`: α-SIM per part (issue 4).
 // Writes DIR/<part>.stl and DIR/simplify.json (DESIGN §4 fields, plus status and reason).
 #include "app/commands.hpp"
+#include "app/option_checks.hpp"
 
 #include "core/error.hpp"
 #include "core/io/atomic_file.hpp"
@@ -153,12 +154,12 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("simplify", "α-SIM: simplify every part to the level of detail a cable needs");
   auto o = std::make_shared<SimplifyCommandOptions>();
   cmd->add_option("SCENE", o->scene, "Scene file (TOML)")->required();
-  auto* dim = cmd->add_option("--dim-pre", o->dim_pre, "Features smaller than this vanish (default: the scene's dim_pre)");
+  auto* dim = cmd->add_option("--dim-pre", o->dim_pre, "Features smaller than this vanish (default: the scene's dim_pre)")
+                  ->check(finite_number(0.0, false));
   cmd->add_option("--out", o->out, "Output directory (DIR/<part>.stl, DIR/simplify.json)");
   cmd->add_flag("--step", o->step, "Also write DIR/<part>.step (OpenCASCADE)");
   cmd->add_flag("--quiet", o->quiet, "Print nothing");
   cmd->callback([o, dim, &exit_code]() {
-    // Whether the option was given, not a sentinel value: `--dim-pre nan` is an error.
     o->dim_pre_given = dim->count() > 0;
     exit_code = run_simplify(*o);
   });

@@ -1,0 +1,14 @@
+#pragma once
+/// Checks of numeric command-line values, applied to the options themselves (CLI11
+/// validators), so that a bad given value is a usage error (exit 2, the option named)
+/// before any work — and never mistaken for an option's "not given" value.
+
+#include <CLI/CLI.hpp>
+
+namespace loom::app {
+
+/// Accepts a finite number ≥ min (min_allowed) or > min (!min_allowed); rejects NaN,
+/// ±inf and text that is not a whole number. The message names the limit and the value.
+CLI::Validator finite_number(double min, bool min_allowed);
+
+}  // namespace loom::app
