@@ -432,12 +432,12 @@ std::vector<PlaneSpec> planes_for(const AlphaSimOptions& opt) {
 
 /// One closed or open mesh as a one-part EmbreeIndex: exact (double) distances and
 /// ray-parity inside tests (DESIGN §9: Embree for BVH queries).
-EmbreeIndex mesh_index(const Mesh& m, bool closed) {
-  Part p;
-  p.name = "alpha-sim";
-  p.mesh = m;
-  p.closed = closed;
-  return EmbreeIndex({p});
+EmbreeIndex mesh_index(Mesh m, bool closed) {
+  std::vector<Part> parts(1);
+  parts[0].name = "alpha-sim";
+  parts[0].mesh = std::move(m);
+  parts[0].closed = closed;
+  return EmbreeIndex(parts);
 }
 
 /// Number of `samples` inside or within tol of the closed mesh indexed by q (parallel).
@@ -448,7 +448,7 @@ std::size_t count_contained_mesh(const EmbreeIndex& q, const std::vector<Vec3>& 
       tbb::blocked_range<std::size_t>(0, samples.size(), 1024), std::size_t(0),
       [&](const tbb::blocked_range<std::size_t>& r, std::size_t acc) {
         for (std::size_t i = r.begin(); i != r.end(); ++i)
-          if (q.closest(samples[i], tol).found() || q.inside(samples[i])) ++acc;
+          if (q.any_within(samples[i], tol) || q.inside(samples[i])) ++acc;
         return acc;
       },
       std::plus<std::size_t>());
@@ -564,6 +564,28 @@ std::string safe_file_name(const std::string& name) {
   for (auto& ch : s)
     if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_' || ch == '.')) ch = '_';
   return s;
+}
+
+/// True for the statuses whose projection was replaced by its convex hull.
+bool is_hull(ProjectionStatus s) {
+  return s == ProjectionStatus::Empty || s == ProjectionStatus::Torn || s == ProjectionStatus::Eroded;
+}
+
+/// Densifies `shape` where it misses `checks` (refine), keeps the Delaunay triangles that
+/// still hold one (cover), and records the outcome in rep: Repaired, or Torn (replaced by
+/// the convex hull) when the added area exceeds torn_fraction of the region.
+void repair_projection(AlphaShape2D& shape, const std::vector<Vec2>& checks, double tol, double torn_fraction,
+                       ProjectionReport& rep) {
+  // When refine finds no check outside, every one is within tol of the region already:
+  // cover() then only has to attach isolated vertices (it need not test the checks again).
+  const bool changed = shape.refine(checks, tol) > 0;
+  const double added = shape.cover(changed ? checks : std::vector<Vec2>(), tol);
+  if (added > torn_fraction * shape.area()) {
+    rep.status = ProjectionStatus::Torn;
+    shape.keep_all();
+  } else if (added > 0.0) {
+    rep.status = ProjectionStatus::Repaired;
+  }
 }
 
 void keep_original(AlphaSimPart& out, const Part& part, AlphaSimStatus status, const std::string& reason) {
@@ -706,17 +728,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
     } else {
       smp.checks.reserve(smp.checks.size() + cover_samples.size());
       for (const auto& p : cover_samples) smp.checks.push_back(pr.project(p));
-      // When refine inserts nothing, every check is within tol of the region already:
-      // cover() then only has to attach isolated vertices (skips the same checks again).
-      const bool changed = shape->refine(smp.checks, tol) > 0;
-      const std::vector<Vec2> none;
-      const double added = shape->cover(changed ? smp.checks : none, tol);
-      if (added > opt.torn_fraction * shape->area()) {
-        rep.status = ProjectionStatus::Torn;
-        shape->keep_all();
-      } else if (added > 0.0) {
-        rep.status = ProjectionStatus::Repaired;
-      }
+      repair_projection(*shape, smp.checks, tol, opt.torn_fraction, rep);
     }
     pr.shape = shape;
     prisms[k] = pr;
@@ -768,21 +780,12 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
       if (miss[k] == 0) continue;
       any = true;
       auto& rep = r.projections[k];
-      if (rep.status == ProjectionStatus::Empty || rep.status == ProjectionStatus::Torn ||
-          rep.status == ProjectionStatus::Eroded) {
+      if (is_hull(rep.status)) {
         hull_missed = true;  // already the convex hull
       } else if (round < kRefineRounds) {
         auto& checks = plane_samples[k].checks;
         checks.insert(checks.end(), missed[k].begin(), missed[k].end());
-        const bool changed = shapes[k]->refine(checks, tol) > 0;
-        const std::vector<Vec2> none;
-        const double added = shapes[k]->cover(changed ? checks : none, tol);
-        if (added > opt.torn_fraction * shapes[k]->area()) {
-          rep.status = ProjectionStatus::Torn;
-          shapes[k]->keep_all();
-        } else if (added > 0.0) {
-          rep.status = ProjectionStatus::Repaired;
-        }
+        repair_projection(*shapes[k], checks, tol, opt.torn_fraction, rep);
       } else {
         rep.status = ProjectionStatus::Eroded;
         shapes[k]->keep_all();
@@ -802,9 +805,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
     auto& rep = r.projections[k];
     rep.kept_triangles = shapes[k]->kept_triangle_count();
     rep.area = shapes[k]->area();
-    if (rep.status == ProjectionStatus::Empty || rep.status == ProjectionStatus::Torn ||
-        rep.status == ProjectionStatus::Eroded)
-      hull = true;
+    hull = hull || is_hull(rep.status);
   }
   auto solid = std::make_shared<AlphaSimSolid>(prisms);
   {
@@ -832,8 +833,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
     r.fallback = AlphaSimFallback::ConvexHull;
     std::string planes;
     for (const auto& rep : r.projections)
-      if (rep.status == ProjectionStatus::Empty || rep.status == ProjectionStatus::Torn ||
-          rep.status == ProjectionStatus::Eroded)
+      if (is_hull(rep.status))
         planes += (planes.empty() ? "" : ", ") + rep.plane + " (" + projection_status_name(rep.status) + ")";
     r.reason = "convex hull used for " + planes;
   }

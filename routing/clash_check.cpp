@@ -487,21 +487,19 @@ class StructureTracer {
     refresh(a);
     refresh(b);
     const double h = b.s - a.s;
-    if (0.5 * (a.d + b.d - h) >= thr_) {  // also when a bound stands for d: d only adds
-      free_.push_back(a);
-      return;
+    // Lipschitz lower bound on [a, b]; also when a bound stands for d (the value only adds).
+    auto proven_clear = [&] { return 0.5 * (a.d + b.d - h) >= thr_; };
+    // Bounds too low for this decision: raise them to what it needs first, then, if that
+    // is not enough, take the values.
+    if (!proven_clear()) {
+      tighten(a, 2.0 * thr_ + h - b.d);
+      tighten(b, 2.0 * thr_ + h - a.d);
     }
-    // Bounds too low for this decision: raise them to what it needs first.
-    tighten(a, 2.0 * thr_ + h - b.d);
-    tighten(b, 2.0 * thr_ + h - a.d);
-    if (0.5 * (a.d + b.d - h) >= thr_) {
-      free_.push_back(a);
-      return;
+    if (!proven_clear()) {
+      resolve(a);
+      resolve(b);
     }
-    resolve(a);
-    resolve(b);
-    const double lb = 0.5 * (a.d + b.d - h);
-    if (lb >= thr_) {
+    if (proven_clear()) {
       free_.push_back(a);
       return;
     }
