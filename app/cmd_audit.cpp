@@ -50,8 +50,8 @@ void print_summary(const AuditReport& rep, const std::filesystem::path& report_p
   std::printf("audit %s: %zu cables (%zu checked), %zu parts, %zu triangles\n", rep.scene.c_str(), rep.cables.size(),
               rep.check_ids.size(), rep.part_names.size(), rep.triangles);
   if (rep.method == ClashMethod::Certified)
-    std::printf("method certified, tolerance %.4g %s (%s), index %s\n", r.tolerance, u, r.tolerance_source.c_str(),
-                rep.index_name.c_str());
+    std::printf("method certified, tolerance %.4g %s (%s), free-space distances within %g%%, index %s\n", r.tolerance,
+                u, r.tolerance_source.c_str(), 100.0 * r.distance_rel_error, rep.index_name.c_str());
   else
     std::printf("method discrete (%s), not certified\n", rep.use_index ? "indexed" : "brute force, no index");
   std::size_t n = 0;

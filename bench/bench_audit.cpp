@@ -8,7 +8,7 @@
 // Writes bench/results/audit*.csv and charts (gnuplot). Fixed seeds.
 //
 //   bench_audit [--quick]      (--quick: smaller scenes, for a smoke run)
-//   bench_audit --probe TRIS_PER_PART [THREADS [BUILD_QUALITY]]   (one audit of the
+//   bench_audit --probe TRIS_PER_PART [THREADS [BUILD_QUALITY [REL_ERROR]]]   (one audit of the
 //                triangle-scaling scene; BUILD_QUALITY as EmbreeOptions, -1 = automatic)
 #include "index/embree_index.hpp"
 #include "routing/clash_check.hpp"
@@ -200,7 +200,7 @@ void gnuplot(const std::string& script) {
 class SplitIndex : public ObstacleIndex {
  public:
   /// The methods timed, in report order.
-  enum Kind { kClosest, kSegmentClosest, kClosestOnPart, kInside, kOther, kKinds };
+  enum Kind { kClosest, kClosestApprox, kSegmentClosest, kClosestOnPart, kInside, kOther, kKinds };
   explicit SplitIndex(const ObstacleIndex& inner) : inner_(inner) {}
   std::string name() const override { return inner_.name(); }
   IndexAccuracy accuracy() const override { return inner_.accuracy(); }
@@ -208,6 +208,9 @@ class SplitIndex : public ObstacleIndex {
   std::optional<AABB> part_bounds(int part) const override { return inner_.part_bounds(part); }
   ClosestHit closest(const Vec3& p, double r) const override {
     return timed(kClosest, [&] { return inner_.closest(p, r); });
+  }
+  ClosestHit closest_approx(const Vec3& p, double r, double e) const override {
+    return timed(kClosestApprox, [&] { return inner_.closest_approx(p, r, e); });
   }
   ClosestHit closest_on_part(const Vec3& p, int part, double r) const override {
     return timed(kClosestOnPart, [&] { return inner_.closest_on_part(p, part, r); });
@@ -229,7 +232,7 @@ class SplitIndex : public ObstacleIndex {
   }
   /// Prints calls and CPU ms per method.
   void print() const {
-    const char* names[kKinds] = {"closest", "segment_closest", "closest_on_part", "inside", "other"};
+    const char* names[kKinds] = {"closest", "closest_approx", "segment_closest", "closest_on_part", "inside", "other"};
     for (int k = 0; k < kKinds; ++k)
       if (calls_[k] > 0)
         std::printf("  %-16s %7lld calls %8.1f cpu ms %6.2f us/call\n", names[k], calls_[k], ms_[k],
@@ -295,7 +298,7 @@ std::uint64_t result_digest(const ClashResult& r) {
 /// audit runs twice: the first run pays for anything the index builds lazily. A third,
 /// single-threaded run through SplitIndex prints CPU time per index method. The digest
 /// identifies the whole report (it must not change when only the speed does).
-int probe(int tris_per_part, int threads, int build_quality) {
+int probe(int tris_per_part, int threads, int build_quality, double rel_error) {
   const BenchScene sc = make_scene(200, tris_per_part, 100, 1.0, 7);
   const double b0 = cpu_ms();
   EmbreeOptions eo;
@@ -305,6 +308,7 @@ int probe(int tris_per_part, int threads, int build_quality) {
   ClashRequest req;
   req.routing_clearance = 3.0;
   req.threads = threads;
+  if (rel_error >= 0.0) req.distance_rel_error = rel_error;
   const double c0 = cpu_ms();
   const ClashResult r = check_clashes(sc.cables, sc.parts, &idx, req);
   const double first = cpu_ms() - c0;
@@ -334,7 +338,8 @@ int main(int argc, char** argv) {
   const int base_parts = quick ? 40 : 200, base_cables = quick ? 20 : 100, tris = 7500;
 
   if (argc > 2 && std::string(argv[1]) == "--probe")
-    return probe(std::atoi(argv[2]), argc > 3 ? std::atoi(argv[3]) : 1, argc > 4 ? std::atoi(argv[4]) : -1);
+    return probe(std::atoi(argv[2]), argc > 3 ? std::atoi(argv[3]) : 1, argc > 4 ? std::atoi(argv[4]) : -1,
+                 argc > 5 ? std::atof(argv[5]) : -1.0);
   const bool breakdown_only = argc > 1 && std::string(argv[1]) == "--breakdown";
   {
     // Where the certified time goes (each check kind alone), paper-scale scene.

@@ -109,6 +109,7 @@ struct QueryState {
   double best2 = std::numeric_limits<double>::infinity();
   double best_s = 0.0;
   double radius_offset = 0.0;  ///< added to the best distance when shrinking (piece half length)
+  double shrink = 1.0;         ///< the search radius shrinks to shrink·best (< 1: approximate)
   double pad = 0.0;
   ClosestHit hit;
   bool done = false;
@@ -157,7 +158,7 @@ bool point_query_callback(RTCPointQueryFunctionArguments* args) {
     q->hit.point = point;
     q->hit.part = part;
     q->hit.triangle = args->primID;
-    const float nr = to_float_up(std::sqrt(d2) + q->radius_offset + q->pad);
+    const float nr = to_float_up(std::sqrt(d2) * q->shrink + q->radius_offset + q->pad);
     if (nr < args->query->radius) {
       args->query->radius = nr;
       return true;
@@ -425,6 +426,13 @@ ClosestHit EmbreeIndex::closest(const Vec3& p, double max_radius) const {
   return closest_in(impl_->scene, -1, -1, p, max_radius);
 }
 
+ClosestHit EmbreeIndex::closest_approx(const Vec3& p, double max_radius, double rel_error) const {
+  if (!(rel_error >= 0.0) || !std::isfinite(rel_error))
+    throw std::invalid_argument("embree index: rel_error must be finite and >= 0, got " + full_precision(rel_error));
+  if (triangle_count_ == 0 || !(max_radius >= 0.0)) return {};
+  return closest_in(impl_->scene, -1, -1, p, max_radius, 1.0 / (1.0 + rel_error));
+}
+
 ClosestHit EmbreeIndex::closest_on_part(const Vec3& p, int part, double max_radius) const {
   check_part_id(part, parts_.size());
   const PartData& pd = parts_[part];
@@ -442,12 +450,13 @@ std::optional<AABB> EmbreeIndex::part_bounds(int part) const {
 }
 
 ClosestHit EmbreeIndex::closest_in(void* scene, int only_part, int filter_part, const Vec3& p,
-                                   double max_radius) const {
+                                   double max_radius, double shrink) const {
   FlushDenormals ftz;
   QueryState q;
   q.parts = &parts_;
   q.only_part = only_part;
   q.filter_part = filter_part;
+  q.shrink = shrink;
   q.p = p;
   q.pad = float_pad(p, max_radius);
   if (std::isfinite(max_radius)) q.best2 = max_radius * max_radius * (1.0 + 1e-15);

@@ -49,6 +49,9 @@ class EmbreeIndex : public ObstacleIndex {
   int part_count() const override { return static_cast<int>(parts_.size()); }
 
   ClosestHit closest(const Vec3& p, double max_radius = std::numeric_limits<double>::infinity()) const override;
+  /// Stops at the first surface point within (1 + rel_error) of every unvisited leaf: the
+  /// search radius shrinks to D / (1 + rel_error) (+ the float pad) at each hit D.
+  ClosestHit closest_approx(const Vec3& p, double max_radius, double rel_error) const override;
   ClosestHit closest_on_part(const Vec3& p, int part,
                              double max_radius = std::numeric_limits<double>::infinity()) const override;
   bool inside(const Vec3& p, int* part = nullptr) const override;
@@ -82,7 +85,9 @@ class EmbreeIndex : public ObstacleIndex {
   double float_pad(const Vec3& p, double radius) const;
   /// Closest point in `scene`: the whole index (only_part = -1; filter_part ≥ 0 keeps that
   /// part's triangles only), or a one-part scene with only_part = its id.
-  ClosestHit closest_in(void* scene, int only_part, int filter_part, const Vec3& p, double max_radius) const;
+  /// `shrink` = 1 / (1 + rel_error) scales the search radius at each hit (1: exact).
+  ClosestHit closest_in(void* scene, int only_part, int filter_part, const Vec3& p, double max_radius,
+                        double shrink = 1.0) const;
   /// Lazily built scene holding only one part (for closest_on_part).
   void* part_scene(int part) const;
 

@@ -61,6 +61,16 @@ class ObstacleIndex {
   /// A tight max_radius is most of the speed: pass what you know.
   virtual ClosestHit closest(const Vec3& p,
                              double max_radius = std::numeric_limits<double>::infinity()) const = 0;
+  /// (1 + rel_error)-approximate closest point: a surface point within max_radius whose
+  /// distance D is at most (1 + rel_error)·d, d being the exact distance to the nearest
+  /// surface — so D / (1 + rel_error) is a certified lower bound on d. found() == false
+  /// only if no surface lies within max_radius (that answer is exact). Far from a finely
+  /// tessellated surface this visits a few leaves instead of every triangle whose box comes
+  /// within d. rel_error ≥ 0; the default implementation answers exactly.
+  virtual ClosestHit closest_approx(const Vec3& p, double max_radius, double rel_error) const {
+    (void)rel_error;
+    return closest(p, max_radius);
+  }
   /// Closest point on one given part (found() == false if farther than max_radius).
   virtual ClosestHit closest_on_part(const Vec3& p, int part,
                                      double max_radius = std::numeric_limits<double>::infinity()) const = 0;

@@ -2,6 +2,7 @@
 // (Lipschitz sphere tracing + exact chord distances). See clash_check.hpp for the contract.
 #include "routing/clash_check.hpp"
 
+#include "core/error.hpp"
 #include "index/triangle_distance.hpp"
 
 #include <tbb/blocked_range.h>
@@ -325,6 +326,7 @@ class StructureTracer {
     max_step_ = ctx.req.max_step > 0.0 ? ctx.req.max_step : kDefaultMaxStepRadii * r_;
     max_step_ = std::max(max_step_, leaf_);
     cut_margin_ = ctx.abs_err + kCutMarginRel * (thr_ + max_step_);
+    rel_error_ = ctx.req.distance_rel_error;
   }
 
   void run() {
@@ -342,9 +344,12 @@ class StructureTracer {
       // caps (both grow with d); otherwise a higher bound, or its value, is needed now.
       const double reach_cap = cap - std::min(L_ - s_prev, max_step_);  // a.d that caps the radius
       refresh(a);
-      tighten(a, std::max(thr_ + 0.5 * max_step_, reach_cap));
-      if (a.pending >= 0 && (2.0 * (a.d - thr_) < max_step_ || a.d + std::min(L_ - s_prev, max_step_) < cap))
-        resolve(a);
+      // With approximate queries the bound steps as it is: positions then depend on ε anyway.
+      if (rel_error_ == 0.0) {
+        tighten(a, std::max(thr_ + 0.5 * max_step_, reach_cap));
+        if (a.pending >= 0 && (2.0 * (a.d - thr_) < max_step_ || a.d + std::min(L_ - s_prev, max_step_) < cap))
+          resolve(a);
+      }
       const double rho = a.d - thr_;
       const double step = std::clamp(2.0 * rho, leaf_, max_step_);
       const double s_next = std::min(L_, s_prev + step);
@@ -372,6 +377,9 @@ class StructureTracer {
     /// Lower bound on the distance to any part surface (≤ its query radius): the query's
     /// own value, or, while `pending` ≥ 0, a bound on it (the query was cut short).
     double d = 0.0;
+    /// Upper bound on that distance: the distance of a surface point the queries found
+    /// (infinity when none was found).
+    double u = kInf;
     Vec3 p = Vec3::Zero();
     int pending = -1;  ///< index into pending_ while d is only a bound on the query's value
   };
@@ -385,6 +393,7 @@ class StructureTracer {
     double reach = 0.0;   ///< no surface within this distance
     bool resolved = false;
     double d = 0.0;       ///< the sample's d once resolved
+    double upper = kInf;  ///< distance of the nearest surface point found so far
   };
 
   /// Sample at arc length s with a closest-point query of the given radius (the Lipschitz
@@ -400,32 +409,59 @@ class StructureTracer {
     ++count_.samples;
     ++count_.distance_queries;
     if (ctx_.req.cut_short_queries && enough < radius) {
-      // Found within `enough`: the nearest surface, so the full query's very answer.
-      const ClosestHit h = ctx_.index->closest(x.p, enough);
-      if (!h.found()) {
-        pending_.push_back({s, x.p, radius, enough, false, 0.0});
-        x.pending = static_cast<int>(pending_.size()) - 1;
-        x.d = std::max(0.0, enough - ctx_.abs_err);
-        return x;
-      }
-      x.d = take(h, s, radius);
-      return x;
+      // Found within `enough`: the nearest surface (to within ε), so the full query's answer.
+      const ClosestHit h = free_space_query(x.p, enough);
+      if (!h.found()) return bounded(x, radius, enough);
+      return found(x, h, radius);
     }
-    x.d = take(ctx_.index->closest(x.p, radius), s, radius);
+    return found(x, free_space_query(x.p, radius), radius);
+  }
+
+  /// A sphere-tracing query: exact, or (1 + ε)-approximate when the request allows it.
+  ClosestHit free_space_query(const Vec3& p, double radius) const {
+    return rel_error_ > 0.0 ? ctx_.index->closest_approx(p, radius, rel_error_) : ctx_.index->closest(p, radius);
+  }
+
+  /// x as a sample known only to have no surface within `reach` (its full query, radius
+  /// `radius`, runs later if a decision needs its value).
+  Sample bounded(Sample x, double radius, double reach, double upper = kInf) {
+    pending_.push_back({x.s, x.p, radius, reach, false, 0.0, upper});
+    x.pending = static_cast<int>(pending_.size()) - 1;
+    x.d = std::max(0.0, reach - ctx_.abs_err);
+    x.u = upper;
+    return x;
+  }
+
+  /// x given the answer h of its sphere-tracing query (radius `radius`): the value when the
+  /// query was exact or missed, a lower bound when it was approximate and hit.
+  Sample found(Sample x, const ClosestHit& h, double radius) {
+    if (rel_error_ > 0.0 && h.found()) {
+      note(h, x.s);
+      return bounded(x, radius, h.distance / (1.0 + rel_error_), h.distance);
+    }
+    x.d = take(h, x.s, radius);
+    x.u = h.distance;
     return x;
   }
 
   /// The d of a sample at s whose query of the given radius answered h; counts h towards
   /// the cable's smallest sampled clearance.
   double take(const ClosestHit& h, double s, double radius) {
-    if (h.found() && !is_attached(in_.attachments, h.part, s)) summary_min_ = std::min(summary_min_, h.distance - r_);
+    note(h, s);
     return h.found() ? std::max(0.0, h.distance - ctx_.abs_err) : std::max(0.0, radius - ctx_.abs_err);
+  }
+
+  /// Counts a surface point a query found from arc length s towards the cable's smallest
+  /// sampled clearance (its distance is a real clearance there, exact or not).
+  void note(const ClosestHit& h, double s) {
+    if (h.found() && !is_attached(in_.attachments, h.part, s)) summary_min_ = std::min(summary_min_, h.distance - r_);
   }
 
   /// Brings a copy of a sample up to date with what is known of its query since.
   void refresh(Sample& x) const {
     if (x.pending < 0) return;
     const Pending& pd = pending_[x.pending];
+    x.u = pd.upper;
     if (pd.resolved) {
       x.d = pd.d;
       x.pending = -1;
@@ -434,26 +470,30 @@ class StructureTracer {
     }
   }
 
-  /// Raises a cut-short sample's bound to `need` (d units) with a query cut short there,
-  /// or finds its value on the way (the nearest surface is then within the cut).
+  /// Raises a sample's bound to `need` (d units) with a query cut short there, or finds its
+  /// value on the way (exact queries: the nearest surface is then within the cut), or, with
+  /// approximate queries, a surface point closer than `need` (the decision then fails).
   void tighten(Sample& x, double need) {
     if (x.pending < 0 || x.d >= need) return;
     Pending& pd = pending_[x.pending];
     const double reach = need + cut_margin_;
     if (!(reach < pd.radius)) {
-      resolve(x);
+      if (rel_error_ == 0.0) resolve(x);
       return;
     }
-    const ClosestHit h = ctx_.index->closest(pd.p, reach);
-    if (h.found()) {
+    const ClosestHit h = free_space_query(pd.p, reach);
+    if (!h.found()) {
+      pd.reach = reach;
+    } else if (rel_error_ == 0.0) {
       pd.d = take(h, pd.s, pd.radius);
       pd.resolved = true;
-      x.d = pd.d;
-      x.pending = -1;
-      return;
+      pd.upper = h.distance;
+    } else {
+      note(h, pd.s);
+      pd.reach = std::max(pd.reach, h.distance / (1.0 + rel_error_));
+      pd.upper = std::min(pd.upper, h.distance);
     }
-    pd.reach = reach;
-    x.d = std::max(0.0, reach - ctx_.abs_err);
+    refresh(x);
   }
 
   /// Replaces a cut-short sample's bound with its query's value (run once per sample).
@@ -461,23 +501,32 @@ class StructureTracer {
     if (x.pending < 0) return;
     Pending& pd = pending_[x.pending];
     if (!pd.resolved) {
-      pd.d = take(ctx_.index->closest(pd.p, pd.radius), pd.s, pd.radius);
+      const ClosestHit h = ctx_.index->closest(pd.p, pd.radius);
+      pd.d = take(h, pd.s, pd.radius);
+      pd.upper = h.distance;
       pd.resolved = true;
     }
-    x.d = pd.d;
-    x.pending = -1;
+    refresh(x);
   }
 
   /// The cut-short samples never resolved count towards the smallest sampled clearance only
   /// if they can lower it: their distance exceeds `reach`, and a query bounded by the
   /// current minimum (+ margin, which covers rounding) finds the same nearest surface as
-  /// their full query whenever it is below that bound.
+  /// their full query whenever it is below that bound. They are taken nearest bound first,
+  /// so that the minimum falls early and stops the rest. With approximate queries the
+  /// smallest clearance is the smallest at the surface points found (an upper bound on the
+  /// true one, as any sampled value is): samples that found one have counted already.
   void settle_pending() {
-    for (Pending& pd : pending_) {
-      if (pd.resolved || pd.reach - r_ >= summary_min_) continue;
-      const double bound = std::min(pd.radius, summary_min_ + r_ + margin_);
-      const ClosestHit h = ctx_.index->closest(pd.p, bound);
-      if (h.found() && !is_attached(in_.attachments, h.part, pd.s)) summary_min_ = std::min(summary_min_, h.distance - r_);
+    std::vector<const Pending*> open;
+    for (const Pending& pd : pending_)
+      if (!pd.resolved && pd.reach - r_ < summary_min_ && (rel_error_ == 0.0 || pd.upper == kInf)) open.push_back(&pd);
+    std::sort(open.begin(), open.end(), [](const Pending* x, const Pending* y) {
+      return x->reach != y->reach ? x->reach < y->reach : x->s < y->s;
+    });
+    for (const Pending* pd : open) {
+      if (pd->reach - r_ >= summary_min_) break;
+      const double bound = std::min(pd->radius, summary_min_ + r_ + margin_);
+      note(free_space_query(pd->p, bound), pd->s);
     }
     pending_.clear();
   }
@@ -495,7 +544,10 @@ class StructureTracer {
       tighten(a, 2.0 * thr_ + h - b.d);
       tighten(b, 2.0 * thr_ + h - a.d);
     }
-    if (!proven_clear()) {
+    // Values are worth their queries only if the upper bounds could prove it.
+    // With approximate bounds a failed proof is cheaper to retry on halves (one approximate
+    // query) than to settle with two exact ones, down to the leaves.
+    if (!proven_clear() && 0.5 * (a.u + b.u - h) >= thr_ && (rel_error_ == 0.0 || h <= leaf_)) {
       resolve(a);
       resolve(b);
     }
@@ -520,9 +572,16 @@ class StructureTracer {
   void flush_free() {
     // Free samples only matter while the trace is inside a closed part.
     if (inside_part_ >= 0) {
+      // The deepest sample is the one farthest from the surface: only samples whose upper
+      // bound reaches the largest lower bound can be it, and only they need their values.
+      double deepest = 0.0;
       for (Sample& f : free_) {
         refresh(f);
-        resolve(f);
+        deepest = std::max(deepest, f.d);
+      }
+      for (Sample& f : free_)
+        if (f.u >= deepest) resolve(f);
+      for (Sample& f : free_) {
         PartObservation o;
         o.part = inside_part_;
         o.key = -r_ - f.d;
@@ -655,6 +714,7 @@ class StructureTracer {
   double r_;
   StretchTracker tracker_;
   double L_ = 0.0, thr_ = 0.0, leaf_ = 0.0, max_step_ = 0.0, margin_ = 0.0;
+  double rel_error_ = 0.0;   ///< ClashRequest::distance_rel_error (0: exact sphere tracing)
   double cut_margin_ = 0.0;  ///< added to a cut-short query's radius: d = max(0, hit − abs_err) and rounding
   int inside_part_ = -1;
   std::vector<Sample> free_;
@@ -1175,6 +1235,9 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
   if (need_index && index == nullptr) throw std::invalid_argument("check_clashes: an index is required");
   if (index != nullptr && index->part_count() != static_cast<int>(parts.size()))
     throw std::invalid_argument("check_clashes: the index does not index the given parts");
+  if (!(request.distance_rel_error >= 0.0) || !std::isfinite(request.distance_rel_error))
+    throw std::invalid_argument("check_clashes: distance_rel_error must be finite and >= 0, got " +
+                                full_precision(request.distance_rel_error));
 
   Context ctx{cables, parts, index, request, {}, 0.0, 0.0, 0.0, 0.0, {}};
   ClashResult res;
@@ -1208,6 +1271,7 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
   if (request.method == ClashMethod::Certified) {
     res.tolerance = ctx.tol;
     res.chord_error = ctx.chord_error;
+    res.distance_rel_error = request.distance_rel_error;
     parallel_indices(cables.size(), request.threads, [&](std::size_t c) {
       CableCheckSummary& sum = res.cables[c];
       sum.length = cables[c].curve.length();

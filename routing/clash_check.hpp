@@ -107,6 +107,14 @@ struct ClashRequest {
   /// The report is the same either way; false queries every sample to its full radius (the
   /// reference the tests compare with).
   bool cut_short_queries = true;
+  /// Certified: relative error ε allowed in the sphere trace's free-space distance queries
+  /// (ObstacleIndex::closest_approx). Those samples only need a lower bound on the distance,
+  /// and D / (1 + ε) is one; it costs steps (1 + ε) shorter at most but spares the BVH
+  /// leaves around the nearest surface, whose number grows with the tessellation. Contact
+  /// decisions, reported distances and the smallest clearance stay exact to the tolerance;
+  /// sample positions, and so the last digits of a report, depend on ε. 0 = exact queries
+  /// (then cut_short_queries changes nothing in the report). Must be finite and ≥ 0.
+  double distance_rel_error = 0.25;
   /// Worker threads (≤ 0: all cores).
   int threads = 0;
   bool check_structure = true;    ///< cable–structure clashes and clearance violations
@@ -184,6 +192,7 @@ struct ClashResult {
   double tolerance = 0.0;          ///< the certified accuracy used (discrete: 0 = not certified)
   std::string tolerance_source;    ///< "request" or the derivation rule
   double chord_error = 0.0;        ///< max distance between the measured chords and the curve
+  double distance_rel_error = 0.0; ///< certified: ε of the free-space queries (ClashRequest)
   double spacing = 0.0;            ///< discrete: sample spacing used (0 = per cable 2r)
   std::vector<std::string> notes;  ///< what the user should know (open parts, …)
 };

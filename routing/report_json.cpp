@@ -38,6 +38,7 @@ json audit_report_json(const AuditReport& rep) {
     put(j, "tolerance", r.tolerance, "tolerance could not be derived");
     j["tolerance_source"] = r.tolerance_source;
     j["chord_error"] = r.chord_error;
+    j["free_space_rel_error"] = r.distance_rel_error;
   } else {
     j["tolerance_note"] = "discrete method: sampled, not certified (obstacles between samples can be missed)";
     if (r.spacing > 0.0) j["spacing"] = r.spacing;

@@ -295,6 +295,58 @@ TEST(EmbreeIndex, BoundedClosestOnPartMatchesBruteForce) {
   EXPECT_GT(bounded_found, 50);  // the bounded path was exercised with hits, not just misses
 }
 
+TEST(EmbreeIndex, ApproximateClosestIsWithinItsFactorOfBruteForce) {
+  // The (1 + ε) contract against brute force: the point returned is a surface point, its
+  // distance D satisfies d ≤ D ≤ (1 + ε)·d, and a miss means nothing within the radius.
+  // A finely tessellated sphere (the case it is for) among the mixed parts; random
+  // points, and points near the surface where the factor is tightest.
+  MixedSceneDetail detail;
+  detail.sphere_nu = 256;
+  detail.sphere_nv = 128;
+  const auto parts = mixed_scene(Vec3(2, -1, 3), detail);
+  const EmbreeIndex e(parts);
+  const BruteForceIndex b(parts);
+  std::mt19937_64 rng(77);
+  auto pts = random_points(rng, bounds_of(parts), 10, 500);
+  const Mesh& sphere = parts[0].mesh;
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  for (int i = 0; i < 200; ++i) pts.push_back(sphere.vertices[rng() % sphere.vertices.size()] + Vec3(u(rng), u(rng), u(rng)));
+  const double err = e.accuracy().abs_error;
+  int approximate = 0;
+  for (double eps : {0.0, 0.1, 0.5}) {
+    for (const Vec3& p : pts) {
+      const ClosestHit exact = b.closest(p);
+      ASSERT_TRUE(exact.found());
+      for (double radius : {std::numeric_limits<double>::infinity(), 1.2 * exact.distance, 0.8 * exact.distance}) {
+        const ClosestHit h = e.closest_approx(p, radius, eps);
+        ASSERT_EQ(h.found(), exact.distance <= radius) << full_precision(p.x()) << " " << full_precision(p.y()) << " "
+                                                      << full_precision(p.z()) << " eps " << eps << " radius " << radius;
+        if (!h.found()) continue;
+        EXPECT_GE(h.distance, exact.distance - err);
+        EXPECT_LE(h.distance, (1.0 + eps) * exact.distance + err);
+        EXPECT_NEAR((h.point - p).norm(), h.distance, 1e-9 * std::max(1.0, h.distance));
+        const auto& c = parts[h.part].mesh.vertices;
+        const auto& f = parts[h.part].mesh.triangles[h.triangle];
+        EXPECT_NEAR(closest_point_on_triangle(p, c[f[0]], c[f[1]], c[f[2]]).dist2, h.distance * h.distance,
+                    1e-9 * std::max(1.0, h.distance * h.distance));
+        if (eps == 0.0) {
+          EXPECT_EQ(h.distance, e.closest(p, radius).distance);
+        }
+        approximate += eps > 0.0 && h.distance > exact.distance + err ? 1 : 0;
+      }
+    }
+  }
+  // The approximation is used (else the test proves nothing about the bound).
+  EXPECT_GT(approximate, 0);
+  EXPECT_THROW(e.closest_approx(pts[0], 1.0, -0.1), std::invalid_argument);
+  EXPECT_THROW(e.closest_approx(pts[0], 1.0, std::numeric_limits<double>::quiet_NaN()), std::invalid_argument);
+  // Degenerate: an empty index finds nothing; the default implementation is exact.
+  const EmbreeIndex empty(std::vector<Part>{});
+  EXPECT_FALSE(empty.closest_approx(pts[0], 10.0, 0.25).found());
+  const ClosestHit bh = b.closest_approx(pts[0], 1e9, 0.25);
+  EXPECT_EQ(bh.distance, b.closest(pts[0]).distance);
+}
+
 TEST(EmbreeIndex, PartBoundsAreTheMeshBoxes) {
   const auto parts = mixed_scene(Vec3(7, -2, 5));
   const EmbreeIndex e(parts);

@@ -5,6 +5,7 @@
 #include "index/index_test_meshes.hpp"
 #include "routing/audit.hpp"
 
+#include "core/error.hpp"
 #include "core/mesh.hpp"
 #include "index/brute_force_index.hpp"
 #include "index/embree_index.hpp"
@@ -635,7 +636,8 @@ std::string report_difference(const ClashResult& x, const ClashResult& y) {
   return "";
 }
 
-/// The certified audit with and without cut-short queries (same index, one thread).
+/// The certified audit with and without cut-short queries (same index, one thread), both
+/// with exact sphere-tracing queries (approximate ones move the samples).
 std::string cut_short_difference(const std::vector<CableInput>& cables, const std::vector<Part>& parts,
                                  double clearance) {
   const EmbreeIndex index(parts);
@@ -643,6 +645,7 @@ std::string cut_short_difference(const std::vector<CableInput>& cables, const st
   req.tolerance = kTol;
   req.routing_clearance = clearance;
   req.threads = 1;
+  req.distance_rel_error = 0.0;
   const ClashResult cut = check_clashes(cables, parts, &index, req);
   req.cut_short_queries = false;
   const ClashResult full = check_clashes(cables, parts, &index, req);
@@ -694,6 +697,106 @@ TEST(ClashCutShort, RandomScenesGiveTheSameReport) {
   }
 }
 
+/// The certified audit with (1 + ε)-approximate sphere-tracing queries against the exact
+/// one: the same findings, each to the tolerance ("" when so, else what differs). Sample
+/// positions differ, so stretch ends may move by one chord (≤ 2r) and the deepest point of
+/// a stretch at constant depth may be another of its points; the smallest clearance of a
+/// cable beyond the band is an upper bound in both (any sampled surface point).
+std::string approximate_difference(const std::vector<CableInput>& cables, const std::vector<Part>& parts,
+                                   double clearance, double rel_error, bool* samples_moved = nullptr) {
+  const EmbreeIndex index(parts);
+  ClashRequest req;
+  req.tolerance = kTol;
+  req.routing_clearance = clearance;
+  req.threads = 1;
+  req.distance_rel_error = 0.0;
+  const ClashResult x = check_clashes(cables, parts, &index, req);
+  req.distance_rel_error = rel_error;
+  const ClashResult y = check_clashes(cables, parts, &index, req);
+  if (samples_moved) *samples_moved = x.counters.samples != y.counters.samples;
+  if (x.clashes.size() != y.clashes.size())
+    return "clash count " + std::to_string(x.clashes.size()) + " vs " + std::to_string(y.clashes.size());
+  for (std::size_t i = 0; i < x.clashes.size(); ++i) {
+    const ClashEntry &a = x.clashes[i], &b = y.clashes[i];
+    const double chord = 2.0 * cables[a.cable].radius + kTol;
+    if (a.kind != b.kind || a.cable != b.cable || a.part != b.part || a.other != b.other || a.keep_out != b.keep_out ||
+        a.inside != b.inside || std::abs(a.clearance - b.clearance) > kTol || std::abs(a.s_begin - b.s_begin) > chord ||
+        std::abs(a.s_end - b.s_end) > chord)
+      return "clash " + std::to_string(i) + ": clearance " + full_precision(a.clearance) + " vs " +
+             full_precision(b.clearance) + ", stretch " + full_precision(a.s_begin) + ".." + full_precision(a.s_end) +
+             " vs " + full_precision(b.s_begin) + ".." + full_precision(b.s_end);
+  }
+  if (x.violations.size() != y.violations.size()) return "violation count";
+  for (std::size_t i = 0; i < x.violations.size(); ++i) {
+    const Violation &a = x.violations[i], &b = y.violations[i];
+    if (a.kind != b.kind || a.cable != b.cable || a.part != b.part || std::abs(a.value - b.value) > kTol ||
+        a.limit != b.limit)
+      return "violation " + std::to_string(i) + ": " + full_precision(a.value) + " vs " + full_precision(b.value);
+  }
+  for (std::size_t i = 0; i < x.cables.size(); ++i) {
+    const CableCheckSummary &a = x.cables[i], &b = y.cables[i];
+    if (a.min_clearance_exact != b.min_clearance_exact || a.min_bend_radius != b.min_bend_radius)
+      return "cable summary " + std::to_string(i);
+    if (a.min_clearance_exact && std::abs(a.min_clearance - b.min_clearance) > kTol)
+      return "cable " + std::to_string(i) + " min clearance " + full_precision(a.min_clearance) + " vs " +
+             full_precision(b.min_clearance);
+    if (!a.min_clearance_exact && (b.min_clearance < clearance - kTol) != (a.min_clearance < clearance - kTol))
+      return "cable " + std::to_string(i) + " inexact min clearance on the wrong side of the band";
+  }
+  return "";
+}
+
+TEST(ClashApproximate, InsideAHullAndAlongPartsTheFindingsAreTheExactOnes) {
+  const std::vector<Part> parts{box_part("hull", {-100, -100, -100}, {100, 100, 100}),
+                                box_part("wall", {150, -50, -50}, {154, 50, 50}),
+                                box_part("near", {200, 4, -5}, {260, 10, 5}),
+                                box_part("far", {300, 40, -5}, {360, 50, 5})};
+  const std::vector<CableInput> cables{straight_cable("A", {-60, 0, 0}, {400, 0, 0}, kR),
+                                       straight_cable("B", {-300, 20, 0}, {500, 20, 0}, 2 * kR)};
+  for (double clearance : {0.0, 3.0})
+    for (double eps : {0.1, 0.25, 1.0})
+      EXPECT_EQ(approximate_difference(cables, parts, clearance, eps), "") << clearance << " eps " << eps;
+}
+
+TEST(ClashApproximate, RandomScenesGiveTheExactFindings) {
+  // The cut-short scenes again, plus finely tessellated spheres (where the approximation
+  // saves the most leaves and its bounds are loosest).
+  int moved_scenes = 0;
+  for (std::uint32_t seed = 1; seed <= 20; ++seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> U(0, 1);
+    std::vector<Part> parts;
+    for (int i = 0; i < 8; ++i) {
+      const Vec3 lo(200 * U(rng), 200 * U(rng), 60 * U(rng));
+      parts.push_back(box_part("p" + std::to_string(i), lo, lo + Vec3(2 + 20 * U(rng), 2 + 20 * U(rng), 2 + 20 * U(rng))));
+    }
+    for (int i = 0; i < 3; ++i) {
+      Part sp;
+      sp.name = "s" + std::to_string(i);
+      sp.mesh = testmesh::uv_sphere(Vec3(200 * U(rng), 200 * U(rng), 60 * U(rng)), 5 + 20 * U(rng), 96, 48);
+      sp.closed = true;
+      parts.push_back(std::move(sp));
+    }
+    std::vector<CableInput> cables;
+    for (int i = 0; i < 3; ++i) cables.push_back(random_cable(rng, i, 6, Vec3(200, 200, 60)));
+    bool moved = false;
+    EXPECT_EQ(approximate_difference(cables, parts, seed % 2 == 0 ? 2.0 : 0.0, 0.25, &moved), "") << "seed " << seed;
+    moved_scenes += moved ? 1 : 0;
+  }
+  EXPECT_GE(moved_scenes, 10);  // the approximation did change the sampling: it was exercised
+}
+
+TEST(ClashApproximate, RejectsABadRelativeError) {
+  const std::vector<Part> parts{box_part("box", {0, 0, 0}, {10, 10, 10})};
+  const std::vector<CableInput> cables{straight_cable("C", {-30, 5, 20}, {30, 5, 20}, kR)};
+  const EmbreeIndex index(parts);
+  ClashRequest req;
+  for (double bad : {-0.5, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+    req.distance_rel_error = bad;
+    EXPECT_THROW(check_clashes(cables, parts, &index, req), std::invalid_argument) << bad;
+  }
+}
+
 // ---------------------------------------------------------------------------------------
 // `loom audit` through the binary: exit codes and report.json on tiny scenes.
 
@@ -733,6 +836,7 @@ TEST(AuditCli, CleanSceneExitsZeroWithAFullReport) {
   EXPECT_EQ(j["units"], "mm");
   EXPECT_EQ(j["method"], "certified");
   EXPECT_DOUBLE_EQ(j["tolerance"].get<double>(), 0.01);  // radius 1 / 100
+  EXPECT_DOUBLE_EQ(j["free_space_rel_error"].get<double>(), 0.25);  // ClashRequest's default
   EXPECT_TRUE(j["clashes"].empty());
   EXPECT_TRUE(j["violations"].empty());
   ASSERT_EQ(j["cables"].size(), 1u);
