@@ -312,10 +312,13 @@ TEST(EmbreeIndex, ApproximateClosestIsWithinItsFactorOfBruteForce) {
   std::uniform_real_distribution<double> u(-0.5, 0.5);
   for (int i = 0; i < 200; ++i) pts.push_back(sphere.vertices[rng() % sphere.vertices.size()] + Vec3(u(rng), u(rng), u(rng)));
   const double err = e.accuracy().abs_error;
+  std::vector<ClosestHit> oracle;
+  for (const Vec3& p : pts) oracle.push_back(b.closest(p));
   int approximate = 0;
   for (double eps : {0.0, 0.1, 0.5}) {
-    for (const Vec3& p : pts) {
-      const ClosestHit exact = b.closest(p);
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const Vec3& p = pts[i];
+      const ClosestHit& exact = oracle[i];
       ASSERT_TRUE(exact.found());
       for (double radius : {std::numeric_limits<double>::infinity(), 1.2 * exact.distance, 0.8 * exact.distance}) {
         const ClosestHit h = e.closest_approx(p, radius, eps);
