@@ -412,9 +412,9 @@ class StructureTracer {
       // Found within `enough`: the nearest surface (to within ε), so the full query's answer.
       const ClosestHit h = free_space_query(x.p, enough);
       if (!h.found()) return bounded(x, radius, enough);
-      return found(x, h, radius);
+      return answered(x, h, radius);
     }
-    return found(x, free_space_query(x.p, radius), radius);
+    return answered(x, free_space_query(x.p, radius), radius);
   }
 
   /// A sphere-tracing query: exact, or (1 + ε)-approximate when the request allows it.
@@ -434,7 +434,7 @@ class StructureTracer {
 
   /// x given the answer h of its sphere-tracing query (radius `radius`): the value when the
   /// query was exact or missed, a lower bound when it was approximate and hit.
-  Sample found(Sample x, const ClosestHit& h, double radius) {
+  Sample answered(Sample x, const ClosestHit& h, double radius) {
     if (rel_error_ > 0.0 && h.found()) {
       note(h, x.s);
       return bounded(x, radius, h.distance / (1.0 + rel_error_), h.distance);

@@ -636,16 +636,53 @@ std::string report_difference(const ClashResult& x, const ClashResult& y) {
   return "";
 }
 
-/// The certified audit with and without cut-short queries (same index, one thread), both
-/// with exact sphere-tracing queries (approximate ones move the samples).
-std::string cut_short_difference(const std::vector<CableInput>& cables, const std::vector<Part>& parts,
-                                 double clearance) {
-  const EmbreeIndex index(parts);
+/// The reference request of the comparisons below: certified at kTol, one thread, exact
+/// sphere-tracing queries.
+ClashRequest exact_request(double clearance) {
   ClashRequest req;
   req.tolerance = kTol;
   req.routing_clearance = clearance;
   req.threads = 1;
   req.distance_rel_error = 0.0;
+  return req;
+}
+
+/// A scene with free stretches inside a closed part, a wall crossed, and parts passed at a
+/// distance within and beyond the clearance band.
+struct AuditScene {
+  std::vector<Part> parts;
+  std::vector<CableInput> cables;
+};
+AuditScene hull_and_parts_scene() {
+  return {{box_part("hull", {-100, -100, -100}, {100, 100, 100}), box_part("wall", {150, -50, -50}, {154, 50, 50}),
+           box_part("near", {200, 4, -5}, {260, 10, 5}), box_part("far", {300, 40, -5}, {360, 50, 5})},
+          {straight_cable("A", {-60, 0, 0}, {400, 0, 0}, kR), straight_cable("B", {-300, 20, 0}, {500, 20, 0}, 2 * kR)}};
+}
+
+/// Random scene `seed`: 8 boxes in a 200 × 200 × 60 volume, then `spheres` closed UV
+/// spheres of 96 × 48 facets, then 3 wandering cubic cables.
+AuditScene random_audit_scene(std::uint32_t seed, int spheres) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> U(0, 1);
+  AuditScene sc;
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 lo(200 * U(rng), 200 * U(rng), 60 * U(rng));
+    sc.parts.push_back(box_part("p" + std::to_string(i), lo, lo + Vec3(2 + 20 * U(rng), 2 + 20 * U(rng), 2 + 20 * U(rng))));
+  }
+  for (int i = 0; i < spheres; ++i) {
+    const Vec3 c(200 * U(rng), 200 * U(rng), 60 * U(rng));
+    sc.parts.push_back(testmesh::make_part("s" + std::to_string(i), testmesh::uv_sphere(c, 5 + 20 * U(rng), 96, 48), true));
+  }
+  for (int i = 0; i < 3; ++i) sc.cables.push_back(random_cable(rng, i, 6, Vec3(200, 200, 60)));
+  return sc;
+}
+
+/// The certified audit with and without cut-short queries (same index, one thread), both
+/// with exact sphere-tracing queries (approximate ones move the samples).
+std::string cut_short_difference(const std::vector<CableInput>& cables, const std::vector<Part>& parts,
+                                 double clearance) {
+  const EmbreeIndex index(parts);
+  ClashRequest req = exact_request(clearance);
   const ClashResult cut = check_clashes(cables, parts, &index, req);
   req.cut_short_queries = false;
   const ClashResult full = check_clashes(cables, parts, &index, req);
@@ -670,30 +707,15 @@ TEST(ClashCutShort, FarCableKeepsItsSmallestSampledClearance) {
 }
 
 TEST(ClashCutShort, InsideAHullAndAlongPartsTheReportIsUnchanged) {
-  // Free stretches inside a closed part (their depth needs the full queries), a wall crossed,
-  // parts passed at a distance within and beyond the clearance band.
-  const std::vector<Part> parts{box_part("hull", {-100, -100, -100}, {100, 100, 100}),
-                                box_part("wall", {150, -50, -50}, {154, 50, 50}),
-                                box_part("near", {200, 4, -5}, {260, 10, 5}),
-                                box_part("far", {300, 40, -5}, {360, 50, 5})};
-  const std::vector<CableInput> cables{straight_cable("A", {-60, 0, 0}, {400, 0, 0}, kR),
-                                       straight_cable("B", {-300, 20, 0}, {500, 20, 0}, 2 * kR)};
-  for (double clearance : {0.0, 3.0}) EXPECT_EQ(cut_short_difference(cables, parts, clearance), "") << clearance;
+  // The depth of the free stretches inside the hull needs the full queries.
+  const AuditScene sc = hull_and_parts_scene();
+  for (double clearance : {0.0, 3.0}) EXPECT_EQ(cut_short_difference(sc.cables, sc.parts, clearance), "") << clearance;
 }
 
 TEST(ClashCutShort, RandomScenesGiveTheSameReport) {
-  // Boxes in a 200 × 200 × 60 volume and wandering cubic cables (fixed seeds).
   for (std::uint32_t seed = 1; seed <= 20; ++seed) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> U(0, 1);
-    std::vector<Part> parts;
-    for (int i = 0; i < 8; ++i) {
-      const Vec3 lo(200 * U(rng), 200 * U(rng), 60 * U(rng));
-      parts.push_back(box_part("p" + std::to_string(i), lo, lo + Vec3(2 + 20 * U(rng), 2 + 20 * U(rng), 2 + 20 * U(rng))));
-    }
-    std::vector<CableInput> cables;
-    for (int i = 0; i < 3; ++i) cables.push_back(random_cable(rng, i, 6, Vec3(200, 200, 60)));
-    EXPECT_EQ(cut_short_difference(cables, parts, seed % 2 == 0 ? 2.0 : 0.0), "") << "seed " << seed;
+    const AuditScene sc = random_audit_scene(seed, 0);
+    EXPECT_EQ(cut_short_difference(sc.cables, sc.parts, seed % 2 == 0 ? 2.0 : 0.0), "") << "seed " << seed;
   }
 }
 
@@ -705,11 +727,7 @@ TEST(ClashCutShort, RandomScenesGiveTheSameReport) {
 std::string approximate_difference(const std::vector<CableInput>& cables, const std::vector<Part>& parts,
                                    double clearance, double rel_error, bool* samples_moved = nullptr) {
   const EmbreeIndex index(parts);
-  ClashRequest req;
-  req.tolerance = kTol;
-  req.routing_clearance = clearance;
-  req.threads = 1;
-  req.distance_rel_error = 0.0;
+  ClashRequest req = exact_request(clearance);
   const ClashResult x = check_clashes(cables, parts, &index, req);
   req.distance_rel_error = rel_error;
   const ClashResult y = check_clashes(cables, parts, &index, req);
@@ -747,15 +765,10 @@ std::string approximate_difference(const std::vector<CableInput>& cables, const 
 }
 
 TEST(ClashApproximate, InsideAHullAndAlongPartsTheFindingsAreTheExactOnes) {
-  const std::vector<Part> parts{box_part("hull", {-100, -100, -100}, {100, 100, 100}),
-                                box_part("wall", {150, -50, -50}, {154, 50, 50}),
-                                box_part("near", {200, 4, -5}, {260, 10, 5}),
-                                box_part("far", {300, 40, -5}, {360, 50, 5})};
-  const std::vector<CableInput> cables{straight_cable("A", {-60, 0, 0}, {400, 0, 0}, kR),
-                                       straight_cable("B", {-300, 20, 0}, {500, 20, 0}, 2 * kR)};
+  const AuditScene sc = hull_and_parts_scene();
   for (double clearance : {0.0, 3.0})
     for (double eps : {0.1, 0.25, 1.0})
-      EXPECT_EQ(approximate_difference(cables, parts, clearance, eps), "") << clearance << " eps " << eps;
+      EXPECT_EQ(approximate_difference(sc.cables, sc.parts, clearance, eps), "") << clearance << " eps " << eps;
 }
 
 TEST(ClashApproximate, RandomScenesGiveTheExactFindings) {
@@ -763,24 +776,10 @@ TEST(ClashApproximate, RandomScenesGiveTheExactFindings) {
   // saves the most leaves and its bounds are loosest).
   int moved_scenes = 0;
   for (std::uint32_t seed = 1; seed <= 20; ++seed) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> U(0, 1);
-    std::vector<Part> parts;
-    for (int i = 0; i < 8; ++i) {
-      const Vec3 lo(200 * U(rng), 200 * U(rng), 60 * U(rng));
-      parts.push_back(box_part("p" + std::to_string(i), lo, lo + Vec3(2 + 20 * U(rng), 2 + 20 * U(rng), 2 + 20 * U(rng))));
-    }
-    for (int i = 0; i < 3; ++i) {
-      Part sp;
-      sp.name = "s" + std::to_string(i);
-      sp.mesh = testmesh::uv_sphere(Vec3(200 * U(rng), 200 * U(rng), 60 * U(rng)), 5 + 20 * U(rng), 96, 48);
-      sp.closed = true;
-      parts.push_back(std::move(sp));
-    }
-    std::vector<CableInput> cables;
-    for (int i = 0; i < 3; ++i) cables.push_back(random_cable(rng, i, 6, Vec3(200, 200, 60)));
+    const AuditScene sc = random_audit_scene(seed, 3);
     bool moved = false;
-    EXPECT_EQ(approximate_difference(cables, parts, seed % 2 == 0 ? 2.0 : 0.0, 0.25, &moved), "") << "seed " << seed;
+    EXPECT_EQ(approximate_difference(sc.cables, sc.parts, seed % 2 == 0 ? 2.0 : 0.0, 0.25, &moved), "")
+        << "seed " << seed;
     moved_scenes += moved ? 1 : 0;
   }
   EXPECT_GE(moved_scenes, 10);  // the approximation did change the sampling: it was exercised
