@@ -300,6 +300,21 @@ class LatticeBitmap {
 
 /// Most bits of one lattice bitmap (8 MiB; two per plane, planes in parallel). A larger
 /// index box (a huge sparse projection) falls back to sorting the lattice points.
+/// The rotations that map the coordinate axes onto themselves (signed permutation
+/// matrices of determinant +1: 24), identity first; only the identity if `all` is false.
+std::vector<Eigen::Matrix3d> axis_rotations(bool all) {
+  std::vector<Eigen::Matrix3d> out{Eigen::Matrix3d::Identity()};
+  if (!all) return out;
+  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (const auto& pm : perms)
+    for (int signs = 0; signs < 8; ++signs) {
+      Eigen::Matrix3d R = Eigen::Matrix3d::Zero();
+      for (int r = 0; r < 3; ++r) R(r, pm[r]) = (signs >> r) & 1 ? -1.0 : 1.0;
+      if (R.determinant() > 0.0 && !R.isIdentity()) out.push_back(R);
+    }
+  return out;
+}
+
 constexpr std::size_t kMaxLatticeBitmapBits = std::size_t(1) << 26;
 
 /// Lexicographic order (x, then y) of plane points.
@@ -993,12 +1008,16 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
     for (const auto& p : parts) all.extend(p.mesh.bounds());
     o.scene_size = all.diagonal() > 0.0 ? all.diagonal() : 1.0;
   }
-  // Parts that are translated copies of an earlier part (ribs, boxes placed along a
-  // span) are simplified once: the result is translated, which keeps containment (up to
-  // the rounding of the copy, far below the tolerance) and every measure.
+  // Parts that are copies of an earlier part (ribs, boxes placed along a span; a spar
+  // turned end for end) are simplified once: the result is moved like the part, which keeps
+  // containment (up to the rounding of the copy, far below the tolerance) and every
+  // measure. A copy is the earlier part moved by a rotation that maps the coordinate axes
+  // onto themselves (projection planes go to projection planes) and a translation. With
+  // user planes only translations qualify: a rotation would turn those planes.
   const double copy_tol = 1e-2 * o.containment_tolerance_factor * o.scene_size;
+  const std::vector<Eigen::Matrix3d> motions = axis_rotations(o.extra_planes.empty());
   std::vector<std::size_t> source(parts.size());
-  std::vector<Vec3> shift(parts.size(), Vec3::Zero());
+  std::vector<Eigen::Affine3d> move(parts.size(), Eigen::Affine3d::Identity());
   for (std::size_t i = 0; i < parts.size(); ++i) {
     source[i] = i;
     const Mesh& mi = parts[i].mesh;
@@ -1006,13 +1025,17 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
     for (std::size_t j = 0; j < i && source[i] == i && !mi.empty() && o.step_dir.empty(); ++j) {
       const Mesh& mj = parts[j].mesh;
       if (source[j] != j || mj.vertices.size() != mi.vertices.size() || mj.triangles != mi.triangles) continue;
-      const Vec3 t = mi.vertices[0] - mj.vertices[0];
-      bool same = true;
-      for (std::size_t v = 0; v < mi.vertices.size() && same; ++v)
-        same = (mi.vertices[v] - mj.vertices[v] - t).cwiseAbs().maxCoeff() <= copy_tol;
-      if (same) {
-        source[i] = j;
-        shift[i] = t;
+      for (const Eigen::Matrix3d& R : motions) {
+        const Vec3 t = mi.vertices[0] - R * mj.vertices[0];
+        bool same = true;
+        for (std::size_t v = 0; v < mi.vertices.size() && same; ++v)
+          same = (mi.vertices[v] - R * mj.vertices[v] - t).cwiseAbs().maxCoeff() <= copy_tol;
+        if (same) {
+          source[i] = j;
+          move[i].linear() = R;
+          move[i].translation() = t;
+          break;
+        }
       }
     }
   }
@@ -1042,7 +1065,7 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
       p.mesh = parts[i].mesh;
     } else {
       p.mesh = out[j].mesh;
-      for (auto& v : p.mesh.vertices) v += shift[i];
+      for (auto& v : p.mesh.vertices) v = move[i] * v;  // a proper rotation: windings stay outward
       p.closed = out[j].closed;
       p.source_faces = out[j].source_faces;
     }

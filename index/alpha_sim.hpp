@@ -133,8 +133,8 @@ struct AlphaSimResult {
   double mesh_ms = 0.0;     ///< OpenCASCADE prisms, Booleans, meshing
   double measure_ms = 0.0;  ///< mesh containment, Hausdorff, lost-space probe
   std::vector<ProjectionReport> projections;
-  /// simplify_parts: the earlier part this one is a translated copy of (its result was
-  /// translated, not recomputed; time_ms is the copy's); empty otherwise.
+  /// simplify_parts: the earlier part this one is a moved copy of (its result was moved,
+  /// not recomputed; time_ms is the copy's); empty otherwise.
   std::string copy_of;
 };
 
@@ -178,8 +178,10 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt);
 /// Simplifies every part in parallel (TBB) and returns them with the simplified meshes
 /// (names, roles, clearances kept), ready for any ObstacleIndex. opt.scene_size ≤ 0 is
 /// replaced by the diagonal of all parts. Results in part order if `results` is given.
-/// A part that is a translated copy of an earlier one (same triangles, vertices shifted by
-/// one vector within 1e-2 of the tolerance) gets that part's result translated (copy_of).
+/// A part that is a moved copy of an earlier one (same triangles; vertices = R·v + t within
+/// 1e-2 of the tolerance, R a rotation mapping the axes onto themselves, e.g. a part turned
+/// end for end; R = identity only when user planes are given) gets that part's result
+/// moved the same way (copy_of).
 std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimOptions& opt,
                                  std::vector<AlphaSimResult>* results);
 

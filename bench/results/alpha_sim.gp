@@ -12,6 +12,7 @@ set ylabel 'Hausdorff / diagonal'
 plot '' using 2:6 with linespoints title 'one-sided Hausdorff'
 set ylabel 'time (ms)'
 plot '' using 2:7 with linespoints title 'simplification time'
-set ylabel 'closest-point queries: simplified / original'
-plot '' using 2:9 with linespoints title 'query speed-up (Embree)'
+set ylabel 'queries/s: simplified / original'
+set logscale y
+plot '' using 2:9 with linespoints title 'closest within 5% diag', '' using 2:11 with linespoints title 'clearance r = dim_pre, in the box', '' using 2:12 with linespoints title 'clearance r = dim_pre, near the surface'
 unset multiplot

@@ -784,22 +784,26 @@ TEST(AlphaSim, FacetedCylinderAcrossTheAxesIsNotEroded) {
   EXPECT_DOUBLE_EQ(oracle_containment(sp.mesh, samples, sp.result.tolerance), 1.0);
 }
 
-TEST(AlphaSim, TranslatedCopiesAreSimplifiedOnce) {
+TEST(AlphaSim, TranslatedAndAxisTurnedCopiesAreSimplifiedOnce) {
   auto plate = [](const Vec3& at) {
     Mesh m = extruded_grid(12, 12, 1.0, 2.0, [](int i, int j) { return !(i == 3 && j == 3) && !(i >= 6 && i < 10 && j >= 6 && j < 10); });
     for (auto& v : m.vertices) v += at;
     return m;
   };
   std::vector<Part> parts = {make_part("a", plate({0, 0, 0})), make_part("b", plate({100.3, 7.1, -2.0})),
-                             make_part("c", plate({0, 0, 0}))};
-  parts[2].mesh.transform(Eigen::Affine3d(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ())));  // not a translation
+                             make_part("c", plate({0, 0, 0})), make_part("d", plate({0, 0, 0}))};
+  parts[2].mesh.transform(Eigen::Affine3d(Eigen::AngleAxisd(M_PI / 6, Vec3::UnitZ())));  // not a copy: 30°
+  // Turned end for end (180° about z) and moved, like the wing's rear spar: a copy.
+  const Eigen::Affine3d turn = Eigen::Translation3d(50.0, 80.0, 3.0) * Eigen::AngleAxisd(M_PI, Vec3::UnitZ());
+  parts[3].mesh.transform(turn);
   std::vector<AlphaSimResult> res;
   const auto simple = simplify_parts(parts, options(1.5), &res);
-  ASSERT_EQ(res.size(), 3u);
+  ASSERT_EQ(res.size(), 4u);
   EXPECT_TRUE(res[0].copy_of.empty());
   EXPECT_EQ(res[1].copy_of, "a");
   EXPECT_EQ(res[1].name, "b");
   EXPECT_TRUE(res[2].copy_of.empty());
+  EXPECT_EQ(res[3].copy_of, "a");
   ASSERT_EQ(simple[1].mesh.vertices.size(), simple[0].mesh.vertices.size());
   EXPECT_EQ(simple[1].mesh.triangles, simple[0].mesh.triangles);
   for (std::size_t i = 0; i < simple[0].mesh.vertices.size(); ++i)
@@ -808,6 +812,19 @@ TEST(AlphaSim, TranslatedCopiesAreSimplifiedOnce) {
   const auto samples = dense_surface_samples(parts[1].mesh, 0.75, 1.0, 20000, 5);
   EXPECT_DOUBLE_EQ(oracle_containment(simple[1].mesh, samples, res[1].tolerance), 1.0);
   EXPECT_EQ(res[1].triangles_after, res[0].triangles_after);
+  // The turned copy: the result turned the same way, and it contains its own original.
+  for (std::size_t i = 0; i < simple[0].mesh.vertices.size(); ++i)
+    ASSERT_LT((simple[3].mesh.vertices[i] - turn * simple[0].mesh.vertices[i]).norm(), 1e-9);
+  EXPECT_GT(simple[3].mesh.signed_volume(), 0.0);  // still outward
+  EXPECT_NEAR(simple[3].mesh.signed_volume(), simple[0].mesh.signed_volume(), 1e-9 * simple[0].mesh.signed_volume());
+  const auto samples_d = dense_surface_samples(parts[3].mesh, 0.75, 1.0, 20000, 6);
+  EXPECT_DOUBLE_EQ(oracle_containment(simple[3].mesh, samples_d, res[3].tolerance), 1.0);
+  // With a user plane a rotation would turn it: only translations are reused then.
+  auto with_plane = options(1.5);
+  with_plane.extra_planes = {Vec3(1, 1, 0)};
+  std::vector<AlphaSimResult> res_plane;
+  simplify_parts({parts[0], parts[3]}, with_plane, &res_plane);
+  EXPECT_TRUE(res_plane[1].copy_of.empty());
   EXPECT_EQ(simplify_part(parts[1], options(1.5)).result.status, AlphaSimStatus::Ok);
 }
 
