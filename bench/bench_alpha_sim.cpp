@@ -92,28 +92,13 @@ double rate(const ObstacleIndex& idx, const std::vector<Vec3>& pts, double radiu
   return best;
 }
 
-/// Closest-point queries per second on `parts` through EmbreeIndex (random points in box).
-double query_rate(const std::vector<Part>& parts, const AABB& box, double radius, int n, std::uint64_t seed) {
-  return rate(EmbreeIndex(parts), box_points(box, n, seed), radius);
-}
-
-/// Closest-point queries per second through EmbreeIndex for points near the original
-/// surface: near_points(near, radius), searched within `radius`.
-double near_query_rate(const std::vector<Part>& parts, const std::vector<Part>& near, double radius, int n,
-                       std::uint64_t seed) {
-  return rate(EmbreeIndex(parts), near_points(near, radius, n, seed), radius);
-}
-
-/// Clearance queries (closest within the clearance radius dim_pre: a cable of diameter
-/// dim_pre kept dim_pre / 2 off) per second through EmbreeIndex: on the original parts and
-/// on the simplified ones.
-struct ClearanceRates {
+/// Speed-up of `simplified` over `original` on the same points and radius (rate() each).
+struct Rates {
   double original = 0, simplified = 0;
   double speedup() const { return simplified / original; }
 };
-ClearanceRates clearance_rates(const std::vector<Part>& original, const std::vector<Part>& simple,
-                               const std::vector<Vec3>& pts, double radius) {
-  return {rate(EmbreeIndex(original), pts, radius), rate(EmbreeIndex(simple), pts, radius)};
+Rates rates(const EmbreeIndex& original, const EmbreeIndex& simplified, const std::vector<Vec3>& pts, double radius) {
+  return {rate(original, pts, radius), rate(simplified, pts, radius)};
 }
 
 Part load_part(const std::string& rel) {
@@ -171,16 +156,17 @@ int main(int argc, char** argv) {
     const double set_cpu = cpu_seconds() - cpu0, set_wall = seconds_since(t_set);
     AABB box;
     for (const auto& p : set.parts) box.extend(p.mesh.bounds());
-    const double radius = 0.05 * box.diagonal();
-    const double q_orig = query_rate(set.parts, box, radius, n_queries, 11);
-    const double q_simp = query_rate(simple, box, radius, n_queries, 11);
-    // Near the surface, within 5 cable diameters (= dim_pre).
-    const double qn_orig = near_query_rate(set.parts, set.parts, 5.0 * set.dim_pre, n_queries, 13);
-    const double qn_simp = near_query_rate(simple, set.parts, 5.0 * set.dim_pre, n_queries, 13);
-    // Clearance queries (radius dim_pre) in the box and within 5·dim_pre of the surface.
-    const ClearanceRates cb = clearance_rates(set.parts, simple, box_points(box, n_queries, 17), set.dim_pre);
-    const ClearanceRates cn =
-        clearance_rates(set.parts, simple, near_points(set.parts, 5.0 * set.dim_pre, n_queries, 19), set.dim_pre);
+    const EmbreeIndex original_index(set.parts), simple_index(simple);
+    // Closest within 5% of the diagonal in the box, and within 5·dim_pre of points up to
+    // that far from the surface (5 cable diameters).
+    const Rates qb = rates(original_index, simple_index, box_points(box, n_queries, 11), 0.05 * box.diagonal());
+    const Rates qn =
+        rates(original_index, simple_index, near_points(set.parts, 5.0 * set.dim_pre, n_queries, 13), 5.0 * set.dim_pre);
+    // Clearance queries (closest within dim_pre: a cable of diameter dim_pre kept dim_pre/2
+    // off) at the same two kinds of points.
+    const Rates cb = rates(original_index, simple_index, box_points(box, n_queries, 17), set.dim_pre);
+    const Rates cn =
+        rates(original_index, simple_index, near_points(set.parts, 5.0 * set.dim_pre, n_queries, 19), set.dim_pre);
     std::size_t before = 0, after = 0;
     double haus = 0, time_ms = 0, cont = 1;
     for (std::size_t i = 0; i < res.size(); ++i) {
@@ -193,8 +179,9 @@ int main(int argc, char** argv) {
       parts_csv << set.name << "," << r.name << "," << set.dim_pre << "," << r.triangles_before << ","
                 << r.triangles_after << "," << double(r.triangles_after) / std::max<std::size_t>(1, r.triangles_before)
                 << "," << r.hausdorff << "," << r.containment << "," << alpha_sim_status_name(r.status) << ","
-                << alpha_sim_fallback_name(r.fallback) << "," << r.time_ms << "," << q_orig << "," << q_simp << ","
-                << q_simp / q_orig << "," << qn_orig << "," << qn_simp << "," << qn_simp / qn_orig << "," << cb.original
+                << alpha_sim_fallback_name(r.fallback) << "," << r.time_ms << "," << qb.original << "," << qb.simplified
+                << "," << qb.speedup() << "," << qn.original << "," << qn.simplified << "," << qn.speedup() << ","
+                << cb.original
                 << "," << cb.simplified << "," << cb.speedup() << "," << cn.original << "," << cn.simplified << ","
                 << cn.speedup() << "," << r.copy_of << "\n";
     }
@@ -203,7 +190,8 @@ int main(int argc, char** argv) {
                 "simplify_parts %.2f s CPU %.2f s wall  queries/s in box %.3g -> %.3g (x%.2f), near surface %.3g -> "
                 "%.3g (x%.2f)\n",
                 set.name.c_str(), set.dim_pre, before, after, 100.0 * after / std::max<std::size_t>(1, before), haus,
-                cont, time_ms, set_cpu, set_wall, q_orig, q_simp, q_simp / q_orig, qn_orig, qn_simp, qn_simp / qn_orig);
+                cont, time_ms, set_cpu, set_wall, qb.original, qb.simplified, qb.speedup(), qn.original, qn.simplified,
+                qn.speedup());
     std::printf("%-24s clearance queries (r = dim_pre) per second, original -> simplified: in box %.3g -> %.3g "
                 "(x%.2f), near surface %.3g -> %.3g (x%.2f)\n",
                 set.name.c_str(), cb.original, cb.simplified, cb.speedup(), cn.original, cn.simplified, cn.speedup());
@@ -246,7 +234,8 @@ int main(int argc, char** argv) {
   Part motor = load_part("occt/motor.stl");
   const AABB mbox = motor.mesh.bounds();
   const double diag = mbox.diagonal();
-  const double q_orig = query_rate({motor}, mbox, 0.05 * diag, n_queries, 5);
+  const EmbreeIndex motor_index({motor});
+  const std::vector<Vec3> sweep_box = box_points(mbox, n_queries, 5), clear_box = box_points(mbox, n_queries, 17);
   std::ofstream sweep_csv(out_dir / "alpha_sim_sweep.csv");
   sweep_csv << "dim_pre,dim_pre_rel,triangles_after,triangle_ratio,hausdorff,hausdorff_rel,time_ms,query_rate,"
                "query_speedup,status,clearance_box_speedup,clearance_near_speedup\n";
@@ -256,18 +245,19 @@ int main(int argc, char** argv) {
     const auto sp = simplify_part(motor, o);
     Part simple = motor;
     simple.mesh = sp.mesh;
-    const double q = query_rate({simple}, mbox, 0.05 * diag, n_queries, 5);
-    const ClearanceRates cb = clearance_rates({motor}, {simple}, box_points(mbox, n_queries, 17), o.dim_pre);
-    const ClearanceRates cn = clearance_rates({motor}, {simple}, near_points({motor}, 5.0 * o.dim_pre, n_queries, 19), o.dim_pre);
+    const EmbreeIndex simple_index({simple});
+    const Rates q = rates(motor_index, simple_index, sweep_box, 0.05 * diag);
+    const Rates cb = rates(motor_index, simple_index, clear_box, o.dim_pre);
+    const Rates cn = rates(motor_index, simple_index, near_points({motor}, 5.0 * o.dim_pre, n_queries, 19), o.dim_pre);
     const auto& r = sp.result;
     sweep_csv << o.dim_pre << "," << rel << "," << r.triangles_after << ","
               << double(r.triangles_after) / r.triangles_before << "," << r.hausdorff << "," << r.hausdorff / diag
-              << "," << r.time_ms << "," << q << "," << q / q_orig << "," << alpha_sim_status_name(r.status) << ","
+              << "," << r.time_ms << "," << q.simplified << "," << q.speedup() << "," << alpha_sim_status_name(r.status) << ","
               << cb.speedup() << "," << cn.speedup() << "\n";
     std::printf("motor dim_pre %.4g (%.3f diag): tris %zu (%.1f%%) hausdorff %.4g  %.0f ms  speedup x%.2f  %s  "
                 "clearance queries x%.2f in box, x%.2f near surface\n",
                 o.dim_pre, rel, r.triangles_after, 100.0 * r.triangles_after / r.triangles_before, r.hausdorff,
-                r.time_ms, q / q_orig, alpha_sim_status_name(r.status), cb.speedup(), cn.speedup());
+                r.time_ms, q.speedup(), alpha_sim_status_name(r.status), cb.speedup(), cn.speedup());
   }
   sweep_csv.close();
 

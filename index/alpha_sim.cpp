@@ -298,8 +298,6 @@ class LatticeBitmap {
   std::vector<std::uint64_t> bits_;
 };
 
-/// Most bits of one lattice bitmap (8 MiB; two per plane, planes in parallel). A larger
-/// index box (a huge sparse projection) falls back to sorting the lattice points.
 /// The rotations that map the coordinate axes onto themselves (signed permutation
 /// matrices of determinant +1: 24), identity first; only the identity if `all` is false.
 std::vector<Eigen::Matrix3d> axis_rotations(bool all) {
@@ -315,6 +313,8 @@ std::vector<Eigen::Matrix3d> axis_rotations(bool all) {
   return out;
 }
 
+/// Most bits of one lattice bitmap (8 MiB; two per plane, planes in parallel). A larger
+/// index box (a huge sparse projection) falls back to sorting the lattice points.
 constexpr std::size_t kMaxLatticeBitmapBits = std::size_t(1) << 26;
 
 /// Lexicographic order (x, then y) of plane points.
@@ -616,6 +616,28 @@ void keep_original(AlphaSimPart& out, const Part& part, AlphaSimStatus status, c
   r.volume_after = r.volume_before;
   r.containment = r.containment_implicit = 1.0;  // the same surface
   r.hausdorff = 0.0;
+}
+
+/// The projection reports of a part turned by R (an axis-mapping rotation), from those of
+/// the part before the turn: the projection that had normal n is the turned part's
+/// projection with normal ±R·n, reported in the order and under the names of `specs`.
+/// Reports that do not cover every plane (a part kept early) are returned as they are.
+std::vector<ProjectionReport> turned_projections(const std::vector<ProjectionReport>& before,
+                                                 const Eigen::Matrix3d& R, const std::vector<PlaneSpec>& specs) {
+  if (before.size() != specs.size()) return before;
+  std::vector<ProjectionReport> out(specs.size());
+  std::size_t matched = 0;
+  for (const ProjectionReport& rep : before) {
+    const Vec3 n = R * rep.normal;
+    for (std::size_t k = 0; k < specs.size(); ++k)
+      if (std::abs(std::abs(n.dot(specs[k].frame.n)) - 1.0) < 1e-9) {
+        out[k] = rep;
+        out[k].plane = specs[k].name;
+        out[k].normal = specs[k].frame.n;
+        ++matched;
+      }
+  }
+  return matched == specs.size() ? out : before;
 }
 
 }  // namespace
@@ -1071,6 +1093,7 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
     }
     out[i] = std::move(p);
     res[i] = res[j];
+    if (!move[i].linear().isIdentity()) res[i].projections = turned_projections(res[j].projections, move[i].linear(), planes_for(o));
     res[i].name = parts[i].name;
     res[i].copy_of = parts[j].name;
     res[i].time_ms = ms_since(t0);

@@ -819,6 +819,25 @@ TEST(AlphaSim, TranslatedAndAxisTurnedCopiesAreSimplifiedOnce) {
   EXPECT_NEAR(simple[3].mesh.signed_volume(), simple[0].mesh.signed_volume(), 1e-9 * simple[0].mesh.signed_volume());
   const auto samples_d = dense_surface_samples(parts[3].mesh, 0.75, 1.0, 20000, 6);
   EXPECT_DOUBLE_EQ(oracle_containment(simple[3].mesh, samples_d, res[3].tolerance), 1.0);
+  // A copy turned a quarter about x: its XY projection is the source's XZ one (no hole)
+  // and its XZ projection the source's XY one (the big hole); reported as a direct
+  // simplification of the turned part reports them.
+  Part e = parts[0];
+  e.name = "e";
+  e.mesh.transform(Eigen::Affine3d(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitX())));
+  std::vector<AlphaSimResult> res_e;
+  simplify_parts({parts[0], e}, options(1.5), &res_e);
+  ASSERT_EQ(res_e[1].copy_of, "a");
+  const auto direct = simplify_part(e, options(1.5)).result;
+  ASSERT_EQ(res_e[1].projections.size(), direct.projections.size());
+  for (std::size_t k = 0; k < direct.projections.size(); ++k) {
+    const auto& got = res_e[1].projections[k];
+    const auto& want = direct.projections[k];
+    EXPECT_EQ(got.plane, want.plane);
+    EXPECT_EQ(got.holes, want.holes) << want.plane;
+    EXPECT_NEAR(got.area, want.area, 1e-6 * want.area) << want.plane;
+  }
+  EXPECT_EQ(res_e[1].projections[1].holes, 1u);  // XZ: the big hole
   // With a user plane a rotation would turn it: only translations are reused then.
   auto with_plane = options(1.5);
   with_plane.extra_planes = {Vec3(1, 1, 0)};
