@@ -215,6 +215,16 @@ LineCrossing line_crossing(const Vec3& p, const Vec3& u, const Vec3& a, const Ve
   return out;
 }
 
+/// Distance along the unit direction u from p, inside box b, to where the ray leaves b.
+double box_exit_distance(const AABB& b, const Vec3& p, const Vec3& u) {
+  double t = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    if (u[k] > 0.0) t = std::min(t, (b.max[k] - p[k]) / u[k]);
+    else if (u[k] < 0.0) t = std::min(t, (b.min[k] - p[k]) / u[k]);
+  }
+  return std::max(0.0, t);
+}
+
 bool memory_monitor(void* ptr, ssize_t bytes, bool /*post*/) {
   static_cast<std::atomic<long long>*>(ptr)->fetch_add(bytes);
   return true;
@@ -586,6 +596,10 @@ bool EmbreeIndex::inside(const Vec3& p, int* part) const {
     // rounding of the origin could hide, is still collected; the double test below
     // decides on which side of p each crossing lies.
     const Vec3 org = pc - back * u;
+    // Only crossings of the candidates count, and p lies in each candidate's box: the ray
+    // can stop where it leaves the last of them instead of crossing the whole scene.
+    double exit = 0.0;
+    for (int c : cand) exit = std::max(exit, box_exit_distance(parts_[c].bounds, p, u));
     hits.clear();
     CollectContext cc;
     rtcInitIntersectContext(&cc.ctx);
@@ -599,7 +613,7 @@ bool EmbreeIndex::inside(const Vec3& p, int* part) const {
     rh.ray.dir_y = static_cast<float>(u.y());
     rh.ray.dir_z = static_cast<float>(u.z());
     rh.ray.tnear = 0.0f;
-    rh.ray.tfar = std::numeric_limits<float>::infinity();
+    rh.ray.tfar = to_float_up(back + exit + 4.0 * float_pad(p, exit));
     rh.ray.time = 0.0f;
     rh.ray.mask = 0xFFFFFFFFu;
     rh.ray.id = 0;
