@@ -120,6 +120,32 @@ TEST(EmbreeIndex, AircraftSizedOffsetKeepsPrecision) {
   EXPECT_TRUE(e.accuracy().exact);
 }
 
+// inside() stops its rays where they leave the last candidate part's box: with a small
+// part nested in a large one, a point in the small part's box but outside its solid must
+// still see the large part's far wall (a ray stopped at the small box would miss it).
+TEST(EmbreeIndex, InsideSeesTheFarWallOfANestingPart) {
+  const std::vector<Part> parts = {make_part("inner", uv_sphere(Vec3::Zero(), 1, 24, 12), true),
+                                   make_part("outer", box(Vec3::Constant(-40), Vec3::Constant(40)), true),
+                                   make_part("beyond", box(Vec3(50, -1, -1), Vec3(52, 1, 1)), true)};
+  const EmbreeIndex e(parts);
+  const BruteForceIndex b(parts);
+  struct Case {
+    Vec3 p;
+    int part;  ///< expected part, -1 outside
+  };
+  const Case cases[] = {{Vec3(0.9, 0.9, 0.9), 1}, {Vec3(-0.95, 0.9, -0.9), 1}, {Vec3(0.1, 0.2, 0.3), 0},
+                        {Vec3(39.5, 0, 0), 1},    {Vec3(45, 0, 0), -1},        {Vec3(51, 0, 0), 2}};
+  for (const Case& c : cases) {
+    int pe = -1, pb = -1;
+    EXPECT_EQ(e.inside(c.p, &pe), c.part >= 0) << c.p.transpose();
+    EXPECT_EQ(b.inside(c.p, &pb), c.part >= 0) << c.p.transpose();
+    if (c.part >= 0) {
+      EXPECT_EQ(pe, c.part) << c.p.transpose();
+      EXPECT_EQ(pb, c.part) << c.p.transpose();
+    }
+  }
+}
+
 TEST(EmbreeIndex, InsideAgreesWithWindingNumberNearEdgesAndVertices) {
   const auto parts = mixed_scene(Vec3(0.5, 0.25, 0.125));
   const EmbreeIndex e(parts);
