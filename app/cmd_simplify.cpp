@@ -3,7 +3,6 @@
 #include "app/commands.hpp"
 #include "app/option_checks.hpp"
 
-#include "core/error.hpp"
 #include "core/io/atomic_file.hpp"
 #include "core/io/mesh_write.hpp"
 #include "core/io/scene_load.hpp"
@@ -55,9 +54,7 @@ int run_simplify(const SimplifyCommandOptions& o) {
   Scene scene = load_scene(o.scene, lo);
   const bool given = o.dim_pre_given;
   const double dim_pre = given ? o.dim_pre : scene.simplify.dim_pre.value;
-  if (!(std::isfinite(dim_pre) && dim_pre > 0.0))
-    throw InputError({given ? "--dim-pre" : o.scene, 0, given ? "" : "simplify.dim_pre"},
-                     "dim_pre must be a finite number > 0, got " + full_precision(dim_pre));
+  // Both are finite and > 0: a given --dim-pre is checked on the option, the scene's by load_scene.
   const std::filesystem::path out_dir(o.out);
 
   AlphaSimOptions opt;

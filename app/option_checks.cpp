@@ -1,6 +1,5 @@
 #include "app/option_checks.hpp"
 
-#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -13,7 +12,6 @@ CLI::Validator finite_number(double min, bool min_allowed) {
       [min, min_allowed, limit](std::string& text) -> std::string {
         const char* begin = text.c_str();
         char* end = nullptr;
-        errno = 0;
         const double v = std::strtod(begin, &end);
         const bool whole = end != begin && *end == '\0';
         if (!whole || !std::isfinite(v) || v < min || (!min_allowed && v == min))
