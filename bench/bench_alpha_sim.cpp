@@ -7,8 +7,11 @@
 //     and for points within 5·dim_pre of the original surface (routing's clearance queries);
 //  3. throughput (input triangles/s, wall and CPU) with 1 and 2 TBB threads (the wing's
 //     translated copies — ribs, boxes — are simplified once, as simplify_parts does);
-//  4. sweep of dim_pre on occt/motor.stl: triangles, Hausdorff, time, query speed.
-// Writes bench/results/alpha_sim_parts.csv, alpha_sim_sweep.csv, alpha_sim.png.
+//  4. sweep of dim_pre on occt/motor.stl: triangles, Hausdorff, time, query speed;
+//  5. the wing's CAD files tessellated finer (50k -> 420k triangles): throughput and
+//     clearance-query speed-up against the input size (`--tessellation` runs only this).
+// Writes bench/results/alpha_sim_parts.csv, alpha_sim_sweep.csv, alpha_sim_throughput.csv,
+// alpha_sim_tessellation.csv, alpha_sim.png, alpha_sim_tessellation.png.
 #include "core/io/mesh_read.hpp"
 #include "core/io/scene_load.hpp"
 #include "index/alpha_sim.hpp"
@@ -109,20 +112,112 @@ Part load_part(const std::string& rel) {
   return p;
 }
 
+/// The wing-section's CAD files (each once, in its own frame) tessellated at a linear and
+/// angular deflection, as parts.
+std::vector<Part> wing_files(double linear, double angular_deg) {
+  const fs::path dir = fs::path(LOOM_SOURCE_DIR) / "examples" / "wing-section";
+  TessellationParams tp;
+  tp.linear_deflection = linear;
+  tp.angular_deflection_deg = angular_deg;
+  std::vector<Part> parts;
+  for (const char* f : {"spar.step", "rib.step", "avionics-box.step", "actuator.step", "connector-bracket.step",
+                        "actuator-envelope.step"}) {
+    Part p;
+    p.name = f;
+    for (const NamedMesh& nm : read_cad_file(dir / f, tp, false)) p.mesh.append(nm.mesh);
+    p.closed = analyse_topology(p.mesh).closed;
+    parts.push_back(std::move(p));
+  }
+  return parts;
+}
+
+/// 5. The same wing parts tessellated finer (what a CAD export for clash analysis may
+/// hold): α-SIM's cost follows the projected area in L_max² cells and the input size, its
+/// benefit the triangles it removes. Throughput on 2 threads (without the mesh
+/// verification, as in 3) and clearance-query speed-up per tessellation.
+void tessellation_sweep(const fs::path& out_dir, double dim_pre, int n_queries) {
+  std::ofstream csv(out_dir / "alpha_sim_tessellation.csv");
+  csv << "linear_deflection,angular_deflection_deg,triangles_before,triangles_after,seconds,triangles_per_second,"
+         "cpu_seconds,clearance_box_original,clearance_box_simplified,clearance_box_speedup,clearance_near_original,"
+         "clearance_near_simplified,clearance_near_speedup\n";
+  const std::pair<double, double> levels[] = {{0.4, 20.0}, {0.1, 10.0}, {0.04, 5.0}, {0.01, 2.5}};
+  for (const auto& [linear, angular] : levels) {
+    const std::vector<Part> parts = wing_files(linear, angular);
+    std::size_t before = 0, after = 0;
+    for (const auto& p : parts) before += p.mesh.triangle_count();
+    AlphaSimOptions o;
+    o.dim_pre = dim_pre;
+    o.measure = false;
+    std::vector<AlphaSimResult> res;
+    std::vector<Part> simple;
+    double sec = 0.0, cpu = 0.0;
+    {
+      tbb::global_control gc(tbb::global_control::max_allowed_parallelism, 2);
+      const double cpu0 = cpu_seconds();
+      const auto t0 = Clock::now();
+      simple = simplify_parts(parts, o, &res);
+      sec = seconds_since(t0);
+      cpu = cpu_seconds() - cpu0;
+    }
+    for (const auto& r : res) after += r.triangles_after;
+    AABB box;
+    for (const auto& p : parts) box.extend(p.mesh.bounds());
+    const EmbreeIndex original_index(parts), simple_index(simple);
+    const Rates cb = rates(original_index, simple_index, box_points(box, n_queries, 17), dim_pre);
+    const Rates cn = rates(original_index, simple_index, near_points(parts, 5.0 * dim_pre, n_queries, 19), dim_pre);
+    csv << linear << "," << angular << "," << before << "," << after << "," << sec << "," << before / sec << "," << cpu
+        << "," << cb.original << "," << cb.simplified << "," << cb.speedup() << "," << cn.original << ","
+        << cn.simplified << "," << cn.speedup() << "\n";
+    std::printf("wing files at deflection %g / %g deg: %zu -> %zu triangles, simplified in %.2f s on 2 threads = %.3g "
+                "triangles/s (CPU %.2f s); clearance queries x%.2f in box, x%.2f near surface\n",
+                linear, angular, before, after, sec, before / sec, cpu, cb.speedup(), cn.speedup());
+  }
+  csv.close();
+  const fs::path gp = out_dir / "alpha_sim_tessellation.gp";
+  std::ofstream g(gp);
+  g << "set terminal pngcairo size 1200,450 noenhanced\n"
+    << "set output '" << (out_dir / "alpha_sim_tessellation.png").string() << "'\n"
+    << "set datafile separator ','\nset key top left\nset multiplot layout 1,2 title "
+       "'alpha-SIM on the wing-section CAD files tessellated finer (dim_pre = " << dim_pre << " mm)'\n"
+    << "set logscale x\nset xlabel 'input triangles'\nset grid\n"
+    << "set ylabel 'clearance queries/s: simplified / original'\nplot '"
+    << (out_dir / "alpha_sim_tessellation.csv").string()
+    << "' using 3:10 with linespoints title 'in the box', '' using 3:13 with linespoints title 'near the surface', "
+       "5 with lines dashtype 2 title 'target 5x'\n"
+    << "set ylabel 'input triangles/s (2 threads)'\nset logscale y\nset yrange [1e4:2e6]\nplot '' using 3:6 with linespoints title "
+       "'throughput', 1e6 with lines dashtype 2 title 'target 1e6/s'\nunset multiplot\n";
+  g.close();
+  const std::string cmd = "gnuplot '" + gp.string() + "'";
+  if (std::system(cmd.c_str()) != 0) std::printf("gnuplot failed\n");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  const fs::path out_dir = argc > 1 ? fs::path(argv[1]) : fs::path(LOOM_SOURCE_DIR) / "bench" / "results";
+  // `bench_alpha_sim --tessellation [DIR]` runs only part 5.
+  const bool tessellation_only = argc > 1 && std::string(argv[1]) == "--tessellation";
+  const int arg0 = tessellation_only ? 2 : 1;
+  const fs::path out_dir = argc > arg0 ? fs::path(argv[arg0]) : fs::path(LOOM_SOURCE_DIR) / "bench" / "results";
   fs::create_directories(out_dir);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   const int n_queries = 20000;
+  // The wing's dim_pre (its smallest cable diameter), from the scene file alone.
+  SceneLoadOptions settings_only;
+  settings_only.load_parts = false;
+  const double wing_dim_pre =
+      load_scene(fs::path(LOOM_SOURCE_DIR) / "examples" / "wing-section" / "scene.toml", settings_only)
+          .simplify.dim_pre.value;
+  if (tessellation_only) {
+    tessellation_sweep(out_dir, wing_dim_pre, n_queries);
+    return 0;
+  }
 
   // ---- 1 + 2: per part, at the scene's dim_pre (wing) or 2% of the part diagonal (real meshes).
   std::ofstream parts_csv(out_dir / "alpha_sim_parts.csv");
   parts_csv << "set,part,dim_pre,triangles_before,triangles_after,ratio,hausdorff,containment,status,fallback,time_ms,"
                "query_rate_original,query_rate_simplified,query_speedup,near_rate_original,near_rate_simplified,"
                "near_speedup,clearance_box_original,clearance_box_simplified,clearance_box_speedup,"
-               "clearance_near_original,clearance_near_simplified,clearance_near_speedup,copy_of\n";
+               "clearance_near_original,clearance_near_simplified,clearance_near_speedup,copy_of,shapes_ms,mesh_ms,measure_ms\n";
   struct Set {
     std::string name;
     std::vector<Part> parts;
@@ -183,7 +278,7 @@ int main(int argc, char** argv) {
                 << "," << qb.speedup() << "," << qn.original << "," << qn.simplified << "," << qn.speedup() << ","
                 << cb.original
                 << "," << cb.simplified << "," << cb.speedup() << "," << cn.original << "," << cn.simplified << ","
-                << cn.speedup() << "," << r.copy_of << "\n";
+                << cn.speedup() << "," << r.copy_of << "," << r.shapes_ms << "," << r.mesh_ms << "," << r.measure_ms << "\n";
     }
     total_in += before;
     std::printf("%-24s dim_pre %-8.4g tris %7zu -> %6zu (%5.1f%%) hausdorff %-9.4g containment %.6f  %7.0f ms parts, "
@@ -260,6 +355,8 @@ int main(int argc, char** argv) {
                 r.time_ms, q.speedup(), alpha_sim_status_name(r.status), cb.speedup(), cn.speedup());
   }
   sweep_csv.close();
+
+  tessellation_sweep(out_dir, wing_dim_pre, n_queries);
 
   // Chart.
   const fs::path gp = out_dir / "alpha_sim.gp";
