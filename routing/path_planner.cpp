@@ -680,9 +680,12 @@ void plan_between_stubs(const ObstacleIndex& index, TubeContext& ctx, const ob::
         r.blocking_part = -1;
       } else {
         r.reason = NoPathReason::NoCorridor;
+        // Said with the budget: the planner may have run out of time in a corridor that
+        // exists (a slow build, a tight limit), which only a longer limit tells apart.
         r.message = "no corridor wider than the tube (radius + clearance = " + fmt_len(ctx.required) +
-                    ") found; a thin path passes " + fmt_len(best) + " from part " +
-                    std::to_string(r.blocking_part) + " at " + fmt_point(*r.blocked_at);
+                    ") found within " + fmt_len(time_limit) + " s; a thin path passes " + fmt_len(best) +
+                    " from part " + std::to_string(r.blocking_part) + " at " + fmt_point(*r.blocked_at) +
+                    " (a longer time limit may still find one)";
       }
     }
     r.diagnose_ms = ms_since(t2);

@@ -319,6 +319,7 @@ TEST(PathPlanner, HoleNarrowerThanTheTubeIsNoCorridor) {
   const PlanResult r = plan_path(index, req);
   ASSERT_FALSE(r.solved());
   EXPECT_EQ(r.reason, NoPathReason::NoCorridor) << r.message;
+  EXPECT_NE(r.message.find("within 0.5 s"), std::string::npos) << r.message;  // the budget it ran out of
   ASSERT_TRUE(r.blocked_at.has_value());
   // The narrowest passage of the thin path is in the hole (or at its rim, within the
   // required distance of the wall faces x = 48 and x = 52). The ports face each other through
