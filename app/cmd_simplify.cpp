@@ -112,7 +112,7 @@ int run_simplify(const SimplifyCommandOptions& o) {
                      {"projections", projections}});
     if (!o.quiet) {
       // Below the containment tolerance a distance is rounding (a part kept as it was).
-      const double hausdorff = r.hausdorff < tolerance ? 0.0 : r.hausdorff;
+      const double hausdorff = r.hausdorff < r.tolerance ? 0.0 : r.hausdorff;
       const std::string when = r.copy_of.empty() ? std::to_string(static_cast<long long>(std::lround(r.time_ms))) + " ms"
                                                  : "copy of " + r.copy_of;
       const double pct = r.triangles_before > 0 ? 100.0 * r.triangles_after / r.triangles_before : 0.0;
@@ -132,7 +132,7 @@ int run_simplify(const SimplifyCommandOptions& o) {
             {"dim_pre_source", given ? std::string("--dim-pre") : scene.simplify.dim_pre.source},
             {"alpha", opt.alpha_factor * dim_pre},
             {"l_max", opt.sampling_factor * dim_pre},
-            {"tolerance", opt.containment_tolerance_factor * opt.scene_size},
+            {"tolerance", tolerance},
             {"triangles_before", before},
             {"triangles_after", after},
             {"parts", parts}};

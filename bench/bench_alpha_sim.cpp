@@ -8,12 +8,13 @@
 //  3. throughput (input triangles/s, wall and CPU) with 1 and 2 TBB threads (the wing's
 //     translated copies — ribs, boxes — are simplified once, as simplify_parts does);
 //  4. sweep of dim_pre on occt/motor.stl: triangles, Hausdorff, time, query speed;
-//  5. the wing's CAD files tessellated finer (50k -> 420k triangles): throughput and
+//  5. the wing's CAD files at four tessellations (50k -> 420k triangles): throughput and
 //     clearance-query speed-up against the input size (`--tessellation` runs only this).
 // Writes bench/results/alpha_sim_parts.csv, alpha_sim_sweep.csv, alpha_sim_throughput.csv,
 // alpha_sim_tessellation.csv, alpha_sim.png, alpha_sim_tessellation.png.
 #include "core/io/mesh_read.hpp"
 #include "core/io/scene_load.hpp"
+#include "core/units.hpp"
 #include "index/alpha_sim.hpp"
 #include "index/embree_index.hpp"
 
@@ -112,37 +113,48 @@ Part load_part(const std::string& rel) {
   return p;
 }
 
-/// The wing-section's CAD files (each once, in its own frame) tessellated at a linear and
-/// angular deflection, as parts.
-std::vector<Part> wing_files(double linear, double angular_deg) {
-  const fs::path dir = fs::path(LOOM_SOURCE_DIR) / "examples" / "wing-section";
+/// Each distinct file of a scene's parts (in its own frame: copies are left out, since
+/// simplify_parts would reuse their results), tessellated at a linear and angular
+/// deflection, as parts.
+std::vector<Part> scene_files(const Scene& settings_only, double linear, double angular_deg) {
   TessellationParams tp;
   tp.linear_deflection = linear;
   tp.angular_deflection_deg = angular_deg;
+  tp.unit_in_mm = unit_in_mm(settings_only.units);
+  std::vector<std::string> files;
+  for (const Part& sp : settings_only.parts)
+    if (std::find(files.begin(), files.end(), sp.source_file) == files.end()) files.push_back(sp.source_file);
   std::vector<Part> parts;
-  for (const char* f : {"spar.step", "rib.step", "avionics-box.step", "actuator.step", "connector-bracket.step",
-                        "actuator-envelope.step"}) {
+  for (const std::string& f : files) {
     Part p;
-    p.name = f;
-    for (const NamedMesh& nm : read_cad_file(dir / f, tp, false)) p.mesh.append(nm.mesh);
+    p.name = fs::path(f).filename().string();
+    for (const NamedMesh& nm : read_cad_file(f, tp, false)) p.mesh.append(nm.mesh);
     p.closed = analyse_topology(p.mesh).closed;
     parts.push_back(std::move(p));
   }
   return parts;
 }
 
-/// 5. The same wing parts tessellated finer (what a CAD export for clash analysis may
-/// hold): α-SIM's cost follows the projected area in L_max² cells and the input size, its
-/// benefit the triangles it removes. Throughput on 2 threads (without the mesh
-/// verification, as in 3) and clearance-query speed-up per tessellation.
-void tessellation_sweep(const fs::path& out_dir, double dim_pre, int n_queries) {
+/// Draws a gnuplot script (the chart is optional: a missing gnuplot is reported, not fatal).
+void run_gnuplot(const fs::path& script) {
+  const std::string cmd = "gnuplot '" + script.string() + "'";
+  if (std::system(cmd.c_str()) != 0) std::printf("gnuplot failed\n");
+}
+
+/// 5. The wing's CAD files at four tessellations, 0.4 mm / 20° to 0.01 mm / 2.5° (the
+/// scene's own is 0.065 mm / 20°; a CAD export for clash analysis may be finer): α-SIM's
+/// cost follows the projected area in L_max² cells and the input size, its benefit the
+/// triangles it removes. Throughput on 2 threads (without the mesh verification, as in 3)
+/// and clearance-query speed-up per tessellation.
+void tessellation_sweep(const fs::path& out_dir, const Scene& wing_settings, int n_queries) {
+  const double dim_pre = wing_settings.simplify.dim_pre.value;
   std::ofstream csv(out_dir / "alpha_sim_tessellation.csv");
   csv << "linear_deflection,angular_deflection_deg,triangles_before,triangles_after,seconds,triangles_per_second,"
          "cpu_seconds,clearance_box_original,clearance_box_simplified,clearance_box_speedup,clearance_near_original,"
          "clearance_near_simplified,clearance_near_speedup\n";
   const std::pair<double, double> levels[] = {{0.4, 20.0}, {0.1, 10.0}, {0.04, 5.0}, {0.01, 2.5}};
   for (const auto& [linear, angular] : levels) {
-    const std::vector<Part> parts = wing_files(linear, angular);
+    const std::vector<Part> parts = scene_files(wing_settings, linear, angular);
     std::size_t before = 0, after = 0;
     for (const auto& p : parts) before += p.mesh.triangle_count();
     AlphaSimOptions o;
@@ -178,7 +190,7 @@ void tessellation_sweep(const fs::path& out_dir, double dim_pre, int n_queries) 
   g << "set terminal pngcairo size 1200,450 noenhanced\n"
     << "set output '" << (out_dir / "alpha_sim_tessellation.png").string() << "'\n"
     << "set datafile separator ','\nset key top left\nset multiplot layout 1,2 title "
-       "'alpha-SIM on the wing-section CAD files tessellated finer (dim_pre = " << dim_pre << " mm)'\n"
+       "'alpha-SIM on the wing-section CAD files at four tessellations (dim_pre = " << dim_pre << " mm)'\n"
     << "set logscale x\nset xlabel 'input triangles'\nset grid\n"
     << "set ylabel 'clearance queries/s: simplified / original'\nplot '"
     << (out_dir / "alpha_sim_tessellation.csv").string()
@@ -187,8 +199,7 @@ void tessellation_sweep(const fs::path& out_dir, double dim_pre, int n_queries) 
     << "set ylabel 'input triangles/s (2 threads)'\nset logscale y\nset yrange [1e4:2e6]\nplot '' using 3:6 with linespoints title "
        "'throughput', 1e6 with lines dashtype 2 title 'target 1e6/s'\nunset multiplot\n";
   g.close();
-  const std::string cmd = "gnuplot '" + gp.string() + "'";
-  if (std::system(cmd.c_str()) != 0) std::printf("gnuplot failed\n");
+  run_gnuplot(gp);
 }
 
 }  // namespace
@@ -201,14 +212,14 @@ int main(int argc, char** argv) {
   fs::create_directories(out_dir);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   const int n_queries = 20000;
-  // The wing's dim_pre (its smallest cable diameter), from the scene file alone.
+  // The wing's settings (dim_pre = its smallest cable diameter) and part files, without
+  // tessellating them.
   SceneLoadOptions settings_only;
   settings_only.load_parts = false;
-  const double wing_dim_pre =
-      load_scene(fs::path(LOOM_SOURCE_DIR) / "examples" / "wing-section" / "scene.toml", settings_only)
-          .simplify.dim_pre.value;
+  const Scene wing_settings =
+      load_scene(fs::path(LOOM_SOURCE_DIR) / "examples" / "wing-section" / "scene.toml", settings_only);
   if (tessellation_only) {
-    tessellation_sweep(out_dir, wing_dim_pre, n_queries);
+    tessellation_sweep(out_dir, wing_settings, n_queries);
     return 0;
   }
 
@@ -356,7 +367,7 @@ int main(int argc, char** argv) {
   }
   sweep_csv.close();
 
-  tessellation_sweep(out_dir, wing_dim_pre, n_queries);
+  tessellation_sweep(out_dir, wing_settings, n_queries);
 
   // Chart.
   const fs::path gp = out_dir / "alpha_sim.gp";
@@ -375,8 +386,7 @@ int main(int argc, char** argv) {
        "'clearance r = dim_pre, in the box', '' using 2:12 with linespoints title "
        "'clearance r = dim_pre, near the surface'\nunset multiplot\n";
   g.close();
-  const std::string cmd = "gnuplot '" + gp.string() + "'";
-  if (std::system(cmd.c_str()) != 0) std::printf("gnuplot failed\n");
+  run_gnuplot(gp);
   std::printf("wrote %s\n", out_dir.string().c_str());
   return 0;
 }
