@@ -216,10 +216,14 @@ double triangle_solid_angle(const Vec3& p, const Vec3& a, const Vec3& b, const V
 bool triangle_is_degenerate(const Vec3& a, const Vec3& b, const Vec3& c) { return is_degenerate(a, b, c); }
 
 double segment_box_dist2_lower(const Vec3& a, const Vec3& b, const Vec3& lo, const Vec3& hi) {
+  // Two bounds, the larger taken: the gap between the segment's own box and the box (tight
+  // when the segment runs along a face), and the midpoint sphere's (tight for a segment
+  // pointing at the box).
+  const double gap2 = (lo - a.cwiseMax(b)).cwiseMax(a.cwiseMin(b) - hi).cwiseMax(Vec3::Zero()).squaredNorm();
   const Vec3 m = 0.5 * (a + b);
   const double half = 0.5 * (b - a).norm();
   const double d = std::sqrt(point_box_dist2(m, lo, hi)) - half;
-  return d > 0.0 ? d * d : 0.0;
+  return d > 0.0 ? std::max(gap2, d * d) : gap2;
 }
 
 }  // namespace loom

@@ -84,7 +84,8 @@ inline double point_box_dist2(const Vec3& p, const Vec3& lo, const Vec3& hi) {
 }
 
 /// Lower bound on the squared distance from segment ab to the box [lo, hi] (exact when
-/// the segment is a point; otherwise uses the box around the segment's midpoint sphere).
+/// the segment is a point): the larger of the gap between the segment's box and [lo, hi]
+/// and the distance from the box to the sphere around the segment.
 double segment_box_dist2_lower(const Vec3& a, const Vec3& b, const Vec3& lo, const Vec3& hi);
 
 }  // namespace loom
