@@ -3,6 +3,7 @@
 #include "routing/clash_check.hpp"
 
 #include "core/error.hpp"
+#include "index/box_pairs.hpp"
 #include "index/triangle_distance.hpp"
 
 #include <tbb/blocked_range.h>
@@ -798,144 +799,35 @@ void group_pair_contacts(std::vector<PairContact>& contacts, const std::vector<C
   }
 }
 
-/// A B-spline span of one cable with its control-polygon box (contains the span).
-struct SpanBox {
-  int cable = -1;
-  double u0 = 0.0, u1 = 0.0;
-  AABB box;  ///< inflated by the cable radius + chord error
-};
-
-std::vector<SpanBox> span_boxes(const Context& ctx, int cable) {
-  const Centerline& c = ctx.cables[cable].curve;
-  const auto& K = c.knots();
-  const auto& P = c.control_points();
-  const int p = c.degree();
-  const double infl = ctx.cables[cable].radius + ctx.chord_error;
-  std::vector<SpanBox> out;
-  for (int k = p; k + 1 < static_cast<int>(K.size()) && k < static_cast<int>(P.size()); ++k) {
-    if (!(K[k + 1] > K[k])) continue;
-    SpanBox sb;
-    sb.cable = cable;
-    sb.u0 = K[k];
-    sb.u1 = K[k + 1];
-    for (int j = k - p; j <= k; ++j) sb.box.extend(P[j]);
-    sb.box.min.array() -= infl;
-    sb.box.max.array() += infl;
-    out.push_back(sb);
-  }
-  return out;
-}
-
-bool boxes_overlap(const AABB& a, const AABB& b) {
-  return (a.min.array() <= b.max.array()).all() && (b.min.array() <= a.max.array()).all();
-}
-
-/// Chords of one span plus block boxes for the narrow phase.
+/// One B-spline span of one cable, flattened to chords, with a box per block of kBlock
+/// chords (inflated by the cable radius + chord error: two blocks whose boxes do not meet
+/// hold no pair of chords closer than the radii sum).
 struct SpanChords {
+  int cable = -1;
   Chords ch;
-  std::vector<AABB> blocks;  ///< box of chords [k·kBlock, (k+1)·kBlock), inflated by r + chord error
+  std::vector<AABB> blocks;  ///< box of chords [k·kBlock, (k+1)·kBlock)
 };
 
-/// Exact chord–chord narrow phase of two spans (or a span and itself).
-void narrow_phase(Context& ctx, const SpanBox& A, const SpanChords& CA, const SpanBox& B, const SpanChords& CB,
-                  bool same_span, std::vector<PairContact>& out) {
-  const CableInput& ca = ctx.cables[A.cable];
-  const CableInput& cb = ctx.cables[B.cable];
-  const bool self = A.cable == B.cable;
-  const double r_sum = ca.radius + cb.radius;
-  const double self_gap = M_PI * ca.radius;
-  std::int64_t tests = 0;
-  for (std::size_t ba = 0; ba < CA.blocks.size(); ++ba) {
-    for (std::size_t bb = same_span ? ba : 0; bb < CB.blocks.size(); ++bb) {
-      if (!boxes_overlap(CA.blocks[ba], CB.blocks[bb])) continue;
-      const std::size_t ka1 = std::min(CA.ch.size(), (ba + 1) * kBlock);
-      const std::size_t kb1 = std::min(CB.ch.size(), (bb + 1) * kBlock);
-      if (self) {  // whole block pair closer in s than π r: excused
-        const double gap_max = std::max(std::abs(CB.ch.s[kb1] - CA.ch.s[ba * kBlock]),
-                                        std::abs(CA.ch.s[ka1] - CB.ch.s[bb * kBlock]));
-        if (gap_max < self_gap) continue;
-      }
-      for (std::size_t ka = ba * kBlock; ka < ka1; ++ka) {
-        for (std::size_t kb = (same_span && bb == ba) ? ka : bb * kBlock; kb < kb1; ++kb) {
-          const double sa0 = CA.ch.s[ka], sa1 = CA.ch.s[ka + 1];
-          const double tb0 = CB.ch.s[kb], tb1 = CB.ch.s[kb + 1];
-          if (self && std::max(std::abs(tb1 - sa0), std::abs(sa1 - tb0)) < self_gap) continue;
-          // Midpoint bound: chords whose midpoints are farther apart than their half
-          // lengths plus the radii cannot touch.
-          const Vec3 ma = 0.5 * (CA.ch.p[ka] + CA.ch.p[ka + 1]), mb = 0.5 * (CB.ch.p[kb] + CB.ch.p[kb + 1]);
-          const double reach = r_sum + 0.5 * ((CA.ch.p[ka + 1] - CA.ch.p[ka]).norm() + (CB.ch.p[kb + 1] - CB.ch.p[kb]).norm());
-          if ((ma - mb).squaredNorm() >= reach * reach) continue;
-          ++tests;
-          const SegmentSegmentResult r =
-              closest_segment_segment(CA.ch.p[ka], CA.ch.p[ka + 1], CB.ch.p[kb], CB.ch.p[kb + 1]);
-          const double d = std::sqrt(r.dist2);
-          if (!(d < r_sum)) continue;
-          double s = sa0 + r.s * (sa1 - sa0), t = tb0 + r.t * (tb1 - tb0);
-          if (self && std::abs(s - t) < self_gap) continue;
-          if (!self && excused(ca, s, r.p, cb, t, r.q)) continue;
-          PairContact pc;
-          pc.dist = d;
-          pc.a = A.cable;
-          pc.b = B.cable;
-          pc.p = r.p;
-          pc.q = r.q;
-          pc.s = s;
-          pc.t = t;
-          pc.sa0 = sa0;
-          pc.sa1 = sa1;
-          pc.tb0 = tb0;
-          pc.tb1 = tb1;
-          const bool swap = self ? s > t : A.cable > B.cable;
-          if (swap) {
-            std::swap(pc.a, pc.b);
-            std::swap(pc.p, pc.q);
-            std::swap(pc.s, pc.t);
-            std::swap(pc.sa0, pc.tb0);
-            std::swap(pc.sa1, pc.tb1);
-          }
-          out.push_back(pc);
-        }
-      }
-    }
-  }
-  ctx.counters.pairs += tests;
-}
-
-void certified_cable_pairs(Context& ctx, std::vector<ClashEntry>& out) {
-  if (!ctx.req.check_cable_cable && !ctx.req.check_self) return;
-  std::vector<SpanBox> spans;
+/// Every non-empty knot span of every cable, flattened (in parallel).
+std::vector<SpanChords> flatten_spans(Context& ctx) {
+  struct SpanRef {
+    int cable;
+    double u0, u1;
+  };
+  std::vector<SpanRef> refs;
   for (std::size_t c = 0; c < ctx.cables.size(); ++c) {
-    auto sb = span_boxes(ctx, static_cast<int>(c));
-    spans.insert(spans.end(), sb.begin(), sb.end());
+    const Centerline& curve = ctx.cables[c].curve;
+    const auto& K = curve.knots();
+    const int p = curve.degree();
+    for (int k = p; k + 1 < static_cast<int>(K.size()) && k < static_cast<int>(curve.control_points().size()); ++k)
+      if (K[k + 1] > K[k]) refs.push_back({static_cast<int>(c), K[k], K[k + 1]});
   }
-  std::vector<std::size_t> order(spans.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return spans[x].box.min.x() < spans[y].box.min.x(); });
-  // Sweep and prune on x.
-  std::vector<std::pair<std::size_t, std::size_t>> pairs;
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    const SpanBox& a = spans[order[i]];
-    if (ctx.req.check_self) pairs.emplace_back(order[i], order[i]);
-    for (std::size_t j = i + 1; j < order.size(); ++j) {
-      const SpanBox& b = spans[order[j]];
-      if (b.box.min.x() > a.box.max.x()) break;
-      if (!boxes_overlap(a.box, b.box)) continue;
-      if (a.cable == b.cable ? !ctx.req.check_self : !ctx.req.check_cable_cable) continue;
-      pairs.emplace_back(order[i], order[j]);
-    }
-  }
-  // Flatten every span that takes part in a pair (once).
-  std::vector<char> used(spans.size(), 0);
-  for (const auto& pr : pairs) used[pr.first] = used[pr.second] = 1;
-  std::vector<std::size_t> used_list;
-  for (std::size_t i = 0; i < spans.size(); ++i)
-    if (used[i]) used_list.push_back(i);
-  std::vector<SpanChords> chords(spans.size());
-  parallel_indices(used_list.size(), ctx.req.threads, [&](std::size_t k) {
-    const SpanBox& sb = spans[used_list[k]];
-    const CableInput& c = ctx.cables[sb.cable];
-    SpanChords& sc = chords[used_list[k]];
-    flatten(c.curve, sb.u0, sb.u1, ctx.chord_error, kMaxChordRadii * c.radius, sc.ch);
+  std::vector<SpanChords> spans(refs.size());
+  parallel_indices(refs.size(), ctx.req.threads, [&](std::size_t k) {
+    const CableInput& c = ctx.cables[refs[k].cable];
+    SpanChords& sc = spans[k];
+    sc.cable = refs[k].cable;
+    flatten(c.curve, refs[k].u0, refs[k].u1, ctx.chord_error, kMaxChordRadii * c.radius, sc.ch);
     ctx.counters.samples += as_i64(sc.ch.p.size());
     const double infl = c.radius + ctx.chord_error;
     for (std::size_t b = 0; b * kBlock < sc.ch.size(); ++b) {
@@ -946,13 +838,111 @@ void certified_cable_pairs(Context& ctx, std::vector<ClashEntry>& out) {
       sc.blocks.push_back(box);
     }
   });
+  return spans;
+}
+
+/// Exact chord–chord narrow phase of block ba of span A against block bb of span B (a block
+/// against itself when A and B are one span and ba == bb). Returns the segment tests made.
+std::int64_t narrow_phase(const Context& ctx, const SpanChords& A, std::size_t ba, const SpanChords& B, std::size_t bb,
+                          std::vector<PairContact>& out) {
+  const CableInput& ca = ctx.cables[A.cable];
+  const CableInput& cb = ctx.cables[B.cable];
+  const bool self = A.cable == B.cable;
+  const bool same_block = &A == &B && ba == bb;
+  const double r_sum = ca.radius + cb.radius;
+  const double self_gap = M_PI * ca.radius;
+  const std::size_t ka1 = std::min(A.ch.size(), (ba + 1) * kBlock);
+  const std::size_t kb1 = std::min(B.ch.size(), (bb + 1) * kBlock);
+  if (self) {  // whole block pair closer in s than π r: excused
+    const double gap_max =
+        std::max(std::abs(B.ch.s[kb1] - A.ch.s[ba * kBlock]), std::abs(A.ch.s[ka1] - B.ch.s[bb * kBlock]));
+    if (gap_max < self_gap) return 0;
+  }
+  std::int64_t tests = 0;
+  for (std::size_t ka = ba * kBlock; ka < ka1; ++ka) {
+    for (std::size_t kb = same_block ? ka : bb * kBlock; kb < kb1; ++kb) {
+      const double sa0 = A.ch.s[ka], sa1 = A.ch.s[ka + 1];
+      const double tb0 = B.ch.s[kb], tb1 = B.ch.s[kb + 1];
+      if (self && std::max(std::abs(tb1 - sa0), std::abs(sa1 - tb0)) < self_gap) continue;
+      // Midpoint bound: chords whose midpoints are farther apart than their half
+      // lengths plus the radii cannot touch.
+      const Vec3 ma = 0.5 * (A.ch.p[ka] + A.ch.p[ka + 1]), mb = 0.5 * (B.ch.p[kb] + B.ch.p[kb + 1]);
+      const double reach = r_sum + 0.5 * ((A.ch.p[ka + 1] - A.ch.p[ka]).norm() + (B.ch.p[kb + 1] - B.ch.p[kb]).norm());
+      if ((ma - mb).squaredNorm() >= reach * reach) continue;
+      ++tests;
+      const SegmentSegmentResult r = closest_segment_segment(A.ch.p[ka], A.ch.p[ka + 1], B.ch.p[kb], B.ch.p[kb + 1]);
+      const double d = std::sqrt(r.dist2);
+      if (!(d < r_sum)) continue;
+      double s = sa0 + r.s * (sa1 - sa0), t = tb0 + r.t * (tb1 - tb0);
+      if (self && std::abs(s - t) < self_gap) continue;
+      if (!self && excused(ca, s, r.p, cb, t, r.q)) continue;
+      PairContact pc;
+      pc.dist = d;
+      pc.a = A.cable;
+      pc.b = B.cable;
+      pc.p = r.p;
+      pc.q = r.q;
+      pc.s = s;
+      pc.t = t;
+      pc.sa0 = sa0;
+      pc.sa1 = sa1;
+      pc.tb0 = tb0;
+      pc.tb1 = tb1;
+      const bool swap = self ? s > t : A.cable > B.cable;
+      if (swap) {
+        std::swap(pc.a, pc.b);
+        std::swap(pc.p, pc.q);
+        std::swap(pc.s, pc.t);
+        std::swap(pc.sa0, pc.tb0);
+        std::swap(pc.sa1, pc.tb1);
+      }
+      out.push_back(pc);
+    }
+  }
+  return tests;
+}
+
+/// Block pairs handed to one narrow-phase task (amortises task and lock overhead).
+constexpr std::size_t kPairsPerTask = 256;
+
+void certified_cable_pairs(Context& ctx, std::vector<ClashEntry>& out) {
+  if (!ctx.req.check_cable_cable && !ctx.req.check_self) return;
+  const std::vector<SpanChords> spans = flatten_spans(ctx);
+  // Broad phase over the block boxes of all cables together (a BVH, Embree's rtcCollide):
+  // the candidates are local chord groups, not whole spans, so their number follows the
+  // chords that really come near each other as cables are added.
+  struct BlockRef {
+    std::uint32_t span, block;
+  };
+  std::vector<BlockRef> blocks;
+  std::vector<AABB> boxes;
+  for (std::size_t i = 0; i < spans.size(); ++i)
+    for (std::size_t b = 0; b < spans[i].blocks.size(); ++b) {
+      blocks.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(b)});
+      boxes.push_back(spans[i].blocks[b]);
+    }
+  std::vector<BoxPair> pairs = overlapping_box_pairs(boxes, ctx.req.threads);
+  // Keep the kinds asked for; a block against itself (self check) is not a box pair.
+  pairs.erase(std::remove_if(pairs.begin(), pairs.end(),
+                             [&](const BoxPair& pr) {
+                               const bool same = spans[blocks[pr.first].span].cable == spans[blocks[pr.second].span].cable;
+                               return same ? !ctx.req.check_self : !ctx.req.check_cable_cable;
+                             }),
+              pairs.end());
+  if (ctx.req.check_self)
+    for (std::uint32_t i = 0; i < blocks.size(); ++i) pairs.emplace_back(i, i);
   std::mutex mu;
   std::vector<PairContact> contacts;
-  parallel_indices(pairs.size(), ctx.req.threads, [&](std::size_t k) {
+  const std::size_t tasks = (pairs.size() + kPairsPerTask - 1) / kPairsPerTask;
+  parallel_indices(tasks, ctx.req.threads, [&](std::size_t t) {
     std::vector<PairContact> local;
-    const auto& pr = pairs[k];
-    narrow_phase(ctx, spans[pr.first], chords[pr.first], spans[pr.second], chords[pr.second], pr.first == pr.second,
-                 local);
+    std::int64_t tests = 0;
+    for (std::size_t k = t * kPairsPerTask; k < std::min(pairs.size(), (t + 1) * kPairsPerTask); ++k) {
+      const BlockRef& x = blocks[pairs[k].first];
+      const BlockRef& y = blocks[pairs[k].second];
+      tests += narrow_phase(ctx, spans[x.span], x.block, spans[y.span], y.block, local);
+    }
+    ctx.counters.pairs += tests;
     if (!local.empty()) {
       std::lock_guard<std::mutex> lock(mu);
       contacts.insert(contacts.end(), local.begin(), local.end());

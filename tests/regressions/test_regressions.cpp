@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/centerline.hpp"
+#include "index/box_pairs.hpp"
 #include "routing/sweep.hpp"
 
 namespace {
@@ -43,6 +44,21 @@ TEST(Regression, SweepDoubleReflectionTurnsWithinThirdOrderOfTheTangent) {
   }
   // The case is only a regression test if it still exercises the excess it was found for.
   EXPECT_GT(worst_excess, 1e-9);
+}
+
+// 2026-11-21, session 9: BoxPairs.EqualsBruteForce (RapidCheck) aborted the process in
+// Embree's BVH builder (assertion `diag[dim] > 0.0f`, heuristic_openmerge_array.h) on two
+// equal point boxes: re-centred on their own centre, they rounded to float boxes of zero
+// size (denormals flushed). The broad phase now pads every float box outwards by a normal
+// float length, so no set of boxes has zero extent.
+TEST(Regression, BoxPairsTwoEqualPointBoxesDoNotAbortTheBuilder) {
+  for (const Vec3& p : {Vec3(0, 0, 0), Vec3(1, 1, 1), Vec3(0.1, -2.5, 7.0)}) {
+    loom::AABB b;
+    b.min = b.max = p;
+    const auto pairs = loom::overlapping_box_pairs({b, b}, 2);
+    ASSERT_EQ(pairs.size(), 1u);
+    EXPECT_EQ(pairs[0], loom::BoxPair(0, 1));
+  }
 }
 
 }  // namespace
