@@ -735,6 +735,27 @@ struct PairContact {
   Vec3 p = Vec3::Zero(), q = Vec3::Zero();
   double s = 0.0, t = 0.0;
   double sa0 = 0.0, sa1 = 0.0, tb0 = 0.0, tb1 = 0.0;
+
+  /// The contact of point p (arc length s, interval [sa0, sa1]) on cable a with q (t,
+  /// [tb0, tb1]) on cable b, sides put in the order above (smaller cable first; for a
+  /// self contact, smaller arc length first).
+  static PairContact ordered(int a, double s, double sa0, double sa1, const Vec3& p, int b, double t, double tb0,
+                             double tb1, const Vec3& q, double dist) {
+    PairContact pc;
+    pc.dist = dist;
+    const bool swap = a == b ? s > t : a > b;
+    pc.a = swap ? b : a;
+    pc.b = swap ? a : b;
+    pc.p = swap ? q : p;
+    pc.q = swap ? p : q;
+    pc.s = swap ? t : s;
+    pc.t = swap ? s : t;
+    pc.sa0 = swap ? tb0 : sa0;
+    pc.sa1 = swap ? tb1 : sa1;
+    pc.tb0 = swap ? sa0 : tb0;
+    pc.tb1 = swap ? sa1 : tb1;
+    return pc;
+  }
 };
 
 /// One entry per connected group of contacts (intervals touching on both cables).
@@ -876,27 +897,7 @@ std::int64_t narrow_phase(const Context& ctx, const SpanChords& A, std::size_t b
       double s = sa0 + r.s * (sa1 - sa0), t = tb0 + r.t * (tb1 - tb0);
       if (self && std::abs(s - t) < self_gap) continue;
       if (!self && excused(ca, s, r.p, cb, t, r.q)) continue;
-      PairContact pc;
-      pc.dist = d;
-      pc.a = A.cable;
-      pc.b = B.cable;
-      pc.p = r.p;
-      pc.q = r.q;
-      pc.s = s;
-      pc.t = t;
-      pc.sa0 = sa0;
-      pc.sa1 = sa1;
-      pc.tb0 = tb0;
-      pc.tb1 = tb1;
-      const bool swap = self ? s > t : A.cable > B.cable;
-      if (swap) {
-        std::swap(pc.a, pc.b);
-        std::swap(pc.p, pc.q);
-        std::swap(pc.s, pc.t);
-        std::swap(pc.sa0, pc.tb0);
-        std::swap(pc.sa1, pc.tb1);
-      }
-      out.push_back(pc);
+      out.push_back(PairContact::ordered(A.cable, s, sa0, sa1, r.p, B.cable, t, tb0, tb1, r.q, d));
     }
   }
   return tests;
@@ -1071,26 +1072,8 @@ void discrete_cable_pairs(Context& ctx, const std::vector<DiscreteSamples>& ds, 
     const double s = mid ? 0.5 * (ds[a].s[k] + ds[a].s[k + 1]) : ds[a].s[k];
     const double t = ds[b].s[m];
     if (!self && excused(cables[a], s, p, cables[b], t, q)) return;
-    PairContact pc;
-    pc.a = a;
-    pc.b = b;
-    pc.dist = d;
-    pc.p = p;
-    pc.q = q;
-    pc.s = s;
-    pc.t = t;
     const double ha = ds[a].spacing, hb = ds[b].spacing;
-    pc.sa0 = s - ha;
-    pc.sa1 = s + ha;
-    pc.tb0 = t - hb;
-    pc.tb1 = t + hb;
-    if (self && s > t) {
-      std::swap(pc.p, pc.q);
-      std::swap(pc.s, pc.t);
-      std::swap(pc.sa0, pc.tb0);
-      std::swap(pc.sa1, pc.tb1);
-    }
-    local.push_back(pc);
+    local.push_back(PairContact::ordered(a, s, s - ha, s + ha, p, b, t, t - hb, t + hb, q, d));
   };
   auto want = [&](int a, int b) { return a == b ? ctx.req.check_self : ctx.req.check_cable_cable; };
   if (!ctx.req.use_index) {
