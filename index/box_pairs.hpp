@@ -2,15 +2,11 @@
 #pragma once
 
 #include "core/geometry.hpp"
+#include "index/box_tree.hpp"
 
-#include <cstdint>
-#include <utility>
 #include <vector>
 
 namespace loom {
-
-/// One unordered pair of box indices, first < second.
-using BoxPair = std::pair<std::uint32_t, std::uint32_t>;
 
 /// Every pair {i, j}, i < j, of boxes that overlap as closed boxes (touching faces count),
 /// sorted by (i, j), without duplicates. A box is never paired with itself. Boxes are in

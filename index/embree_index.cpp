@@ -1,5 +1,7 @@
 #include "index/embree_index.hpp"
 
+#include "index/box_tree.hpp"
+
 #include "core/error.hpp"
 #include "index/triangle_distance.hpp"
 
@@ -240,6 +242,9 @@ struct EmbreeIndex::Impl {
   mutable std::unique_ptr<std::once_flag[]> part_once;
   std::atomic<long long> embree_bytes{0};
   std::string last_error;
+  /// Boxes of the closed parts with triangles (others empty), indexed by part id: the
+  /// candidates of an inside test without a pass over every part.
+  std::unique_ptr<BoxTree> closed_boxes;
 };
 
 namespace {
@@ -352,6 +357,10 @@ EmbreeIndex::EmbreeIndex(const std::vector<Part>& parts, const EmbreeOptions& op
     throw std::runtime_error("embree index: build failed: " + im.last_error);
   im.part_scenes.assign(parts_.size(), nullptr);
   im.part_once.reset(new std::once_flag[parts_.size()]);
+  std::vector<AABB> closed(parts_.size());
+  for (std::size_t i = 0; i < parts_.size(); ++i)
+    if (parts_[i].closed && !parts_[i].triangles.empty()) closed[i] = parts_[i].bounds;
+  im.closed_boxes = std::make_unique<BoxTree>(std::move(closed));
 }
 
 EmbreeIndex::~EmbreeIndex() {
@@ -579,10 +588,13 @@ RayHit EmbreeIndex::ray(const Vec3& origin, const Vec3& dir, double t_max) const
 
 bool EmbreeIndex::inside(const Vec3& p, int* part) const {
   // Candidate closed parts whose box contains p.
-  std::vector<int> cand;
-  for (int i = 0; i < part_count(); ++i)
-    if (parts_[i].closed && !parts_[i].triangles.empty() && parts_[i].bounds.contains(p)) cand.push_back(i);
-  if (cand.empty()) return false;
+  if (!p.allFinite()) return false;
+  std::vector<std::uint32_t> found;
+  AABB at;
+  at.extend(p);
+  impl_->closed_boxes->overlapping(at, found);
+  if (found.empty()) return false;
+  const std::vector<int> cand(found.begin(), found.end());
   FlushDenormals ftz;
   const Vec3 pc = p - centre_;
   const double back = 4.0 * float_pad(p, 0.0);

@@ -5,6 +5,7 @@
 #include "core/harness_topology.hpp"
 #include "core/io/harness_xml.hpp"
 #include "core/io/scene_load.hpp"
+#include "index/box_tree.hpp"
 #include "index/brute_force_index.hpp"
 #include "index/embree_index.hpp"
 #include "routing/cable_geometry.hpp"
@@ -34,15 +35,24 @@ std::pair<std::string, std::string> use_nodes(const Harness& h, const SegmentUse
 
 }  // namespace
 
+/// Relative widening of the port's query box over the largest per-part reach (rounding only).
+constexpr double kReachRoundingRel = 1e-12;
+
 std::vector<std::string> attach_ports(const Harness& h, const std::vector<Part>& parts, double routing_clearance,
                                       std::vector<CableInput>& inputs, const ObstacleIndex* index) {
   // Part boxes once per audit (from the index when it keeps them: no pass over every
   // triangle), and the part containing each port once per port (many cables share a port).
   std::vector<AABB> boxes(parts.size());
+  double max_part_clearance = 0.0;
   for (std::size_t q = 0; q < parts.size(); ++q) {
     const auto kept = index ? index->part_bounds(static_cast<int>(q)) : std::nullopt;
     boxes[q] = kept ? *kept : parts[q].mesh.bounds();
+    max_part_clearance = std::max(max_part_clearance, parts[q].clearance);
   }
+  // The parts near a port through a BVH over their boxes, not a pass over every part per
+  // cable end (assemblies have thousands of parts, harnesses thousands of cable ends).
+  const BoxTree part_tree(boxes);
+  std::vector<std::uint32_t> near_port;
   std::map<int, int> containing;  // port -> part containing it (−1: none), when asked
   auto part_containing = [&](int port) {
     auto it = containing.find(port);
@@ -63,7 +73,17 @@ std::vector<std::string> attach_ports(const Harness& h, const std::vector<Part>&
       const int p = h.find_port(h.cables[c].ports[end]);
       if (p < 0) continue;
       const Vec3 at = h.ports[p].position;
-      for (std::size_t q = 0; q < parts.size(); ++q) {
+      if (!at.allFinite()) continue;  // an unplaced port sits on no part
+      AABB reach_box;
+      reach_box.extend(at);
+      // A little wider than any part's reach, so that rounding cannot drop a box the exact
+      // test below keeps.
+      const double max_reach = (in.radius + routing_clearance + max_part_clearance) * (1.0 + kReachRoundingRel) +
+                               kReachRoundingRel * at.cwiseAbs().maxCoeff();
+      reach_box.min.array() -= max_reach;
+      reach_box.max.array() += max_reach;
+      part_tree.overlapping(reach_box, near_port);
+      for (const std::uint32_t q : near_port) {
         if (parts[q].role == PartRole::KeepOut) continue;  // never excused
         const double reach = in.radius + routing_clearance + parts[q].clearance;
         AABB box = boxes[q];

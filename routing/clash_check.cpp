@@ -4,6 +4,7 @@
 
 #include "core/error.hpp"
 #include "index/box_pairs.hpp"
+#include "index/box_tree.hpp"
 #include "index/triangle_distance.hpp"
 
 #include <tbb/blocked_range.h>
@@ -16,6 +17,7 @@
 #include <limits>
 #include <optional>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <numeric>
 #include <stdexcept>
@@ -288,6 +290,9 @@ struct Context {
   double abs_err = 0.0;
   double band = 0.0;  ///< largest required clearance over parts
   AtomicCounters counters;
+  /// BVH over the parts' boxes (info[q].box): the parts near a stretch without a pass over
+  /// every part (assemblies have thousands). Built for the certified structure pass only.
+  std::unique_ptr<BoxTree> part_tree;
 };
 
 /// Segment id of the cable at arc length s (−1 if unknown).
@@ -608,13 +613,10 @@ class StructureTracer {
     // Candidate parts for the secondary check: boxes within the band of this stretch.
     AABB box;
     for (const Vec3& p : ch.p) box.extend(p);
-    std::vector<int> cand;
-    for (std::size_t q = 0; q < ctx_.info.size(); ++q) {
-      const AABB& pb = ctx_.info[q].box;
-      const double reach = thr_ + 1e-9;
-      if ((box.min.array() - reach <= pb.max.array()).all() && (pb.min.array() <= box.max.array() + reach).all())
-        cand.push_back(static_cast<int>(q));
-    }
+    const double band_reach = thr_ + 1e-9;
+    box.min.array() -= band_reach;
+    box.max.array() += band_reach;
+    ctx_.part_tree->overlapping(box, cand_);
     const double touch = std::max(4.0 * ctx_.abs_err, ctx_.chord_error);
     std::vector<PartObservation> obs;
     for (std::size_t k = 0; k < ch.size(); ++k) {
@@ -656,11 +658,12 @@ class StructureTracer {
                   obs.end());
         obs.push_back(o);
       }
-      if (primary >= 0 && cand.size() > 1) {
+      if (primary >= 0 && cand_.size() > 1) {
         AABB cb;
         cb.extend(a);
         cb.extend(b);
-        for (int q : cand) {
+        for (const std::uint32_t cq : cand_) {
+          const int q = static_cast<int>(cq);
           if (q == primary || q == inside_part_) continue;
           const AABB& pb = ctx_.info[q].box;
           const double reach = r_ + ctx_.info[q].required + margin_;
@@ -716,6 +719,7 @@ class StructureTracer {
   StretchTracker tracker_;
   double L_ = 0.0, thr_ = 0.0, leaf_ = 0.0, max_step_ = 0.0, margin_ = 0.0;
   double rel_error_ = 0.0;   ///< ClashRequest::distance_rel_error (0: exact sphere tracing)
+  std::vector<std::uint32_t> cand_;  ///< near(): parts whose boxes reach the stretch (reused buffer)
   double cut_margin_ = 0.0;  ///< added to a cut-short query's radius: d = max(0, hit − abs_err) and rounding
   int inside_part_ = -1;
   std::vector<Sample> free_;
@@ -1212,7 +1216,7 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
     throw std::invalid_argument("check_clashes: distance_rel_error must be finite and >= 0, got " +
                                 full_precision(request.distance_rel_error));
 
-  Context ctx{cables, parts, index, request, {}, 0.0, 0.0, 0.0, 0.0, {}};
+  Context ctx{cables, parts, index, request, {}, 0.0, 0.0, 0.0, 0.0, {}, nullptr};
   ClashResult res;
   ctx.info.resize(parts.size());
   for (std::size_t q = 0; q < parts.size(); ++q) {
@@ -1245,6 +1249,13 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
     res.tolerance = ctx.tol;
     res.chord_error = ctx.chord_error;
     res.distance_rel_error = request.distance_rel_error;
+    if (request.check_structure && !parts.empty()) {
+      std::vector<AABB> boxes(parts.size());
+      for (std::size_t q = 0; q < parts.size(); ++q) boxes[q] = ctx.info[q].box;
+      // In the audit's arena: Embree's builder runs on TBB and must not exceed `threads`.
+      tbb::task_arena arena(request.threads > 0 ? request.threads : tbb::task_arena::automatic);
+      arena.execute([&] { ctx.part_tree = std::make_unique<BoxTree>(std::move(boxes)); });
+    }
     parallel_indices(cables.size(), request.threads, [&](std::size_t c) {
       CableCheckSummary& sum = res.cables[c];
       sum.length = cables[c].curve.length();

@@ -2,6 +2,7 @@
 // far from the origin), degenerate inputs (empty, one box, all equal, points, touching
 // faces), thread counts, bad input, and a rapidcheck invariant.
 #include "index/box_pairs.hpp"
+#include "index/random_boxes.hpp"
 
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
@@ -12,40 +13,16 @@
 #include <stdexcept>
 
 using namespace loom;
+using loom::test::box;
+using loom::test::random_boxes;
 
 namespace {
-
-bool closed_overlap(const AABB& a, const AABB& b) {
-  for (int k = 0; k < 3; ++k)
-    if (a.max[k] < b.min[k] || b.max[k] < a.min[k]) return false;
-  return true;
-}
 
 std::vector<BoxPair> brute_pairs(const std::vector<AABB>& boxes) {
   std::vector<BoxPair> out;
   for (std::uint32_t i = 0; i < boxes.size(); ++i)
     for (std::uint32_t j = i + 1; j < boxes.size(); ++j)
-      if (closed_overlap(boxes[i], boxes[j])) out.emplace_back(i, j);
-  return out;
-}
-
-AABB box(const Vec3& lo, const Vec3& hi) {
-  AABB b;
-  b.min = lo;
-  b.max = hi;
-  return b;
-}
-
-/// n boxes with centres uniform in [0, extent]³ (+ offset) and half sizes up to `half`.
-std::vector<AABB> random_boxes(unsigned seed, int n, double extent, double half, const Vec3& offset = Vec3::Zero()) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> U(0.0, 1.0);
-  std::vector<AABB> out;
-  for (int i = 0; i < n; ++i) {
-    const Vec3 c = offset + extent * Vec3(U(rng), U(rng), U(rng));
-    const Vec3 h = half * Vec3(U(rng), U(rng), U(rng));
-    out.push_back(box(c - h, c + h));
-  }
+      if (boxes_overlap(boxes[i], boxes[j])) out.emplace_back(i, j);
   return out;
 }
 

@@ -1,0 +1,219 @@
+// Box BVH with Embree user geometry: point queries for overlap, rtcCollide for pairs.
+#include "index/box_tree.hpp"
+
+#include <embree3/rtcore.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace loom {
+
+namespace {
+
+/// Smallest outward move of a corner (in the re-centred frame, scene units). Why: Embree
+/// runs with denormals flushed, so a point box at the centre would round to a zero-size
+/// float box, and its builder asserts (Debian's build keeps asserts) on a set whose bounds
+/// have no extent — two equal point boxes abort the process. 1e-20 is a normal float, far
+/// below any length loom measures, and only ever widens a candidate test.
+constexpr double kMinPad = 1e-20;
+/// Relative outward move before rounding: covers the re-centring subtraction's rounding
+/// and float's 2^-24 with room to spare.
+constexpr double kRelPad = 0x1p-20;
+
+float round_down(double x) {
+  const double moved = x - std::max(std::abs(x) * kRelPad, kMinPad);
+  return std::nextafter(static_cast<float>(moved), -std::numeric_limits<float>::infinity());
+}
+float round_up(double x) {
+  const double moved = x + std::max(std::abs(x) * kRelPad, kMinPad);
+  return std::nextafter(static_cast<float>(moved), std::numeric_limits<float>::infinity());
+}
+
+void check_box(const AABB& b, std::size_t i) {
+  if (box_is_unset(b)) return;
+  if (!b.min.allFinite() || !b.max.allFinite() || !(b.min.array() <= b.max.array()).all()) {
+    std::ostringstream os;
+    os.precision(17);
+    os << "box tree: box " << i << " is neither unset nor a finite box: min (" << b.min.transpose() << "), max ("
+       << b.max.transpose() << ")";
+    throw std::invalid_argument(os.str());
+  }
+}
+
+void device_error(void* user, RTCError code, const char* str) {
+  auto* msg = static_cast<std::string*>(user);
+  if (msg->empty()) *msg = "embree error " + std::to_string(static_cast<int>(code)) + ": " + (str ? str : "");
+}
+
+}  // namespace
+
+struct BoxTree::Impl {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::string error;  ///< first Embree error (reported by the call that raised it)
+  Vec3 centre = Vec3::Zero();
+  std::vector<std::uint32_t> ids;  ///< Embree primitive → box index (empty boxes left out)
+  std::vector<float> lo, hi;       ///< 3 floats per primitive: re-centred, rounded outwards
+  std::vector<AABB> boxes;         ///< as given
+
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+};
+
+namespace {
+
+void bounds_function(const RTCBoundsFunctionArguments* args) {
+  const auto* im = static_cast<const BoxTree::Impl*>(args->geometryUserPtr);
+  const std::size_t k = 3 * static_cast<std::size_t>(args->primID);
+  RTCBounds* b = args->bounds_o;
+  b->lower_x = im->lo[k];
+  b->lower_y = im->lo[k + 1];
+  b->lower_z = im->lo[k + 2];
+  b->upper_x = im->hi[k];
+  b->upper_y = im->hi[k + 1];
+  b->upper_z = im->hi[k + 2];
+}
+
+/// One overlap query: the exact box and what was found.
+struct OverlapQuery {
+  const BoxTree::Impl* im = nullptr;
+  AABB query;
+  std::vector<std::uint32_t>* out = nullptr;
+};
+
+bool overlap_callback(RTCPointQueryFunctionArguments* args) {
+  auto* q = static_cast<OverlapQuery*>(args->userPtr);
+  const std::uint32_t i = q->im->ids[args->primID];
+  if (boxes_overlap(q->im->boxes[i], q->query)) q->out->push_back(i);
+  return false;  // the search sphere never shrinks: every overlapping box is wanted
+}
+
+struct CollideState {
+  const BoxTree::Impl* im = nullptr;
+  tbb::enumerable_thread_specific<std::vector<BoxPair>> found;
+};
+
+void collide_callback(void* user, RTCCollision* collisions, unsigned count) {
+  auto* st = static_cast<CollideState*>(user);
+  const BoxTree::Impl& im = *st->im;
+  std::vector<BoxPair>& out = st->found.local();
+  for (unsigned k = 0; k < count; ++k) {
+    const std::uint32_t i = im.ids[collisions[k].primID0], j = im.ids[collisions[k].primID1];
+    // One scene against itself: Embree visits every ordered pair of overlapping leaves, so
+    // (i, j) and (j, i) both arrive; keeping i < j reports each pair once. Leaves pair all
+    // their primitives, so most candidates fail the exact box test.
+    if (i < j && boxes_overlap(im.boxes[i], im.boxes[j])) out.emplace_back(i, j);
+  }
+}
+
+}  // namespace
+
+BoxTree::BoxTree(std::vector<AABB> boxes) : impl_(std::make_unique<Impl>()) {
+  Impl& im = *impl_;
+  im.boxes = std::move(boxes);
+  if (im.boxes.size() > std::numeric_limits<std::uint32_t>::max())
+    throw std::invalid_argument("box tree: more boxes than 32-bit ids");
+  AABB all;
+  for (std::size_t i = 0; i < im.boxes.size(); ++i) {
+    check_box(im.boxes[i], i);
+    all.extend(im.boxes[i]);
+  }
+  // Re-centred before rounding to float so that far-from-origin scenes keep tight boxes.
+  im.centre = all.center();
+  for (std::size_t i = 0; i < im.boxes.size(); ++i) {
+    const AABB& b = im.boxes[i];
+    if (b.empty()) continue;
+    im.ids.push_back(static_cast<std::uint32_t>(i));
+    for (int a = 0; a < 3; ++a) {
+      im.lo.push_back(round_down(b.min[a] - im.centre[a]));
+      im.hi.push_back(round_up(b.max[a] - im.centre[a]));
+    }
+  }
+  if (im.ids.empty()) return;  // nothing to index: every query answers nothing
+  im.device = rtcNewDevice(nullptr);
+  if (!im.device) throw std::runtime_error("box tree: rtcNewDevice failed");
+  rtcSetDeviceErrorFunction(im.device, device_error, &im.error);
+  im.scene = rtcNewScene(im.device);
+  // Low quality (Morton) build: fast, and the queries are few per box.
+  rtcSetSceneBuildQuality(im.scene, RTC_BUILD_QUALITY_LOW);
+  RTCGeometry g = rtcNewGeometry(im.device, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(im.ids.size()));
+  rtcSetGeometryUserData(g, &im);
+  rtcSetGeometryBoundsFunction(g, bounds_function, nullptr);
+  rtcCommitGeometry(g);
+  rtcAttachGeometry(im.scene, g);
+  rtcReleaseGeometry(g);
+  rtcCommitScene(im.scene);
+  if (!im.error.empty()) throw std::runtime_error("box tree: " + im.error);
+}
+
+BoxTree::~BoxTree() = default;
+std::size_t BoxTree::size() const { return impl_->boxes.size(); }
+const AABB& BoxTree::box(std::size_t i) const { return impl_->boxes[i]; }
+BoxTree::BoxTree(BoxTree&& o) noexcept = default;
+BoxTree& BoxTree::operator=(BoxTree&& o) noexcept = default;
+
+void BoxTree::overlapping(const AABB& query, std::vector<std::uint32_t>& out) const {
+  out.clear();
+  if (box_is_unset(query)) return;
+  if (!query.min.allFinite() || !query.max.allFinite() || !(query.min.array() <= query.max.array()).all()) {
+    std::ostringstream os;
+    os.precision(17);
+    os << "box tree: query is not a finite box: min (" << query.min.transpose() << "), max (" << query.max.transpose()
+       << ")";
+    throw std::invalid_argument(os.str());
+  }
+  const Impl& im = *impl_;
+  if (im.ids.empty()) return;
+  // The sphere around the query's centre through its corners holds the query box; its
+  // radius is padded for the float rounding of the centre (relative to the larger of the
+  // centre's and the radius' magnitude) so that no overlapping float box is culled.
+  const Vec3 c = query.center() - im.centre;
+  const double half = 0.5 * query.diagonal();
+  const double pad = 4.0 * kRelPad * (c.cwiseAbs().maxCoeff() + half) + kMinPad;
+  RTCPointQuery pq;
+  pq.x = static_cast<float>(c.x());
+  pq.y = static_cast<float>(c.y());
+  pq.z = static_cast<float>(c.z());
+  pq.time = 0.0f;
+  pq.radius = std::nextafter(static_cast<float>(half + pad), std::numeric_limits<float>::infinity());
+  RTCPointQueryContext ctx;
+  rtcInitPointQueryContext(&ctx);
+  OverlapQuery q;
+  q.im = &im;
+  q.query = query;
+  q.out = &out;
+  rtcPointQuery(im.scene, &pq, &ctx, overlap_callback, &q);
+  // Leaves report their primitives in tree order; callers want a stable, ascending list.
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
+std::vector<BoxPair> BoxTree::self_pairs() const {
+  std::vector<BoxPair> pairs;
+  const Impl& im = *impl_;
+  if (im.ids.size() < 2) return pairs;
+  CollideState state;
+  state.im = &im;
+  rtcCollide(im.scene, im.scene, collide_callback, &state);
+  if (!im.error.empty()) throw std::runtime_error("box tree: " + im.error);
+  std::size_t total = 0;
+  for (const auto& v : state.found) total += v.size();
+  pairs.reserve(total);
+  for (const auto& v : state.found) pairs.insert(pairs.end(), v.begin(), v.end());
+  tbb::parallel_sort(pairs.begin(), pairs.end());
+  // Each ordered leaf pair is visited once, so no pair should repeat; unique() makes the
+  // contract hold without leaning on that traversal detail.
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  return pairs;
+}
+
+}  // namespace loom
