@@ -3,13 +3,16 @@
 // Measures, in one process: index build; the certified audit (all clash kinds + bend +
 // clearance) with 1 and 2 threads; the indexed discrete method; the brute-force discrete
 // baseline (every sample against every triangle — measured on a subset of cables and
-// scaled, it is O(n·m)); time against cables and against triangles; and sample spacing
-// against time and missed clashes for discrete vs certified.
+// scaled, it is O(n·m)); time against cables and against triangles — both finer
+// tessellation of the same parts and a larger assembly (far copies of the parts, which must
+// leave the findings unchanged: the run fails if they do not); and sample spacing against
+// time and missed clashes for discrete vs certified.
 // Writes bench/results/audit*.csv and charts (gnuplot). Fixed seeds.
 //
 //   bench_audit [--quick]      (--quick: smaller scenes, for a smoke run)
 //   bench_audit --probe TRIS_PER_PART [THREADS [BUILD_QUALITY [REL_ERROR]]]   (one audit of the
 //                triangle-scaling scene; BUILD_QUALITY as EmbreeOptions, -1 = automatic)
+//   bench_audit --assembly TRIS_PER_PART [MAX_COPIES]   (the assembly series alone, printed)
 #include "index/embree_index.hpp"
 #include "routing/clash_check.hpp"
 
@@ -139,6 +142,33 @@ BenchScene make_scene(int n_parts, int tris_per_part, int n_cables, double scale
     in.radius = 1.0 + 4.0 * U(rng);
     in.min_bend_radius = 6.0 * in.radius;
     sc.cables.push_back(std::move(in));
+  }
+  return sc;
+}
+
+/// Grid pitch (mm) of the assembly series' copies: the base section spans 0–1000 mm in y
+/// and z (parts reach ~200 mm past it, cables ~180 mm), so copies a pitch away stay more
+/// than 500 mm from every cable.
+constexpr double kAssemblyPitch = 2000.0;
+/// Triangles per part of the assembly series' base scene (~195k triangles in 200 parts):
+/// 64 copies stay within a few GB.
+constexpr int kAssemblyTrisPerPart = 1500;
+
+/// The assembly series' scene: `base` plus `copies` − 1 copies of all its parts, moved by
+/// multiples of kAssemblyPitch on a (y, z) grid (6 columns), appended after the base parts
+/// (so part ids of the base are unchanged). No copy comes near a cable: the audit's
+/// findings are the base scene's, only the indexed assembly grows.
+BenchScene with_far_copies(const BenchScene& base, int copies) {
+  BenchScene sc = base;
+  for (int j = 1; j < copies; ++j) {
+    const Vec3 offset(0.0, kAssemblyPitch * (j % 6), kAssemblyPitch * (j / 6));
+    for (std::size_t q = 0; q < base.parts.size(); ++q) {
+      Part p = base.parts[q];
+      p.name += "-copy" + std::to_string(j);
+      for (Vec3& v : p.mesh.vertices) v += offset;
+      sc.triangles += p.mesh.triangle_count();
+      sc.parts.push_back(std::move(p));
+    }
   }
   return sc;
 }
@@ -338,6 +368,42 @@ int probe(int tris_per_part, int threads, int build_quality, double rel_error) {
   return 0;
 }
 
+
+
+/// The assembly series: 1, 2, 4, ... `max_copies` copies of a base scene's parts
+/// (`tris_per_part` triangles each, 100 cables), index build and certified audit time on 2
+/// threads, as "assembly" rows of audit_scaling.csv when `csv` is given. Returns 1 (after
+/// saying so) if the findings differ from the base scene's: the copies are far from every
+/// cable, so they must not.
+int assembly_series(std::ostream* csv, int tris_per_part, int max_copies) {
+  const BenchScene base = make_scene(200, tris_per_part, 100, 1.0, 7);
+  std::set<ClashKey> base_keys;
+  for (int copies = 1; copies <= max_copies; copies *= 2) {
+    const BenchScene sc = with_far_copies(base, copies);
+    const double t0 = now_ms();
+    const EmbreeIndex idx(sc.parts);
+    const double index_ms = now_ms() - t0;
+    ClashRequest req;
+    req.routing_clearance = 3.0;
+    req.threads = 2;
+    const Timed t = timed_check(sc, &idx, req);
+    const std::set<ClashKey> keys = clash_keys(t.res);
+    if (copies == 1) base_keys = keys;
+    std::printf("assembly x%d: %zu parts, %zu triangles: index %.0f ms, certified %.1f ms (cpu %.1f), %zu clashes, "
+                "%zu violations, digest %016llx\n",
+                copies, sc.parts.size(), sc.triangles, index_ms, t.ms, t.cpu, t.res.clashes.size(),
+                t.res.violations.size(), static_cast<unsigned long long>(result_digest(t.res)));
+    if (keys != base_keys) {
+      std::fprintf(stderr, "assembly x%d: the findings differ from the base scene's\n", copies);
+      return 1;
+    }
+    if (csv)
+      *csv << "assembly," << sc.cables.size() << "," << sc.triangles << "," << t.ms << "," << t.cpu << ",,,,"
+           << sc.parts.size() << "," << index_ms << "\n";
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -349,6 +415,8 @@ int main(int argc, char** argv) {
   if (argc > 2 && std::string(argv[1]) == "--probe")
     return probe(std::atoi(argv[2]), argc > 3 ? std::atoi(argv[3]) : 1, argc > 4 ? std::atoi(argv[4]) : -1,
                  argc > 5 ? std::atof(argv[5]) : -1.0);
+  if (argc > 2 && std::string(argv[1]) == "--assembly")
+    return assembly_series(nullptr, std::atoi(argv[2]), argc > 3 ? std::atoi(argv[3]) : 64);
   const bool breakdown_only = argc > 1 && std::string(argv[1]) == "--breakdown";
   {
     // Where the certified time goes (each check kind alone), paper-scale scene.
@@ -441,7 +509,9 @@ int main(int argc, char** argv) {
     std::ofstream csv(dir + "audit_scaling.csv");
     // Per cable count also the cable–structure pass alone and the cable–cable + self pass
     // alone (with its pair tests): cables added to a fixed volume meet each other more often.
-    csv << "series,cables,triangles,certified_ms,certified_cpu_ms,structure_ms,pairs_ms,pair_tests\n";
+    // Two triangle series: the same 200 parts tessellated finer (the cables meet more
+    // facets), and the assembly grown by far copies of its parts (only the index grows).
+    csv << "series,cables,triangles,certified_ms,certified_cpu_ms,structure_ms,pairs_ms,pair_tests,parts,index_ms\n";
     const BenchScene big = make_scene(base_parts, tris, quick ? 80 : 400, 1.0, 7);
     EmbreeIndex idx(big.parts);
     for (int n : {25, 50, 100, 200, 400}) {
@@ -456,21 +526,25 @@ int main(int argc, char** argv) {
       const Timed structure = timed_check(sub, &idx, with_checks(req, true, false, false, false));
       const Timed pairs = timed_check(sub, &idx, with_checks(req, false, true, true, false));
       csv << "cables," << n << "," << big.triangles << "," << t.ms << "," << t.cpu << "," << structure.ms << ","
-          << pairs.ms << "," << pairs.res.counters.pair_tests << "\n";
+          << pairs.ms << "," << pairs.res.counters.pair_tests << "," << big.parts.size() << ",\n";
       std::printf("cables %d: %.1f ms (structure %.1f ms, cable-cable + self %.1f ms, %lld pair tests)\n", n, t.ms,
                   structure.ms, pairs.ms, static_cast<long long>(pairs.res.counters.pair_tests));
     }
     for (int tp : {500, 1500, 5000, 15000, 50000}) {
       if (quick && tp > 5000) break;
       const BenchScene sc = make_scene(base_parts, tp, base_cables, 1.0, 7);
+      const double t0 = now_ms();
       EmbreeIndex ix(sc.parts);
+      const double index_ms = now_ms() - t0;
       ClashRequest req;
       req.routing_clearance = 3.0;
       req.threads = 2;
       const Timed t = timed_check(sc, &ix, req);
-      csv << "triangles," << sc.cables.size() << "," << sc.triangles << "," << t.ms << "," << t.cpu << ",,,\n";
+      csv << "triangles," << sc.cables.size() << "," << sc.triangles << "," << t.ms << "," << t.cpu << ",,,,"
+          << sc.parts.size() << "," << index_ms << "\n";
       std::printf("triangles %zu: %.1f ms\n", sc.triangles, t.ms);
     }
+    if (assembly_series(&csv, kAssemblyTrisPerPart, quick ? 4 : 64) != 0) return 1;
   }
 
   // ---- 3. speed vs accuracy: spacing (discrete) and tolerance (certified) ---------------
@@ -513,7 +587,10 @@ int main(int argc, char** argv) {
           "set title 'certified audit time vs cables (200 parts)'\nset xlabel 'cables'\nset ylabel 'CPU ms (both threads)'\nset key off\n"
           "plot '" + dir + "audit_scaling.csv' using (strcol(1) eq 'cables' ? $2 : 1/0):5 with linespoints pt 7\n"
           "set title 'certified audit time vs triangles (100 cables)'\nset xlabel 'triangles'\nset logscale x\n"
-          "plot '" + dir + "audit_scaling.csv' using (strcol(1) eq 'triangles' ? $3 : 1/0):5 with linespoints pt 7\n"
+          "set key top left\n"
+          "plot '" + dir + "audit_scaling.csv' using (strcol(1) eq 'triangles' ? $3 : 1/0):5 with linespoints pt 7 "
+          "title 'finer tessellation (200 parts)', '' using (strcol(1) eq 'assembly' ? $3 : 1/0):5 with linespoints pt 5 "
+          "title 'more parts, far from the cables'\n"
           "unset logscale x\nset title 'speed vs accuracy'\nset xlabel 'CPU time (ms)'\nset ylabel 'missed clashes'\n"
           "set logscale x\nset key top right\n"
           "plot '" + dir + "audit_accuracy.csv' using (strcol(1) eq 'discrete' ? $4 : 1/0):6:(sprintf('%g', $2)) "
