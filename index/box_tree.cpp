@@ -35,12 +35,14 @@ float round_up(double x) {
   return std::nextafter(static_cast<float>(moved), std::numeric_limits<float>::infinity());
 }
 
-void check_box(const AABB& b, std::size_t i) {
+/// Throws std::invalid_argument("box tree: <what> ...") with the box at full precision
+/// unless b is unset or a finite box with min ≤ max.
+void check_box(const AABB& b, const std::string& what) {
   if (box_is_unset(b)) return;
   if (!b.min.allFinite() || !b.max.allFinite() || !(b.min.array() <= b.max.array()).all()) {
     std::ostringstream os;
     os.precision(17);
-    os << "box tree: box " << i << " is neither unset nor a finite box: min (" << b.min.transpose() << "), max ("
+    os << "box tree: " << what << " is neither unset nor a finite box: min (" << b.min.transpose() << "), max ("
        << b.max.transpose() << ")";
     throw std::invalid_argument(os.str());
   }
@@ -58,7 +60,7 @@ struct BoxTree::Impl {
   RTCScene scene = nullptr;
   std::string error;  ///< first Embree error (reported by the call that raised it)
   Vec3 centre = Vec3::Zero();
-  std::vector<std::uint32_t> ids;  ///< Embree primitive → box index (empty boxes left out)
+  std::vector<std::uint32_t> ids;  ///< Embree primitive → box index (unset boxes left out)
   std::vector<float> lo, hi;       ///< 3 floats per primitive: re-centred, rounded outwards
   std::vector<AABB> boxes;         ///< as given
 
@@ -123,14 +125,14 @@ BoxTree::BoxTree(std::vector<AABB> boxes) : impl_(std::make_unique<Impl>()) {
     throw std::invalid_argument("box tree: more boxes than 32-bit ids");
   AABB all;
   for (std::size_t i = 0; i < im.boxes.size(); ++i) {
-    check_box(im.boxes[i], i);
+    check_box(im.boxes[i], "box " + std::to_string(i));
     all.extend(im.boxes[i]);
   }
   // Re-centred before rounding to float so that far-from-origin scenes keep tight boxes.
   im.centre = all.center();
   for (std::size_t i = 0; i < im.boxes.size(); ++i) {
     const AABB& b = im.boxes[i];
-    if (b.empty()) continue;
+    if (box_is_unset(b)) continue;
     im.ids.push_back(static_cast<std::uint32_t>(i));
     for (int a = 0; a < 3; ++a) {
       im.lo.push_back(round_down(b.min[a] - im.centre[a]));
@@ -157,22 +159,14 @@ BoxTree::BoxTree(std::vector<AABB> boxes) : impl_(std::make_unique<Impl>()) {
 
 BoxTree::~BoxTree() = default;
 std::size_t BoxTree::size() const { return impl_->boxes.size(); }
-const AABB& BoxTree::box(std::size_t i) const { return impl_->boxes[i]; }
 BoxTree::BoxTree(BoxTree&& o) noexcept = default;
 BoxTree& BoxTree::operator=(BoxTree&& o) noexcept = default;
 
 void BoxTree::overlapping(const AABB& query, std::vector<std::uint32_t>& out) const {
   out.clear();
-  if (box_is_unset(query)) return;
-  if (!query.min.allFinite() || !query.max.allFinite() || !(query.min.array() <= query.max.array()).all()) {
-    std::ostringstream os;
-    os.precision(17);
-    os << "box tree: query is not a finite box: min (" << query.min.transpose() << "), max (" << query.max.transpose()
-       << ")";
-    throw std::invalid_argument(os.str());
-  }
+  check_box(query, "query");
   const Impl& im = *impl_;
-  if (im.ids.empty()) return;
+  if (box_is_unset(query) || im.ids.empty()) return;
   // The sphere around the query's centre through its corners holds the query box; its
   // radius is padded for the float rounding of the centre (relative to the larger of the
   // centre's and the radius' magnitude) so that no overlapping float box is culled.

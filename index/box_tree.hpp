@@ -43,10 +43,8 @@ class BoxTree {
   BoxTree(BoxTree&&) noexcept;
   BoxTree& operator=(BoxTree&&) noexcept;
 
-  /// Number of boxes (empty ones included).
+  /// Number of boxes (unset ones included).
   std::size_t size() const;
-  /// Box i as given.
-  const AABB& box(std::size_t i) const;
 
   /// Clears `out`, then fills it with the indices of the boxes that overlap the closed box
   /// `query` (boxes_overlap), ascending. An empty query overlaps nothing. Throws

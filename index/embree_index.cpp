@@ -589,12 +589,11 @@ RayHit EmbreeIndex::ray(const Vec3& origin, const Vec3& dir, double t_max) const
 bool EmbreeIndex::inside(const Vec3& p, int* part) const {
   // Candidate closed parts whose box contains p.
   if (!p.allFinite()) return false;
-  std::vector<std::uint32_t> found;
+  std::vector<std::uint32_t> cand;
   AABB at;
   at.extend(p);
-  impl_->closed_boxes->overlapping(at, found);
-  if (found.empty()) return false;
-  const std::vector<int> cand(found.begin(), found.end());
+  impl_->closed_boxes->overlapping(at, cand);
+  if (cand.empty()) return false;
   FlushDenormals ftz;
   const Vec3 pc = p - centre_;
   const double back = 4.0 * float_pad(p, 0.0);
@@ -611,7 +610,7 @@ bool EmbreeIndex::inside(const Vec3& p, int* part) const {
     // Only crossings of the candidates count, and p lies in each candidate's box: the ray
     // can stop where it leaves the last of them instead of crossing the whole scene.
     double exit = 0.0;
-    for (int c : cand) exit = std::max(exit, box_exit_distance(parts_[c].bounds, p, u));
+    for (const std::uint32_t c : cand) exit = std::max(exit, box_exit_distance(parts_[c].bounds, p, u));
     hits.clear();
     CollectContext cc;
     rtcInitIntersectContext(&cc.ctx);
@@ -638,7 +637,7 @@ bool EmbreeIndex::inside(const Vec3& p, int* part) const {
     std::fill(crossings.begin(), crossings.end(), 0);
     bool grazing = false;
     for (const auto& h : hits) {
-      const auto it = std::find(cand.begin(), cand.end(), static_cast<int>(h.first));
+      const auto it = std::find(cand.begin(), cand.end(), h.first);
       if (it == cand.end()) continue;
       const auto c = parts_[h.first].corners(h.second);
       const LineCrossing x = line_crossing(p, u, c[0], c[1], c[2]);
@@ -659,7 +658,7 @@ bool EmbreeIndex::inside(const Vec3& p, int* part) const {
   if (valid_rays == 0) valid_rays = 1;  // every ray grazed: treat as outside (on the surface)
   for (std::size_t i = 0; i < cand.size(); ++i)
     if (2 * votes_in[i] > valid_rays) {
-      if (part) *part = cand[i];
+      if (part) *part = static_cast<int>(cand[i]);
       return true;
     }
   return false;
