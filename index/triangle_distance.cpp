@@ -7,6 +7,9 @@ namespace loom {
 
 namespace {
 
+/// Relative shrink of the plane lower bound: far above the rounding of its few products,
+/// far below any distance difference a caller decides on.
+constexpr double kPlaneBoundShrinkRel = 1e-9;
 /// Relative threshold below which a triangle's squared area (|n|²) counts as zero compared
 /// with the fourth power of its longest edge: such a triangle is treated as its edges.
 constexpr double kDegenerateArea2Rel = 1e-24;
@@ -224,6 +227,20 @@ double segment_box_dist2_lower(const Vec3& a, const Vec3& b, const Vec3& lo, con
   const double half = 0.5 * (b - a).norm();
   const double d = std::sqrt(point_box_dist2(m, lo, hi)) - half;
   return d > 0.0 ? std::max(gap2, d * d) : gap2;
+}
+
+double segment_triangle_dist2_lower(const Vec3& a, const Vec3& b, const Vec3& t0, const Vec3& t1,
+                                    const Vec3& t2) {
+  // The same degeneracy rule as the kernels: a sliver's rounded normal is no plane.
+  if (is_degenerate(t0, t1, t2)) return 0.0;
+  const Vec3 n = (t1 - t0).cross(t2 - t0);
+  const double n2 = n.squaredNorm();
+  const double da = n.dot(a - t0), db = n.dot(b - t0);
+  // Ends on both sides (or on the plane): the segment meets the plane, no bound.
+  if ((da <= 0.0 && db >= 0.0) || (da >= 0.0 && db <= 0.0)) return 0.0;
+  const double m = std::min(std::abs(da), std::abs(db));
+  const double d2 = m * m / n2;
+  return std::isfinite(d2) ? d2 * (1.0 - kPlaneBoundShrinkRel) : 0.0;
 }
 
 }  // namespace loom

@@ -88,4 +88,13 @@ inline double point_box_dist2(const Vec3& p, const Vec3& lo, const Vec3& hi) {
 /// and the distance from the box to the sphere around the segment.
 double segment_box_dist2_lower(const Vec3& a, const Vec3& b, const Vec3& lo, const Vec3& hi);
 
+/// Lower bound on the squared distance from segment ab to triangle t0t1t2: the squared
+/// distance to the triangle's plane when both ends lie on the same side of it, shrunk by a
+/// relative 1e-9 so that rounding never lifts it above the exact kernel's value; 0 when the
+/// segment meets the plane or the triangle is degenerate (has no plane). Costs a cross and
+/// two dot products: an index tests it before closest_segment_triangle (five sub-kernels)
+/// to skip triangles whose box comes near the segment but whose plane does not.
+double segment_triangle_dist2_lower(const Vec3& a, const Vec3& b, const Vec3& t0, const Vec3& t1,
+                                    const Vec3& t2);
+
 }  // namespace loom

@@ -211,6 +211,35 @@ TEST(TriangleDistance, SegmentBoxLowerBoundAgainstExactMinimum) {
   EXPECT_NEAR(segment_box_dist2_lower(Vec3(-5, 2, 0.5), Vec3(5, 2, 0.5), Vec3::Zero(), Vec3::Ones()), 1.0, 1e-15);
 }
 
+TEST(TriangleDistance, SegmentTrianglePlaneLowerBound) {
+  // Oracle: the exact segment–triangle kernel. The bound never exceeds it, is 0 whenever the
+  // segment meets the plane, and equals it when the closest pair lies inside the triangle.
+  std::mt19937_64 rng(23);
+  for (int k = 0; k < 2000; ++k) {
+    const Vec3 t0 = rnd(rng, 2), t1 = rnd(rng, 2);
+    Vec3 t2 = rnd(rng, 2);
+    Vec3 a = rnd(rng, 4), b = a + rnd(rng, 3);
+    if (k % 4 == 1) b = a;  // a point
+    if (k % 4 == 2) t2 = t0 + 0.5 * (t1 - t0);  // degenerate: no plane, no bound
+    const double exact = closest_segment_triangle(a, b, t0, t1, t2).dist2;
+    const double lower = segment_triangle_dist2_lower(a, b, t0, t1, t2);
+    ASSERT_LE(lower, exact) << k << " a=" << a.transpose() << " b=" << b.transpose();
+    ASSERT_GE(lower, 0.0) << k;
+    if (k % 4 == 2) {
+      EXPECT_EQ(lower, 0.0) << k;
+    }
+  }
+  // A segment parallel to the triangle, 2 above its interior: the bound is the distance.
+  const Vec3 t0(0, 0, 0), t1(4, 0, 0), t2(0, 4, 0);
+  EXPECT_NEAR(segment_triangle_dist2_lower(Vec3(0.5, 0.5, 2), Vec3(1.5, 0.5, 2), t0, t1, t2), 4.0, 1e-8);
+  // Ends on both sides of the plane (far outside the triangle): no bound.
+  EXPECT_EQ(segment_triangle_dist2_lower(Vec3(9, 9, -1), Vec3(9, 9, 1), t0, t1, t2), 0.0);
+  // An end on the plane: no bound.
+  EXPECT_EQ(segment_triangle_dist2_lower(Vec3(9, 9, 0), Vec3(9, 9, 1), t0, t1, t2), 0.0);
+  // Below the plane, 3 away: the sign does not matter.
+  EXPECT_NEAR(segment_triangle_dist2_lower(Vec3(1, 1, -3), Vec3(1, 1, -5), t0, t1, t2), 9.0, 1e-7);
+}
+
 TEST(TriangleDistance, KnownDegeneracyGivesIdenticalResults) {
   // The overloads taking triangle_is_degenerate() as known must agree bit for bit with the
   // ones that test it, on proper, sliver, collinear and point triangles.
