@@ -368,8 +368,6 @@ int probe(int tris_per_part, int threads, int build_quality, double rel_error) {
   return 0;
 }
 
-
-
 /// The assembly series: 1, 2, 4, ... `max_copies` copies of a base scene's parts
 /// (`tris_per_part` triangles each, 100 cables), index build and certified audit time on 2
 /// threads, as "assembly" rows of audit_scaling.csv when `csv` is given. Returns 1 (after

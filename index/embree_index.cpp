@@ -142,7 +142,7 @@ bool point_query_callback(RTCPointQueryFunctionArguments* args) {
     const bool degenerate = pd.degenerate[args->primID] != 0;
     // The plane is as cheap again and much tighter on a finely tessellated curved surface
     // along the segment (the triangles beside the nearest have boxes within the limit).
-    if (!degenerate && segment_triangle_dist2_lower(q->a, q->b, c[0], c[1], c[2]) > limit2) return false;
+    if (segment_triangle_dist2_lower(q->a, q->b, c[0], c[1], c[2], degenerate) > limit2) return false;
     const SegmentTriangleResult r = closest_segment_triangle(q->a, q->b, c[0], c[1], c[2], degenerate);
     d2 = r.dist2;
     point = r.triangle_point;

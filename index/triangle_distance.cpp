@@ -231,8 +231,13 @@ double segment_box_dist2_lower(const Vec3& a, const Vec3& b, const Vec3& lo, con
 
 double segment_triangle_dist2_lower(const Vec3& a, const Vec3& b, const Vec3& t0, const Vec3& t1,
                                     const Vec3& t2) {
+  return segment_triangle_dist2_lower(a, b, t0, t1, t2, is_degenerate(t0, t1, t2));
+}
+
+double segment_triangle_dist2_lower(const Vec3& a, const Vec3& b, const Vec3& t0, const Vec3& t1,
+                                    const Vec3& t2, bool degenerate) {
   // The same degeneracy rule as the kernels: a sliver's rounded normal is no plane.
-  if (is_degenerate(t0, t1, t2)) return 0.0;
+  if (degenerate) return 0.0;
   const Vec3 n = (t1 - t0).cross(t2 - t0);
   const double n2 = n.squaredNorm();
   const double da = n.dot(a - t0), db = n.dot(b - t0);

@@ -97,4 +97,9 @@ double segment_box_dist2_lower(const Vec3& a, const Vec3& b, const Vec3& lo, con
 double segment_triangle_dist2_lower(const Vec3& a, const Vec3& b, const Vec3& t0, const Vec3& t1,
                                     const Vec3& t2);
 
+/// The same, with `degenerate` == triangle_is_degenerate(t0, t1, t2) already known (an index
+/// stores it per triangle): skips that test, identical result.
+double segment_triangle_dist2_lower(const Vec3& a, const Vec3& b, const Vec3& t0, const Vec3& t1,
+                                    const Vec3& t2, bool degenerate);
+
 }  // namespace loom

@@ -223,6 +223,8 @@ TEST(TriangleDistance, SegmentTrianglePlaneLowerBound) {
     if (k % 4 == 2) t2 = t0 + 0.5 * (t1 - t0);  // degenerate: no plane, no bound
     const double exact = closest_segment_triangle(a, b, t0, t1, t2).dist2;
     const double lower = segment_triangle_dist2_lower(a, b, t0, t1, t2);
+    // The overload with the degeneracy known gives the same value, bit for bit.
+    ASSERT_EQ(lower, segment_triangle_dist2_lower(a, b, t0, t1, t2, triangle_is_degenerate(t0, t1, t2))) << k;
     ASSERT_LE(lower, exact) << k << " a=" << a.transpose() << " b=" << b.transpose();
     ASSERT_GE(lower, 0.0) << k;
     if (k % 4 == 2) {
