@@ -36,6 +36,13 @@ struct AABB {
   Vec3 center() const { return empty() ? Vec3::Zero() : Vec3(0.5 * (min + max)); }
   /// Length of the diagonal, 0 when empty.
   double diagonal() const { return size().norm(); }
+  /// The box grown by r on every side (scene units; r ≥ 0). An empty box stays empty.
+  AABB inflated(double r) const {
+    AABB b = *this;
+    b.min.array() -= r;
+    b.max.array() += r;
+    return b;
+  }
   /// True if p lies in the closed box.
   bool contains(const Vec3& p) const {
     return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();

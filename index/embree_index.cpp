@@ -1,8 +1,7 @@
 #include "index/embree_index.hpp"
 
-#include "index/box_tree.hpp"
-
 #include "core/error.hpp"
+#include "index/box_tree.hpp"
 #include "index/triangle_distance.hpp"
 
 #include <embree3/rtcore.h>

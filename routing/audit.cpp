@@ -33,10 +33,10 @@ std::pair<std::string, std::string> use_nodes(const Harness& h, const SegmentUse
   return u.reversed ? std::make_pair(s.to, s.from) : std::make_pair(s.from, s.to);
 }
 
-}  // namespace
-
 /// Relative widening of the port's query box over the largest per-part reach (rounding only).
 constexpr double kReachRoundingRel = 1e-12;
+
+}  // namespace
 
 std::vector<std::string> attach_ports(const Harness& h, const std::vector<Part>& parts, double routing_clearance,
                                       std::vector<CableInput>& inputs, const ObstacleIndex* index) {
@@ -74,22 +74,17 @@ std::vector<std::string> attach_ports(const Harness& h, const std::vector<Part>&
       if (p < 0) continue;
       const Vec3 at = h.ports[p].position;
       if (!at.allFinite()) continue;  // an unplaced port sits on no part
-      AABB reach_box;
-      reach_box.extend(at);
+      AABB port_box;
+      port_box.extend(at);
       // A little wider than any part's reach, so that rounding cannot drop a box the exact
       // test below keeps.
       const double max_reach = (in.radius + routing_clearance + max_part_clearance) * (1.0 + kReachRoundingRel) +
                                kReachRoundingRel * at.cwiseAbs().maxCoeff();
-      reach_box.min.array() -= max_reach;
-      reach_box.max.array() += max_reach;
-      part_tree.overlapping(reach_box, near_port);
+      part_tree.overlapping(port_box.inflated(max_reach), near_port);
       for (const std::uint32_t q : near_port) {
         if (parts[q].role == PartRole::KeepOut) continue;  // never excused
         const double reach = in.radius + routing_clearance + parts[q].clearance;
-        AABB box = boxes[q];
-        box.min -= Vec3::Constant(reach);
-        box.max += Vec3::Constant(reach);
-        if (!box.contains(at)) continue;
+        if (!boxes[q].inflated(reach).contains(at)) continue;
         bool on = false;
         if (index) {
           on = part_containing(p) == static_cast<int>(q) ||

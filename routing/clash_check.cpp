@@ -613,10 +613,7 @@ class StructureTracer {
     // Candidate parts for the secondary check: boxes within the band of this stretch.
     AABB box;
     for (const Vec3& p : ch.p) box.extend(p);
-    const double band_reach = thr_ + 1e-9;
-    box.min.array() -= band_reach;
-    box.max.array() += band_reach;
-    ctx_.part_tree->overlapping(box, cand_);
+    ctx_.part_tree->overlapping(box.inflated(thr_ + 1e-9), cand_);
     const double touch = std::max(4.0 * ctx_.abs_err, ctx_.chord_error);
     std::vector<PartObservation> obs;
     for (std::size_t k = 0; k < ch.size(); ++k) {
@@ -665,9 +662,7 @@ class StructureTracer {
         for (const std::uint32_t cq : cand_) {
           const int q = static_cast<int>(cq);
           if (q == primary || q == inside_part_) continue;
-          const AABB& pb = ctx_.info[q].box;
-          const double reach = r_ + ctx_.info[q].required + margin_;
-          if (!((cb.min.array() - reach <= pb.max.array()).all() && (pb.min.array() <= cb.max.array() + reach).all()))
+          if (!boxes_overlap(cb.inflated(r_ + ctx_.info[q].required + margin_), ctx_.info[q].box))
             continue;  // the part's box is beyond the band of this chord
           secondary(a, b, ch.s[k], ch.s[k + 1], q, obs);
         }
@@ -858,9 +853,7 @@ std::vector<SpanChords> flatten_spans(Context& ctx) {
     for (std::size_t b = 0; b * kBlock < sc.ch.size(); ++b) {
       AABB box;
       for (std::size_t v = b * kBlock; v <= std::min(sc.ch.size(), (b + 1) * kBlock); ++v) box.extend(sc.ch.p[v]);
-      box.min.array() -= infl;
-      box.max.array() += infl;
-      sc.blocks.push_back(box);
+      sc.blocks.push_back(box.inflated(infl));
     }
   });
   return spans;

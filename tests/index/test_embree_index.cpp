@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 using namespace loom;
@@ -143,6 +144,14 @@ TEST(EmbreeIndex, InsideSeesTheFarWallOfANestingPart) {
       EXPECT_EQ(pe, c.part) << c.p.transpose();
       EXPECT_EQ(pb, c.part) << c.p.transpose();
     }
+  }
+  // A point that is not finite is inside nothing (the part-box tree would reject it as a
+  // query box: inside() answers before asking it).
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  for (const Vec3& p : {Vec3(nan, 0, 0), Vec3(0, inf, 0), Vec3(-inf, -inf, -inf)}) {
+    int pe = 7;
+    EXPECT_FALSE(e.inside(p, &pe)) << p.transpose();
+    EXPECT_EQ(pe, 7) << "inside() wrote a part for " << p.transpose();
   }
 }
 
