@@ -163,6 +163,14 @@ ScanOptions graph_opts(std::optional<double> d = 2.0) {
   return o;
 }
 
+/// The seed paper's method (slabs across the principal axis) with the cloud's diameter.
+ScanOptions axis_opts(double d) {
+  ScanOptions o;
+  o.method = ScanMethod::Axis;
+  o.diameter = d;
+  return o;
+}
+
 // ---- accuracy ------------------------------------------------------------------------
 
 TEST(ScanCenterline, GraphRecoversEveryShapeWithinTwoPercentAtOnePercentNoise) {
@@ -262,10 +270,7 @@ TEST(ScanCenterline, AxisMethodSlabsCutLongArcsOfAHelix) {
   CloudSpec c;
   c.noise = 0.01;
   const auto cloud = sample_tube(t, c);
-  ScanOptions axis;
-  axis.method = ScanMethod::Axis;
-  axis.diameter = c.diameter;
-  const auto ra = extract_centerline(cloud, axis);
+  const auto ra = extract_centerline(cloud, axis_opts(c.diameter));
   const auto rg = extract_centerline(cloud, graph_opts());
   ASSERT_EQ(ra.status, ScanStatus::Ok);
   ASSERT_EQ(rg.status, ScanStatus::Ok);
@@ -281,10 +286,7 @@ TEST(ScanCenterline, AxisMethodFailsOnTheDoubledBackLoopWhereGraphSucceeds) {
   CloudSpec c;
   c.noise = 0.01;
   const auto cloud = sample_tube(t, c);
-  ScanOptions axis;
-  axis.method = ScanMethod::Axis;
-  axis.diameter = c.diameter;
-  const auto ra = extract_centerline(cloud, axis);
+  const auto ra = extract_centerline(cloud, axis_opts(c.diameter));
   if (ra.status == ScanStatus::Ok) {
     const Errors e = compare(t, ra.centerline, c.diameter);
     EXPECT_GT(std::max(e.rms, e.coverage), 2.0 * c.diameter);
@@ -302,10 +304,7 @@ TEST(ScanCenterline, AxisMethodIsNotRobustToOutliersGraphIs) {
   c.noise = 0.01;
   c.outliers = 0.01;
   const auto cloud = sample_tube(t, c);
-  ScanOptions axis;
-  axis.method = ScanMethod::Axis;
-  axis.diameter = c.diameter;
-  const auto ra = extract_centerline(cloud, axis);
+  const auto ra = extract_centerline(cloud, axis_opts(c.diameter));
   const auto rg = extract_centerline(cloud, graph_opts());
   ASSERT_EQ(rg.status, ScanStatus::Ok);
   const double eg = compare(t, rg.centerline, c.diameter).rms;
