@@ -197,6 +197,8 @@ struct AlphaSimPlaneSamples {
 /// those inside the projection of their two triangles) subdivided to ≤ l_max, and the
 /// nodes (points) and cell centres (checks) of the lattice of spacing
 /// l_max inside each projected triangle, plus sub-edge midpoints and centroids (checks).
+/// Vertices and subdivision points in a lattice cell whose four corners are nodes are
+/// left out of the points (the corners already cover that cell); every check is kept.
 /// lattice_bitmap = false deduplicates by sorting every point (the reference; same sets).
 AlphaSimPlaneSamples alpha_sim_plane_samples(const Mesh& mesh, const AlphaSimPrism& frame, double l_max, double snap,
                                              bool lattice_bitmap = true);

@@ -2,7 +2,7 @@ set terminal pngcairo size 1200,450 noenhanced
 set output '/work/main/bench/results/alpha_sim_tessellation.png'
 set datafile separator ','
 set key top left
-set multiplot layout 1,2 title 'alpha-SIM on the wing-section CAD files tessellated finer (dim_pre = 8 mm)'
+set multiplot layout 1,2 title 'alpha-SIM on the wing-section CAD files at four tessellations (dim_pre = 8 mm)'
 set logscale x
 set xlabel 'input triangles'
 set grid

@@ -720,6 +720,40 @@ TEST(AlphaSim, OnlyOutlineEdgesAreSubdivided) {
   EXPECT_GE(off_lattice, 10u);  // the diagonal's and sides' subdivision points along the line
 }
 
+TEST(AlphaSim, PointsInCoveredLatticeCellsAreLeftOutChecksAreKept) {
+  // A square plate seen face-on (XY) with a fin standing on it, seen edge-on: the fin
+  // projects onto a segment inside the plate, in lattice cells whose four corners are all
+  // nodes. Its vertices and subdivision points add nothing there and are left out; its
+  // sub-edge midpoints stay among the checks. Seen from the side (XZ) the fin is face-on
+  // and its points are taken as usual.
+  Mesh plate;
+  plate.vertices = {{0.3, 0.3, 0}, {10.3, 0.3, 0}, {10.3, 10.3, 0}, {0.3, 10.3, 0}};
+  plate.triangles = {{0, 1, 2}, {0, 2, 3}};
+  Mesh with_fin = plate;
+  with_fin.vertices.insert(with_fin.vertices.end(), {{3.1, 5.05, 0.5}, {7.7, 5.05, 0.5}, {7.7, 5.05, 3.0}, {3.1, 5.05, 3.0}});
+  with_fin.triangles.push_back({4, 5, 6});
+  with_fin.triangles.push_back({4, 6, 7});
+  const double l_max = 1.0, snap = std::exp2(-30.0);
+  AlphaSimPrism xy;
+  for (const bool bitmap : {true, false}) {
+    const auto alone = alpha_sim_plane_samples(plate, xy, l_max, snap, bitmap);
+    const auto both = alpha_sim_plane_samples(with_fin, xy, l_max, snap, bitmap);
+    EXPECT_TRUE(both.points == alone.points) << "bitmap " << bitmap;
+    std::size_t fin_checks = 0;
+    for (const Vec2& c : both.checks)
+      if (std::abs(c.y() - 5.05) < 1e-9 && c.x() > 3.1 && c.x() < 7.7) ++fin_checks;
+    EXPECT_GE(fin_checks, 5u) << "bitmap " << bitmap;  // ⌈4.6 / 1⌉ = 5 pieces of each long edge
+  }
+  AlphaSimPrism xz;
+  xz.u = Vec3::UnitX(); xz.v = Vec3::UnitZ(); xz.n = -Vec3::UnitY();
+  const auto side = alpha_sim_plane_samples(with_fin, xz, l_max, snap);
+  std::size_t fin_corners = 0;
+  for (const Vec2& p : side.points)
+    for (const Vec2& q : {Vec2(3.1, 0.5), Vec2(7.7, 0.5), Vec2(7.7, 3.0), Vec2(3.1, 3.0)})
+      if ((p - q).norm() < 1e-9) ++fin_corners;
+  EXPECT_EQ(fin_corners, 4u);
+}
+
 // ---------------------------------------------------------- determinism, indices
 
 TEST(AlphaSim, DeterministicAcrossRuns) {
