@@ -352,8 +352,8 @@ void merge_unique(std::vector<Vec2>& sorted, const std::vector<Vec2>& more) {
 /// shortens distances), but a face seen edge-on costs only its silhouette and a long
 /// sliver triangle only its area, not (longest edge / L_max)². Vertices and subdivision
 /// points in a lattice cell whose four corners are nodes are left out (in_covered_cell).
-/// Checks (points the α-shape must cover) are the sub-edge midpoints, the centres of the lattice cells inside each
-/// triangle and its centroid.
+/// Checks (points the α-shape must cover) are the sub-edge midpoints, the centres of the
+/// lattice cells inside each triangle and its centroid.
 /// Coordinates are snapped to the grid `snap`; points and checks are sorted and unique.
 /// lattice_bitmap = false sorts every point (no LatticeBitmap): the same sets, slower.
 AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
@@ -395,9 +395,9 @@ AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
   // A point in a lattice cell whose four corners are nodes adds nothing to the region: the
   // corners already give the α-shape that cell (two triangles of circumradius L_max/√2,
   // below α = 1.9·L_max at the default factors), and the checks, all kept, repair it
-  // where the triangulation differs. Projected
-  // vertices and subdivision points there are left out: where a face-on surface covers the
-  // faces seen edge-on (a spar's web behind its flanges) they outnumber the lattice ~10×.
+  // where the triangulation differs. Projected vertices and subdivision points there are
+  // left out: where a face-on surface covers faces seen edge-on (a spar's web behind its
+  // flanges) they outnumber the lattice nodes ~10×.
   auto in_covered_cell = [&](const Vec2& q) {
     const long ci = static_cast<long>(std::floor(q.x() / l_max)), cj = static_cast<long>(std::floor(q.y() / l_max));
     return has_node(ci, cj) && has_node(ci + 1, cj) && has_node(ci, cj + 1) && has_node(ci + 1, cj + 1);
