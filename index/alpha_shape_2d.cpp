@@ -607,7 +607,26 @@ std::size_t merge_collinear(std::vector<Vec2>& ring, double angle_tol_rad, doubl
   return n0 - ring.size();
 }
 
-std::size_t grow_simplify(std::vector<PolygonWithHoles2>& polys, double max_dev) {
+namespace {
+/// Orientation of (p, q, r) as -1 (right turn), 0 (collinear), +1 (left turn); exact.
+int orient(const Vec2& p, const Vec2& q, const Vec2& r) {
+  const CGAL::Orientation o = CGAL::orientation(CPoint(p.x(), p.y()), CPoint(q.x(), q.y()), CPoint(r.x(), r.y()));
+  return o == CGAL::LEFT_TURN ? 1 : o == CGAL::RIGHT_TURN ? -1 : 0;
+}
+
+/// True if the closed segments pq and rs share a point (exact predicates).
+bool closed_segments_meet(const Vec2& p, const Vec2& q, const Vec2& r, const Vec2& s) {
+  const int o1 = orient(p, q, r), o2 = orient(p, q, s);
+  if (o1 == 0 && o2 == 0) {
+    // Collinear: they meet iff their boxes overlap.
+    const Vec2 lo1 = p.cwiseMin(q), hi1 = p.cwiseMax(q), lo2 = r.cwiseMin(s), hi2 = r.cwiseMax(s);
+    return lo1.x() <= hi2.x() && lo2.x() <= hi1.x() && lo1.y() <= hi2.y() && lo2.y() <= hi1.y();
+  }
+  return o1 * o2 <= 0 && orient(r, s, p) * orient(r, s, q) <= 0;
+}
+}  // namespace
+
+std::size_t grow_simplify(std::vector<PolygonWithHoles2>& polys, double max_dev, bool merge_corners) {
   // Every ring as a circular doubly linked list over one node array.
   struct Node {
     Vec2 p;
@@ -633,7 +652,9 @@ std::size_t grow_simplify(std::vector<PolygonWithHoles2>& polys, double max_dev)
   }
   if (nodes.empty() || !(max_dev > 0.0)) return 0;
 
-  // Uniform grid over the vertices (about two per cell) for the empty-triangle test.
+  // Uniform grid (about two vertices per cell) holding each vertex and each edge (node →
+  // next) in the cells its box meets. A moved vertex or a new edge is added again; stale
+  // entries are skipped or re-tested at their current geometry, so lookups stay complete.
   Vec2 lo = nodes[0].p, hi = nodes[0].p;
   for (const auto& nd : nodes) {
     lo = lo.cwiseMin(nd.p);
@@ -645,74 +666,153 @@ std::size_t grow_simplify(std::vector<PolygonWithHoles2>& polys, double max_dev)
   const int nx = static_cast<int>(ext.x() / cell) + 1, ny = static_cast<int>(ext.y() / cell) + 1;
   auto cx = [&](double x) { return std::clamp(static_cast<int>((x - lo.x()) / cell), 0, nx - 1); };
   auto cy = [&](double y) { return std::clamp(static_cast<int>((y - lo.y()) / cell), 0, ny - 1); };
-  std::vector<std::uint32_t> start(static_cast<std::size_t>(nx) * ny + 1, 0), items(nodes.size());
-  for (const auto& nd : nodes) ++start[static_cast<std::size_t>(cy(nd.p.y())) * nx + cx(nd.p.x()) + 1];
-  for (std::size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
-  {
-    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-    for (std::uint32_t i = 0; i < nodes.size(); ++i)
-      items[fill[static_cast<std::size_t>(cy(nodes[i].p.y())) * nx + cx(nodes[i].p.x())]++] = i;
+  std::vector<std::vector<std::uint32_t>> vertex_cells(static_cast<std::size_t>(nx) * ny), edge_cells;
+  auto add_vertex = [&](std::uint32_t i) {
+    vertex_cells[static_cast<std::size_t>(cy(nodes[i].p.y())) * nx + cx(nodes[i].p.x())].push_back(i);
+  };
+  for (std::uint32_t i = 0; i < nodes.size(); ++i) add_vertex(i);
+  // Calls f(i) for every entry of `cells` in the cells meeting the box [blo, bhi].
+  auto for_cells = [&](std::vector<std::vector<std::uint32_t>>& cells, const Vec2& blo, const Vec2& bhi, auto&& f) {
+    for (int y = cy(blo.y()); y <= cy(bhi.y()); ++y)
+      for (int x = cx(blo.x()); x <= cx(bhi.x()); ++x)
+        for (const std::uint32_t i : cells[static_cast<std::size_t>(y) * nx + x])
+          if (!f(i)) return false;
+    return true;
+  };
+  auto add_edge = [&](std::uint32_t i) {
+    const Vec2 &p = nodes[i].p, &q = nodes[nodes[i].next].p;
+    for (int y = cy(std::min(p.y(), q.y())); y <= cy(std::max(p.y(), q.y())); ++y)
+      for (int x = cx(std::min(p.x(), q.x())); x <= cx(std::max(p.x(), q.x())); ++x)
+        edge_cells[static_cast<std::size_t>(y) * nx + x].push_back(i);
+  };
+  if (merge_corners) {
+    // Only corner merges add new edges through free space; removing a notch vertex does
+    // not need them (see corner_valid).
+    edge_cells.resize(vertex_cells.size());
+    for (std::uint32_t i = 0; i < nodes.size(); ++i) add_edge(i);
   }
 
-  auto to_c = [](const Vec2& v) { return CPoint(v.x(), v.y()); };
-  // Candidate: removing b adds the triangle (a, b, c); b must turn right (strictly).
-  auto deviation = [&](std::uint32_t b) {
+  // True if no live vertex other than the excluded ones lies in the closed triangle
+  // (p0, p1, p2) (clockwise: the added material lies right of the ring).
+  auto triangle_empty = [&](const Vec2& p0, const Vec2& p1, const Vec2& p2, std::uint32_t x0, std::uint32_t x1,
+                            std::uint32_t x2) {
+    return for_cells(vertex_cells, p0.cwiseMin(p1).cwiseMin(p2), p0.cwiseMax(p1).cwiseMax(p2), [&](std::uint32_t q) {
+      if (q == x0 || q == x1 || q == x2 || !nodes[q].alive) return true;
+      const Vec2& pq = nodes[q].p;
+      // Inside or on unless strictly left of a side.
+      return orient(p0, p1, pq) > 0 || orient(p1, p2, pq) > 0 || orient(p2, p0, pq) > 0;
+    });
+  };
+
+  // Move 1, notch: removing b adds the triangle (a, b, c); b must turn right (strictly).
+  auto notch_deviation = [&](std::uint32_t b) {
     const Node& nb = nodes[b];
     const Node &na = nodes[nb.prev], &nc = nodes[nb.next];
-    if (ring_alive[nb.ring] <= 3) return std::numeric_limits<double>::infinity();
-    if (CGAL::orientation(to_c(na.p), to_c(nb.p), to_c(nc.p)) != CGAL::RIGHT_TURN)
-      return std::numeric_limits<double>::infinity();
+    if (ring_alive[nb.ring] <= 3 || orient(na.p, nb.p, nc.p) >= 0) return std::numeric_limits<double>::infinity();
     const Vec2 ac = nc.p - na.p, ab = nb.p - na.p;
     const double h = std::abs(ac.x() * ab.y() - ac.y() * ab.x()) / ac.norm();
     return std::max(na.dev, nb.dev) + h;
   };
-  auto triangle_empty = [&](std::uint32_t b) {
-    const Node& nb = nodes[b];
-    const std::uint32_t a = nb.prev, c = nb.next;
-    const CPoint pa = to_c(nodes[a].p), pb = to_c(nb.p), pc = to_c(nodes[c].p);
-    const Vec2 tlo = nodes[a].p.cwiseMin(nb.p).cwiseMin(nodes[c].p), thi = nodes[a].p.cwiseMax(nb.p).cwiseMax(nodes[c].p);
-    for (int y = cy(tlo.y()); y <= cy(thi.y()); ++y)
-      for (int x = cx(tlo.x()); x <= cx(thi.x()); ++x) {
-        const std::size_t cidx = static_cast<std::size_t>(y) * nx + x;
-        for (std::uint32_t k = start[cidx]; k < start[cidx + 1]; ++k) {
-          const std::uint32_t q = items[k];
-          if (q == a || q == b || q == c || !nodes[q].alive) continue;
-          const CPoint pq = to_c(nodes[q].p);
-          // Closed clockwise triangle (a, b, c): inside or on unless strictly left of a side.
-          if (CGAL::orientation(pa, pb, pq) != CGAL::LEFT_TURN && CGAL::orientation(pb, pc, pq) != CGAL::LEFT_TURN &&
-              CGAL::orientation(pc, pa, pq) != CGAL::LEFT_TURN)
-            return false;
-        }
-      }
-    return true;
+  // A triangle (a, b, c) whose sides ab and bc are ring edges is crossed by no other edge
+  // unless a vertex lies in it (an edge cannot enter and leave through ac alone).
+  auto notch_valid = [&](std::uint32_t b) {
+    const std::uint32_t a = nodes[b].prev, c = nodes[b].next;
+    return triangle_empty(nodes[a].p, nodes[b].p, nodes[c].p, a, b, c);
   };
-  using Entry = std::tuple<double, double, double, std::uint32_t, std::uint32_t>;  // dev, x, y, node, version
+
+  // Move 2, corner: two left turns b, c on the edge b → c are replaced by the point x where
+  // the lines a → b and d → c meet beyond them; this adds the triangle (b, x, c).
+  struct Corner {
+    Vec2 x;
+    double h = std::numeric_limits<double>::infinity();  // x's distance from the edge bc
+    double dev = std::numeric_limits<double>::infinity();
+  };
+  auto corner = [&](std::uint32_t b) {
+    Corner out;
+    const std::uint32_t a = nodes[b].prev, c = nodes[b].next, d = nodes[c].next;
+    if (!merge_corners || ring_alive[nodes[b].ring] <= 3) return out;
+    const Vec2 &pa = nodes[a].p, &pb = nodes[b].p, &pc = nodes[c].p, &pd = nodes[d].p;
+    if (orient(pa, pb, pc) <= 0 || orient(pb, pc, pd) <= 0) return out;
+    const Vec2 u = pb - pa, w = pc - pd, bc = pc - pb;
+    const double den = u.x() * w.y() - u.y() * w.x();
+    if (!(std::abs(den) > 0.0)) return out;
+    const double t = (bc.x() * w.y() - bc.y() * w.x()) / den;
+    const double s = (bc.x() * u.y() - bc.y() * u.x()) / den;
+    if (!(t > 0.0) || !(s > 0.0)) return out;  // the lines meet behind b or c: turns sum to ≥ 180°
+    out.x = pb + t * u;
+    if (!out.x.allFinite() || orient(pb, pc, out.x) >= 0) return out;  // x must lie right of b → c
+    out.h = point_segment_distance(out.x, pb, pc);
+    out.dev = std::max({nodes[a].dev, nodes[c].dev, nodes[b].dev + out.h});
+    return out;
+  };
+  // The added triangle holds no other vertex and its new sides b–x, x–c meet no edge but
+  // the three it replaces (a long edge could cross both without a vertex inside).
+  auto corner_valid = [&](std::uint32_t b, const Vec2& x) {
+    const std::uint32_t a = nodes[b].prev, c = nodes[b].next;
+    const Vec2 &pb = nodes[b].p, &pc = nodes[c].p;
+    if (!triangle_empty(pb, pc, x, a, b, c)) return false;  // (b, c, x) is clockwise
+    return for_cells(edge_cells, pb.cwiseMin(pc).cwiseMin(x), pb.cwiseMax(pc).cwiseMax(x), [&](std::uint32_t e) {
+      if (e == a || e == b || e == c || !nodes[e].alive) return true;
+      const Vec2 &p = nodes[e].p, &q = nodes[nodes[e].next].p;
+      return !closed_segments_meet(pb, x, p, q) && !closed_segments_meet(x, pc, p, q);
+    });
+  };
+
+  // Deterministic: smallest deviation first, ties by position, then node and move.
+  using Entry = std::tuple<double, double, double, std::uint32_t, std::uint32_t, int>;  // dev, x, y, node, version, move
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap;
   auto push = [&](std::uint32_t b) {
-    const double d = deviation(b);
-    if (d < max_dev) heap.emplace(d, nodes[b].p.x(), nodes[b].p.y(), b, nodes[b].version);
+    const Node& nb = nodes[b];
+    const double dn = notch_deviation(b);
+    if (dn < max_dev) heap.emplace(dn, nb.p.x(), nb.p.y(), b, nb.version, 0);
+    const double dc = corner(b).dev;
+    if (dc < max_dev) heap.emplace(dc, nb.p.x(), nb.p.y(), b, nb.version, 1);
   };
   for (std::uint32_t i = 0; i < nodes.size(); ++i) push(i);
   std::size_t removed = 0;
+  // After a change, the nodes whose moves read it get a new version and are pushed again.
+  auto touch = [&](std::initializer_list<std::uint32_t> changed) {
+    for (const std::uint32_t i : changed) ++nodes[i].version;
+    for (const std::uint32_t i : changed) push(i);
+  };
   while (!heap.empty()) {
-    const auto [d, x, y, b, version] = heap.top();
+    const auto [dev, px, py, b, version, move] = heap.top();
     heap.pop();
-    (void)x;
-    (void)y;
+    (void)dev;
+    (void)px;
+    (void)py;
     Node& nb = nodes[b];
     if (!nb.alive || nb.version != version) continue;
-    if (!(deviation(b) < max_dev) || !triangle_empty(b)) continue;
     const std::uint32_t a = nb.prev, c = nb.next;
-    nodes[a].dev = d;
-    nodes[a].next = c;
-    nodes[c].prev = a;
-    nb.alive = false;
-    --ring_alive[nb.ring];
-    ++removed;
-    ++nodes[a].version;
-    ++nodes[c].version;
-    push(a);
-    push(c);
+    if (move == 0) {
+      const double dn = notch_deviation(b);
+      if (!(dn < max_dev) || !notch_valid(b)) continue;
+      nodes[a].dev = dn;
+      nodes[a].next = c;
+      nodes[c].prev = a;
+      nb.alive = false;
+      --ring_alive[nb.ring];
+      ++removed;
+      if (merge_corners) add_edge(a);
+      // Notch moves read prev and next, corner moves also the node after next.
+      touch({nodes[a].prev, a, c});
+    } else {
+      const Corner k = corner(b);
+      if (!(k.dev < max_dev) || !corner_valid(b, k.x)) continue;
+      const std::uint32_t dn = nodes[c].next;
+      nodes[a].dev = std::max(nodes[a].dev, nb.dev + k.h);
+      nb.dev = std::max(nodes[c].dev, nb.dev + k.h);
+      nb.p = k.x;
+      nb.next = dn;
+      nodes[dn].prev = b;
+      nodes[c].alive = false;
+      --ring_alive[nb.ring];
+      ++removed;
+      add_vertex(b);
+      add_edge(a);
+      add_edge(b);
+      touch({nodes[a].prev, a, b, dn});
+    }
   }
   // Rebuild the rings from their first surviving vertex, in the original order.
   for (std::size_t r = 0; r < rings.size(); ++r) {

@@ -98,12 +98,15 @@ std::size_t merge_collinear(std::vector<Vec2>& ring, double angle_tol_rad, doubl
 
 /// Simplifies the boundary of a region (its pieces: outer rings CCW, holes CW, so the
 /// region lies left of every ring) so that the region only GROWS, by less than max_dev
-/// (scene units): a vertex where the boundary turns right (a notch, a hole's rim) is
-/// removed when the chord that replaces it stays within max_dev of the boundary it
-/// replaces (accumulated over earlier removals) and the triangle it adds holds no other
-/// vertex of any ring, so that rings stay simple and disjoint. Deterministic (smallest
-/// deviation first, ties by position). Returns the number of vertices removed.
-std::size_t grow_simplify(std::vector<PolygonWithHoles2>& polys, double max_dev);
+/// (scene units, accumulated over the moves that built each edge). Two moves:
+/// - notch: a vertex where the boundary turns right (a notch, a hole's rim) is removed;
+///   the triangle it adds must hold no other vertex of any ring;
+/// - corner (merge_corners): two consecutive left turns b, c (a convex arc) become one
+///   vertex where the lines of the edges before b and after c meet; the triangle it adds
+///   must hold no other vertex and its new sides must meet no other edge.
+/// Rings stay simple and disjoint and keep at least three vertices. Deterministic
+/// (smallest deviation first, ties by position). Returns the number of vertices removed.
+std::size_t grow_simplify(std::vector<PolygonWithHoles2>& polys, double max_dev, bool merge_corners = true);
 
 /// Signed area of a closed polygon (positive when counter-clockwise).
 double ring_signed_area(const std::vector<Vec2>& ring);

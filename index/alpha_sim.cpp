@@ -938,9 +938,11 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
     }
     rep.polygons = kept.size();
     polys[k] = std::move(kept);
-    // Coarser than the α-shape where it only adds material (notches, hole rims): fewer
-    // prism faces for the Booleans and fewer output triangles; containment is kept.
-    rep.polygon_vertices -= grow_simplify(polys[k], opt.polygon_growth_factor * opt.dim_pre);
+    // Coarser than the α-shape where it only adds material (notches, hole rims, convex
+    // arcs): fewer prism faces for the Booleans and fewer output triangles; containment is
+    // kept.
+    rep.polygon_vertices -=
+        grow_simplify(polys[k], opt.polygon_growth_factor * opt.dim_pre, opt.merge_convex_corners);
   }
 
   r.shapes_ms = ms_since(t0);

@@ -54,9 +54,12 @@ struct AlphaSimOptions {
   std::size_t max_cloud_points = 4000000;
   /// The boundary polygons that are extruded may grow the α-shape (never shrink it) by
   /// less than polygon_growth_factor·dim_pre where that removes vertices (notches, hole
-  /// rims): fewer faces and triangles. The implicit solid keeps the exact α-shapes (so the
-  /// lost-space probe, which uses it, may miss up to this much of the mesh's growth).
+  /// rims, and with merge_convex_corners pairs of corners on convex arcs): fewer faces and
+  /// triangles. The implicit solid keeps the exact α-shapes (so the lost-space probe,
+  /// which uses it, may miss up to this much of the mesh's growth).
   double polygon_growth_factor = 0.25;
+  /// Convex arcs (a cylinder seen end-on) are also coarsened, outwards (grow_simplify).
+  bool merge_convex_corners = true;
   bool build_mesh = true;       ///< OpenCASCADE prisms ∩ → triangle mesh (else implicit only)
   bool measure = true;          ///< containment of the mesh + Hausdorff distance
   std::filesystem::path step_dir;  ///< if set, writes <step_dir>/<part>.step (OpenCASCADE)

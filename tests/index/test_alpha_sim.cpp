@@ -346,9 +346,45 @@ std::vector<std::vector<Vec2>> rings_of(const std::vector<PolygonWithHoles2>& po
 
 }  // namespace
 
-TEST(AlphaShape2D, GrowSimplifyOnlyGrowsTheRegion) {
-  // A gear-like outer ring (notches of random depth) around a finely faceted round hole,
-  // next to a second piece: the notches and the hole's rim may go, convex corners stay.
+/// Checks that `after` (rings of grow_simplify's output) only grew `before`'s region, by
+/// less than max_dev, with each ring's orientation kept and all rings simple and disjoint.
+void expect_grown_within(const std::vector<std::vector<Vec2>>& before, const std::vector<std::vector<Vec2>>& after,
+                         double max_dev, double half_width, std::uint64_t seed) {
+  ASSERT_EQ(after.size(), before.size());
+  for (std::size_t r = 0; r < after.size(); ++r) {
+    ASSERT_GE(after[r].size(), 3u);
+    EXPECT_GT(ring_signed_area(after[r]) * ring_signed_area(before[r]), 0.0);  // orientation kept
+  }
+  // The region only grows (dense samples of the old region are in the new one), by < max_dev.
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-half_width, half_width);
+  for (int i = 0; i < 20000; ++i) {
+    const Vec2 p(u(rng), u(rng));
+    if (in_rings(p, before, 0.0)) {
+      ASSERT_TRUE(in_rings(p, after, 1e-9)) << p.transpose();
+    } else if (in_rings(p, after, 0.0)) {
+      ASSERT_LT(distance_to_rings(p, before), max_dev) << p.transpose();
+    }
+  }
+  for (const auto& r : after)
+    for (const auto& v : r) ASSERT_LT(distance_to_rings(v, before), max_dev) << v.transpose();
+  // Rings stay simple and disjoint.
+  for (std::size_t r1 = 0; r1 < after.size(); ++r1)
+    for (std::size_t r2 = r1; r2 < after.size(); ++r2)
+      for (std::size_t i = 0; i < after[r1].size(); ++i)
+        for (std::size_t j = 0; j < after[r2].size(); ++j) {
+          const auto& A = after[r1];
+          const auto& B = after[r2];
+          const std::size_t i1 = (i + 1) % A.size(), j1 = (j + 1) % B.size();
+          // Consecutive edges of one ring share a vertex.
+          if (r1 == r2 && (i == j || i1 == j || j1 == i)) continue;
+          ASSERT_FALSE(segments_touch(A[i], A[i1], B[j], B[j1])) << r1 << ":" << i << " " << r2 << ":" << j;
+        }
+}
+
+/// A gear-like outer ring (notches of random depth, seed 17) around a finely faceted
+/// round hole, next to a square piece whose near side is `gap` from the teeth.
+std::vector<PolygonWithHoles2> gear_hole_square(double gap) {
   std::mt19937_64 rng(17);
   std::uniform_real_distribution<double> depth(0.0, 1.5);
   PolygonWithHoles2 gear;
@@ -365,11 +401,23 @@ TEST(AlphaShape2D, GrowSimplifyOnlyGrowsTheRegion) {
   }
   gear.holes.push_back(hole);
   PolygonWithHoles2 square;
-  square.outer = {{21.2, -2}, {25, -2}, {25, 2}, {21.2, 2}};
-  std::vector<PolygonWithHoles2> polys = {gear, square};
+  const double x0 = 20.0 + gap;
+  square.outer = {{x0, -2}, {x0 + 3.8, -2}, {x0 + 3.8, 2}, {x0, 2}};
+  return {gear, square};
+}
+
+std::vector<Vec2> disc_ring(double radius, int n) {
+  std::vector<Vec2> ring;
+  for (int k = 0; k < n; ++k) ring.emplace_back(radius * std::cos(2 * M_PI * k / n), radius * std::sin(2 * M_PI * k / n));
+  return ring;
+}
+
+TEST(AlphaShape2D, GrowSimplifyOnlyGrowsTheRegion) {
+  // Notch moves only: the notches and the hole's rim may go, convex corners stay.
+  std::vector<PolygonWithHoles2> polys = gear_hole_square(1.2);
   const auto before = rings_of(polys);
   const double max_dev = 0.5;
-  const std::size_t removed = grow_simplify(polys, max_dev);
+  const std::size_t removed = grow_simplify(polys, max_dev, /*merge_corners=*/false);
   const auto after = rings_of(polys);
   EXPECT_GT(removed, 150u);
   ASSERT_EQ(after.size(), before.size());
@@ -378,38 +426,65 @@ TEST(AlphaShape2D, GrowSimplifyOnlyGrowsTheRegion) {
   std::size_t total = 0;
   for (std::size_t r = 0; r < after.size(); ++r) {
     total += after[r].size();
-    EXPECT_GT(ring_signed_area(after[r]) * ring_signed_area(before[r]), 0.0);  // orientation kept
     // Every vertex left is an original vertex.
     for (const auto& v : after[r]) EXPECT_NE(std::find(before[r].begin(), before[r].end(), v), before[r].end());
   }
-  EXPECT_EQ(total + removed, 4u * teeth + 200u + 4u);
-  // The region only grows (dense samples of the old region are in the new one), by < max_dev.
-  std::uniform_real_distribution<double> u(-26, 26);
-  for (int i = 0; i < 20000; ++i) {
-    const Vec2 p(u(rng), u(rng));
-    if (in_rings(p, before, 0.0)) {
-      ASSERT_TRUE(in_rings(p, after, 1e-9)) << p.transpose();
-    } else if (in_rings(p, after, 0.0)) {
-      ASSERT_LT(distance_to_rings(p, before), max_dev) << p.transpose();
-    }
-  }
-  for (const auto& r : before)
-    for (const auto& v : r) ASSERT_LT(distance_to_rings(v, after), max_dev);
-  // Rings stay simple and disjoint.
-  for (std::size_t r1 = 0; r1 < after.size(); ++r1)
-    for (std::size_t r2 = r1; r2 < after.size(); ++r2)
-      for (std::size_t i = 0; i < after[r1].size(); ++i)
-        for (std::size_t j = 0; j < after[r2].size(); ++j) {
-          if (r1 == r2 && i == j) continue;
-          const auto& A = after[r1];
-          const auto& B = after[r2];
-          ASSERT_FALSE(segments_touch(A[i], A[(i + 1) % A.size()], B[j], B[(j + 1) % B.size()]))
-              << r1 << ":" << i << " " << r2 << ":" << j;
-        }
+  EXPECT_EQ(total + removed, 4u * 40 + 200u + 4u);
+  expect_grown_within(before, after, max_dev, 26.0, 17);
   // A convex ring cannot grow by removing vertices: unchanged.
   std::vector<PolygonWithHoles2> disc(1);
-  for (int k = 0; k < 48; ++k) disc[0].outer.emplace_back(5 * std::cos(2 * M_PI * k / 48), 5 * std::sin(2 * M_PI * k / 48));
-  EXPECT_EQ(grow_simplify(disc, 1.0), 0u);
+  disc[0].outer = disc_ring(5.0, 48);
+  EXPECT_EQ(grow_simplify(disc, 1.0, false), 0u);
+}
+
+TEST(AlphaShape2D, GrowSimplifyMergesConvexCornersOutward) {
+  // A faceted disc: pairs of convex corners become one vertex on the lines of their
+  // neighbouring edges, the circumscribed polygon whose growth stays below max_dev.
+  std::vector<PolygonWithHoles2> disc(1);
+  disc[0].outer = disc_ring(5.0, 48);
+  const auto disc_before = rings_of(disc);
+  const std::size_t removed = grow_simplify(disc, 1.0, true);
+  EXPECT_GT(removed, 30u);  // a hexagon around r = 5 stands off 0.77; 48 -> < 18 vertices
+  expect_grown_within(disc_before, rings_of(disc), 1.0, 7.0, 5);
+  // A square's corners cannot merge (their edge lines are parallel).
+  std::vector<PolygonWithHoles2> square(1);
+  square[0].outer = {{0, 0}, {2, 0}, {2, 2}, {0, 2}};
+  EXPECT_EQ(grow_simplify(square, 1.0, true), 0u);
+  // The gear, its hole and the square piece, the square 0.3 from the teeth (less than
+  // max_dev): corners grow towards it, but no new edge may meet it.
+  for (const double gap : {1.2, 0.3, 0.05}) {
+    std::vector<PolygonWithHoles2> polys = gear_hole_square(gap);
+    const auto before = rings_of(polys);
+    const std::size_t n = grow_simplify(polys, 0.5, true);
+    const auto after = rings_of(polys);
+    std::size_t total = 0;
+    for (const auto& r : after) total += r.size();
+    EXPECT_EQ(total + n, 4u * 40 + 200u + 4u) << gap;
+    SCOPED_TRACE(gap);
+    expect_grown_within(before, after, 0.5, 26.0, 17);
+  }
+  // A hexagon whose corners (4.8, ±0.5) would merge into (5.067, 0) (growth 0.267; every
+  // other merge grows ≥ 0.7), beside a bar whose long side (x = 4.95) crosses both new
+  // sides with its vertices outside the added triangle, or a small triangle lying wholly
+  // inside it: neither may be reached, so nothing merges.
+  for (const bool bar : {true, false}) {
+    std::vector<PolygonWithHoles2> polys(2);
+    polys[0].outer = {{-3, -2}, {4, -2}, {4.8, -0.5}, {4.8, 0.5}, {4, 2}, {-3, 2}};
+    if (bar)
+      polys[1].outer = {{4.95, -4}, {5.95, -4}, {5.95, 4}, {4.95, 4}};
+    else
+      polys[1].outer = {{4.9, 0.0}, {4.95, -0.03}, {4.95, 0.03}};
+    const auto before = rings_of(polys);
+    SCOPED_TRACE(bar ? "bar" : "small triangle");
+    EXPECT_EQ(grow_simplify(polys, 0.5, true), 0u);
+    expect_grown_within(before, rings_of(polys), 0.5, 7.0, 3);
+    polys.pop_back();  // alone, the hexagon's corners merge
+    EXPECT_EQ(grow_simplify(polys, 0.5, true), 1u);
+    EXPECT_EQ(polys[0].outer.size(), 5u);
+  }
+  // Notch-only removes fewer vertices from the gear than both moves.
+  std::vector<PolygonWithHoles2> notch = gear_hole_square(1.2), both = gear_hole_square(1.2);
+  EXPECT_LT(grow_simplify(notch, 0.5, false), grow_simplify(both, 0.5, true));
 }
 
 TEST(AlphaShape2D, RefineClosesANotchThatCoverWouldBridge) {
@@ -501,8 +576,11 @@ TEST(AlphaSim, LBracketIsReproducedExactly) {
 }
 
 TEST(AlphaSim, CylinderVolumeIsKept) {
+  // Convex arcs kept as they are: the 48-gon is reproduced exactly.
   Part c = make_part("cyl", cylinder_mesh(5.0, 20.0, 48));
-  const auto sp = simplify_part(c, options(1.0));
+  AlphaSimOptions exact = options(1.0);
+  exact.merge_convex_corners = false;
+  const auto sp = simplify_part(c, exact);
   EXPECT_EQ(sp.result.fallback, AlphaSimFallback::None) << sp.result.reason;
   const double polygon_area = 0.5 * 48 * 25.0 * std::sin(2 * M_PI / 48);
   EXPECT_NEAR(sp.result.volume_before, polygon_area * 20.0, 1e-9);
@@ -510,6 +588,25 @@ TEST(AlphaSim, CylinderVolumeIsKept) {
   EXPECT_DOUBLE_EQ(sp.result.containment, 1.0);
   EXPECT_LT(sp.result.hausdorff, sp.result.tolerance);
   EXPECT_EQ(sp.result.projections[0].polygon_vertices, 48u);
+}
+
+TEST(AlphaSim, CylinderArcIsCoarsenedOutwardWithinTheGrowthBudget) {
+  // By default the end view's arc is coarsened outwards: fewer vertices, still contains
+  // the original, stands off it by less than polygon_growth_factor·dim_pre (0.25), and
+  // the cross-section grows by less than perimeter × 0.25.
+  Part c = make_part("cyl", cylinder_mesh(5.0, 20.0, 48));
+  const AlphaSimOptions o = options(1.0);
+  const auto sp = simplify_part(c, o);
+  EXPECT_EQ(sp.result.fallback, AlphaSimFallback::None) << sp.result.reason;
+  const double budget = o.polygon_growth_factor * o.dim_pre;
+  // A circumscribed k-gon stands off r = 5 by 5 (1 / cos(π/k) − 1) < 0.25 from k = 11 on.
+  EXPECT_GE(sp.result.projections[0].polygon_vertices, 11u);
+  EXPECT_LT(sp.result.projections[0].polygon_vertices, 24u);
+  EXPECT_DOUBLE_EQ(sp.result.containment, 1.0);
+  EXPECT_LT(sp.result.hausdorff, budget);
+  EXPECT_GE(sp.result.volume_after, sp.result.volume_before * (1 - 1e-9));
+  EXPECT_LT(sp.result.volume_after, sp.result.volume_before + 2 * M_PI * 5.0 * budget * 20.0);
+  EXPECT_LT(sp.result.triangles_after, 48u * 4);
 }
 
 TEST(AlphaSim, CoarseCylinderIsSmoothedButContained) {
@@ -904,4 +1001,54 @@ RC_GTEST_PROP(AlphaSimProperty, RandomBoxUnionsAreContained, ()) {
   RC_ASSERT(sp.result.containment_implicit == 1.0);
   if (sp.solid)
     for (const auto& v : p.mesh.vertices) RC_ASSERT(sp.solid->contains(v, sp.result.tolerance));
+}
+
+RC_GTEST_PROP(AlphaSimProperty, GrowSimplifyOnlyGrowsRandomStarRings, ()) {
+  // A star-shaped outer ring (random radii at increasing angles) around a star-shaped hole
+  // (radii below the outer ring's distance from the centre), both moves, a random budget:
+  // the region only grows, by less than the budget, and the rings stay simple, disjoint
+  // and oriented.
+  auto star = [](double r_lo, double r_hi, bool clockwise) {
+    const int n = *rc::gen::inRange(4, 60);
+    std::vector<Vec2> ring;
+    for (int k = 0; k < n; ++k) {
+      const double a = 2 * M_PI * (k + 0.01 * *rc::gen::inRange(0, 90)) / n;
+      const double r = r_lo + (r_hi - r_lo) * 0.001 * *rc::gen::inRange(0, 1001);
+      ring.emplace_back(r * std::cos(clockwise ? -a : a), r * std::sin(clockwise ? -a : a));
+    }
+    return ring;
+  };
+  std::vector<PolygonWithHoles2> polys(1);
+  polys[0].outer = star(6.0, 10.0, false);
+  double inner = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < polys[0].outer.size(); ++i)
+    inner = std::min(inner, point_segment_distance(Vec2::Zero(), polys[0].outer[i],
+                                                   polys[0].outer[(i + 1) % polys[0].outer.size()]));
+  if (*rc::gen::arbitrary<bool>()) polys[0].holes.push_back(star(0.15 * inner, 0.9 * inner, true));
+  const double max_dev = 0.01 * *rc::gen::inRange(1, 300);
+  const auto before = rings_of(polys);
+  grow_simplify(polys, max_dev, true);
+  const auto after = rings_of(polys);
+  RC_ASSERT(after.size() == before.size());
+  for (std::size_t r = 0; r < after.size(); ++r) {
+    RC_ASSERT(after[r].size() >= 3u);
+    RC_ASSERT(ring_signed_area(after[r]) * ring_signed_area(before[r]) > 0.0);
+    for (const auto& v : after[r]) RC_ASSERT(distance_to_rings(v, before) < max_dev);
+  }
+  std::mt19937_64 rng(*rc::gen::inRange(0, 1000));
+  std::uniform_real_distribution<double> u(-10.5, 10.5);
+  for (int i = 0; i < 2000; ++i) {
+    const Vec2 p(u(rng), u(rng));
+    if (in_rings(p, before, 0.0)) RC_ASSERT(in_rings(p, after, 1e-9));
+  }
+  for (std::size_t r1 = 0; r1 < after.size(); ++r1)
+    for (std::size_t r2 = r1; r2 < after.size(); ++r2)
+      for (std::size_t i = 0; i < after[r1].size(); ++i)
+        for (std::size_t j = 0; j < after[r2].size(); ++j) {
+          const auto& A = after[r1];
+          const auto& B = after[r2];
+          const std::size_t i1 = (i + 1) % A.size(), j1 = (j + 1) % B.size();
+          if (r1 == r2 && (i == j || i1 == j || j1 == i)) continue;
+          RC_ASSERT(!segments_touch(A[i], A[i1], B[j], B[j1]));
+        }
 }
