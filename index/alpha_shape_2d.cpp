@@ -723,7 +723,7 @@ std::size_t grow_simplify(std::vector<PolygonWithHoles2>& polys, double max_dev,
   // Move 2, corner: two left turns b, c on the edge b → c are replaced by the point x where
   // the lines a → b and d → c meet beyond them; this adds the triangle (b, x, c).
   struct Corner {
-    Vec2 x;
+    Vec2 x = Vec2::Zero();
     double h = std::numeric_limits<double>::infinity();  // x's distance from the edge bc
     double dev = std::numeric_limits<double>::infinity();
   };

@@ -268,18 +268,15 @@ class LatticeBitmap {
   bool active() const { return !bits_.empty(); }
   /// Marks (i, j); false if it lies outside the box (the caller keeps the point itself).
   bool set(long i, long j) {
-    const long x = i - i0_, y = j - j0_;
-    if (x < 0 || y < 0 || x >= nx_ || y >= ny_) return false;
-    const std::size_t k = static_cast<std::size_t>(x) * static_cast<std::size_t>(ny_) + static_cast<std::size_t>(y);
+    const std::size_t k = bit(i, j);
+    if (k == kOutside) return false;
     bits_[k / 64] |= std::uint64_t(1) << (k % 64);
     return true;
   }
   /// True if (i, j) is marked.
   bool test(long i, long j) const {
-    const long x = i - i0_, y = j - j0_;
-    if (x < 0 || y < 0 || x >= nx_ || y >= ny_) return false;
-    const std::size_t k = static_cast<std::size_t>(x) * static_cast<std::size_t>(ny_) + static_cast<std::size_t>(y);
-    return (bits_[k / 64] >> (k % 64)) & 1u;
+    const std::size_t k = bit(i, j);
+    return k != kOutside && ((bits_[k / 64] >> (k % 64)) & 1u);
   }
   /// The marked points, mapped by `point(i, j)`, in increasing (i, j), which is
   /// increasing (x, y) since the mapping is monotone in each index.
@@ -300,6 +297,13 @@ class LatticeBitmap {
   }
 
  private:
+  static constexpr std::size_t kOutside = ~std::size_t(0);
+  /// Bit number of (i, j), or kOutside if it lies outside the box (or no bitmap).
+  std::size_t bit(long i, long j) const {
+    const long x = i - i0_, y = j - j0_;
+    if (x < 0 || y < 0 || x >= nx_ || y >= ny_) return kOutside;
+    return static_cast<std::size_t>(x) * static_cast<std::size_t>(ny_) + static_cast<std::size_t>(y);
+  }
   double h_, offset_;
   long i0_ = 0, j0_ = 0, nx_ = 0, ny_ = 0;
   std::vector<std::uint64_t> bits_;
