@@ -104,14 +104,16 @@ double AlphaSimSolid::distance_bound(const Vec3& p) const {
 // Sampling
 
 std::vector<Vec3> dense_surface_samples(const Mesh& mesh, double spacing, double density,
-                                        std::size_t max_samples, std::uint64_t seed) {
+                                        std::size_t max_samples, std::uint64_t seed, bool fixed_points) {
   std::vector<Vec3> out;
   const std::size_t nt = mesh.triangles.size();
-  std::vector<char> used(mesh.vertices.size(), 0);
-  for (const auto& f : mesh.triangles)
-    for (auto i : f) used[i] = 1;
-  for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
-    if (used[i]) out.push_back(mesh.vertices[i]);
+  if (fixed_points) {
+    std::vector<char> used(mesh.vertices.size(), 0);
+    for (const auto& f : mesh.triangles)
+      for (auto i : f) used[i] = 1;
+    for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
+      if (used[i]) out.push_back(mesh.vertices[i]);
+  }
   // Random points: ≥ 2 per triangle, ≈ density per spacing² of area, capped.
   const double cell = spacing > 0.0 ? spacing * spacing : 1.0;
   std::vector<std::size_t> count(nt);
@@ -127,10 +129,12 @@ std::vector<Vec3> dense_surface_samples(const Mesh& mesh, double spacing, double
   std::uniform_real_distribution<double> uni(0.0, 1.0);
   for (std::size_t t = 0; t < nt; ++t) {
     const auto c = mesh.corners(t);
-    out.push_back((c[0] + c[1]) / 2.0);
-    out.push_back((c[1] + c[2]) / 2.0);
-    out.push_back((c[2] + c[0]) / 2.0);
-    out.push_back((c[0] + c[1] + c[2]) / 3.0);
+    if (fixed_points) {
+      out.push_back((c[0] + c[1]) / 2.0);
+      out.push_back((c[1] + c[2]) / 2.0);
+      out.push_back((c[2] + c[0]) / 2.0);
+      out.push_back((c[0] + c[1] + c[2]) / 3.0);
+    }
     const std::size_t k = std::max<std::size_t>(1, static_cast<std::size_t>(count[t] * scale));
     for (std::size_t s = 0; s < k; ++s) {
       double a = uni(rng), b = uni(rng);
@@ -758,7 +762,9 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
   // nearly coincident silhouettes of a faceted cylinder. Containment is verified below on
   // an independent set (another seed).
   const std::vector<Vec3> cover_samples =
-      dense_surface_samples(part.mesh, r.l_max, opt.containment_density, opt.containment_max_samples, opt.seed + 2);
+      opt.cover_samples ? dense_surface_samples(part.mesh, r.l_max, opt.containment_density,
+                                                opt.containment_max_samples, opt.seed + 2)
+                        : std::vector<Vec3>();
 
   // 1–2. Sample each projection (L_max), 3. build its α-shape (planes in parallel).
   std::vector<AlphaSimPrism> prisms(specs.size());
@@ -842,8 +848,10 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
     return miss;
   };
   for (int round = 0;; ++round) {
+    // Random points only: the fixed ones (vertices, edge midpoints, centroids) are among
+    // the cover samples, which every repair keeps covered.
     samples = dense_surface_samples(part.mesh, r.l_max, opt.containment_density, opt.containment_max_samples,
-                                    opt.seed + 3 * static_cast<std::uint64_t>(round));
+                                    opt.seed + 3 * static_cast<std::uint64_t>(round), false);
     std::vector<std::vector<Vec2>> missed;
     const auto miss = plane_misses(missed);
     bool any = false, hull_missed = false;
@@ -863,6 +871,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
       }
     }
     if (!any) break;
+    ++r.repair_rounds;
     if (hull_missed) {
       keep_original(out, part, AlphaSimStatus::Failed,
                     "convex hull of a projection misses surface samples: original kept");
@@ -992,7 +1001,13 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
 
   const auto t_measure = Clock::now();
   if (opt.measure) {
-    // Containment of the original surface in the output mesh (what indices will use).
+    // Containment of the original surface in the output mesh (what indices will use): the
+    // last round's random points, and the fixed points (with one random point, a seed no
+    // round used) of every triangle.
+    const std::vector<Vec3> fixed = dense_surface_samples(part.mesh, r.l_max, 0.0, 0,
+                                                          opt.seed + 3 * static_cast<std::uint64_t>(kRefineRounds + 1));
+    samples.insert(samples.end(), fixed.begin(), fixed.end());
+    r.containment_samples = samples.size();
     const EmbreeIndex simplified = mesh_index(out.mesh, true);
     const std::size_t in = count_contained_mesh(simplified, samples, tol);
     r.containment = samples.empty() ? 1.0 : static_cast<double>(in) / samples.size();

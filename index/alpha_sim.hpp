@@ -50,6 +50,10 @@ struct AlphaSimOptions {
   /// (at least the vertices, edge midpoints, centroids and two random points per triangle).
   double containment_density = 4.0;
   std::size_t containment_max_samples = 400000;
+  /// Dense samples (vertices, edge midpoints, centroids, random points) are checks of the
+  /// first repair; false leaves only the planes' own checks there (an ablation: the
+  /// verification rounds, on random points, then have to do the repair).
+  bool cover_samples = true;
   /// Most samples in one projection plane (memory bound, ~100 bytes per point).
   std::size_t max_cloud_points = 4000000;
   /// The boundary polygons that are extruded may grow the α-shape (never shrink it) by
@@ -128,6 +132,8 @@ struct AlphaSimResult {
   double containment = 1.0;           ///< fraction of dense original samples inside/on the output mesh
   double containment_implicit = 1.0;  ///< same against the implicit solid
   std::size_t containment_samples = 0;
+  /// Verification rounds that found random samples outside a shape and repaired it.
+  int repair_rounds = 0;
   double hausdorff = 0.0;             ///< max over the output surface of the distance to the original
   double lost_space_radius = 0.0;     ///< largest probed ball radius filled by the simplification
   double lost_space_resolution = 0.0; ///< grid spacing of that probe
@@ -206,10 +212,11 @@ struct AlphaSimPlaneSamples {
 AlphaSimPlaneSamples alpha_sim_plane_samples(const Mesh& mesh, const AlphaSimPrism& frame, double l_max, double snap,
                                              bool lattice_bitmap = true);
 
-/// Dense samples of a mesh surface: vertices, edge midpoints, centroids and random points
-/// (≈ density per spacing² of area, at least two per triangle), capped at max_samples
-/// random ones; deterministic for a seed. World frame.
+/// Dense samples of a mesh surface: vertices, edge midpoints, centroids (the fixed points,
+/// unless fixed_points is false) and random points (≈ density per spacing² of area, at
+/// least two per triangle), capped at max_samples random ones; deterministic for a seed.
+/// World frame.
 std::vector<Vec3> dense_surface_samples(const Mesh& mesh, double spacing, double density,
-                                        std::size_t max_samples, std::uint64_t seed);
+                                        std::size_t max_samples, std::uint64_t seed, bool fixed_points = true);
 
 }  // namespace loom
