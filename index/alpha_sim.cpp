@@ -849,9 +849,10 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
   };
   for (int round = 0;; ++round) {
     // Random points only: the fixed ones (vertices, edge midpoints, centroids) are among
-    // the cover samples, which every repair keeps covered.
+    // the cover samples, which every repair keeps covered (without cover samples they are
+    // tested here too).
     samples = dense_surface_samples(part.mesh, r.l_max, opt.containment_density, opt.containment_max_samples,
-                                    opt.seed + 3 * static_cast<std::uint64_t>(round), false);
+                                    opt.seed + 3 * static_cast<std::uint64_t>(round), !opt.cover_samples);
     std::vector<std::vector<Vec2>> missed;
     const auto miss = plane_misses(missed);
     bool any = false, hull_missed = false;

@@ -52,7 +52,7 @@ struct AlphaSimOptions {
   std::size_t containment_max_samples = 400000;
   /// Dense samples (vertices, edge midpoints, centroids, random points) are checks of the
   /// first repair; false leaves only the planes' own checks there (an ablation: the
-  /// verification rounds, on random points, then have to do the repair).
+  /// verification rounds, which then test the fixed points too, have to do the repair).
   bool cover_samples = true;
   /// Most samples in one projection plane (memory bound, ~100 bytes per point).
   std::size_t max_cloud_points = 4000000;
