@@ -3,6 +3,7 @@
 #include <CGAL/Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_face_base_with_info_2.h>
+#include <CGAL/intersections.h>
 
 #include <algorithm>
 #include <array>
@@ -614,15 +615,10 @@ int orient(const Vec2& p, const Vec2& q, const Vec2& r) {
   return o == CGAL::LEFT_TURN ? 1 : o == CGAL::RIGHT_TURN ? -1 : 0;
 }
 
-/// True if the closed segments pq and rs share a point (exact predicates).
+/// True if the closed segments pq and rs share a point (CGAL, exact predicates).
 bool closed_segments_meet(const Vec2& p, const Vec2& q, const Vec2& r, const Vec2& s) {
-  const int o1 = orient(p, q, r), o2 = orient(p, q, s);
-  if (o1 == 0 && o2 == 0) {
-    // Collinear: they meet iff their boxes overlap.
-    const Vec2 lo1 = p.cwiseMin(q), hi1 = p.cwiseMax(q), lo2 = r.cwiseMin(s), hi2 = r.cwiseMax(s);
-    return lo1.x() <= hi2.x() && lo2.x() <= hi1.x() && lo1.y() <= hi2.y() && lo2.y() <= hi1.y();
-  }
-  return o1 * o2 <= 0 && orient(r, s, p) * orient(r, s, q) <= 0;
+  return CGAL::do_intersect(K::Segment_2(CPoint(p.x(), p.y()), CPoint(q.x(), q.y())),
+                            K::Segment_2(CPoint(r.x(), r.y()), CPoint(s.x(), s.y())));
 }
 }  // namespace
 

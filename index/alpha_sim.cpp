@@ -1002,12 +1002,10 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
 
   const auto t_measure = Clock::now();
   if (opt.measure) {
-    // Containment of the original surface in the output mesh (what indices will use): the
-    // last round's random points, and the fixed points (with one random point, a seed no
-    // round used) of every triangle.
-    const std::vector<Vec3> fixed = dense_surface_samples(part.mesh, r.l_max, 0.0, 0,
-                                                          opt.seed + 3 * static_cast<std::uint64_t>(kRefineRounds + 1));
-    samples.insert(samples.end(), fixed.begin(), fixed.end());
+    // Containment of the original surface in the output mesh (what indices will use), on
+    // a whole dense set (fixed and random points) of a seed no verification round used.
+    samples = dense_surface_samples(part.mesh, r.l_max, opt.containment_density, opt.containment_max_samples,
+                                    opt.seed + 3 * static_cast<std::uint64_t>(kRefineRounds + 1));
     r.containment_samples = samples.size();
     const EmbreeIndex simplified = mesh_index(out.mesh, true);
     const std::size_t in = count_contained_mesh(simplified, samples, tol);
