@@ -103,57 +103,7 @@ double AlphaSimSolid::distance_bound(const Vec3& p) const {
 // ---------------------------------------------------------------------------------------
 // Sampling
 
-std::vector<Vec3> dense_surface_samples(const Mesh& mesh, double spacing, double density,
-                                        std::size_t max_samples, std::uint64_t seed, bool fixed_points) {
-  std::vector<Vec3> out;
-  const std::size_t nt = mesh.triangles.size();
-  if (fixed_points) {
-    std::vector<char> used(mesh.vertices.size(), 0);
-    for (const auto& f : mesh.triangles)
-      for (auto i : f) used[i] = 1;
-    for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
-      if (used[i]) out.push_back(mesh.vertices[i]);
-  }
-  // Random points: ≥ 2 per triangle, ≈ density per spacing² of area, capped.
-  const double cell = spacing > 0.0 ? spacing * spacing : 1.0;
-  std::vector<std::size_t> count(nt);
-  std::size_t total = 0;
-  for (std::size_t t = 0; t < nt; ++t) {
-    const auto c = mesh.corners(t);
-    const double area = 0.5 * (c[1] - c[0]).cross(c[2] - c[0]).norm();
-    count[t] = 2 + static_cast<std::size_t>(std::min(1e6, density * area / cell));
-    total += count[t];
-  }
-  const double scale = total > max_samples && total > 0 ? static_cast<double>(max_samples) / total : 1.0;
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> uni(0.0, 1.0);
-  for (std::size_t t = 0; t < nt; ++t) {
-    const auto c = mesh.corners(t);
-    if (fixed_points) {
-      out.push_back((c[0] + c[1]) / 2.0);
-      out.push_back((c[1] + c[2]) / 2.0);
-      out.push_back((c[2] + c[0]) / 2.0);
-      out.push_back((c[0] + c[1] + c[2]) / 3.0);
-    }
-    const std::size_t k = std::max<std::size_t>(1, static_cast<std::size_t>(count[t] * scale));
-    for (std::size_t s = 0; s < k; ++s) {
-      double a = uni(rng), b = uni(rng);
-      if (a + b > 1.0) {
-        a = 1.0 - a;
-        b = 1.0 - b;
-      }
-      out.push_back(c[0] + a * (c[1] - c[0]) + b * (c[2] - c[0]));
-    }
-  }
-  return out;
-}
-
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 /// One edge of a mesh (a < b) and the third corners of the triangles that share it.
 struct MeshEdge {
@@ -181,6 +131,66 @@ std::vector<MeshEdge> unique_edges(const Mesh& mesh) {
     ++e.triangles;
   }
   return edges;
+}
+
+/// dense_surface_samples() with the mesh's unique edges given (when fixed_points): each
+/// edge's midpoint is taken once, not once per triangle that shares it (a closed mesh's
+/// edges are shared by two: 1.5 points per triangle fewer, the same set of points).
+std::vector<Vec3> dense_surface_samples(const Mesh& mesh, const std::vector<MeshEdge>& edges, double spacing,
+                                        double density, std::size_t max_samples, std::uint64_t seed,
+                                        bool fixed_points) {
+  std::vector<Vec3> out;
+  const std::size_t nt = mesh.triangles.size();
+  if (fixed_points) {
+    std::vector<char> used(mesh.vertices.size(), 0);
+    for (const auto& f : mesh.triangles)
+      for (auto i : f) used[i] = 1;
+    for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
+      if (used[i]) out.push_back(mesh.vertices[i]);
+    for (const MeshEdge& e : edges) out.push_back((mesh.vertices[e.a] + mesh.vertices[e.b]) / 2.0);
+  }
+  // Random points: ≥ 2 per triangle, ≈ density per spacing² of area, capped.
+  const double cell = spacing > 0.0 ? spacing * spacing : 1.0;
+  std::vector<std::size_t> count(nt);
+  std::size_t total = 0;
+  for (std::size_t t = 0; t < nt; ++t) {
+    const auto c = mesh.corners(t);
+    const double area = 0.5 * (c[1] - c[0]).cross(c[2] - c[0]).norm();
+    count[t] = 2 + static_cast<std::size_t>(std::min(1e6, density * area / cell));
+    total += count[t];
+  }
+  const double scale = total > max_samples && total > 0 ? static_cast<double>(max_samples) / total : 1.0;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  for (std::size_t t = 0; t < nt; ++t) {
+    const auto c = mesh.corners(t);
+    if (fixed_points) out.push_back((c[0] + c[1] + c[2]) / 3.0);
+    const std::size_t k = std::max<std::size_t>(1, static_cast<std::size_t>(count[t] * scale));
+    for (std::size_t s = 0; s < k; ++s) {
+      double a = uni(rng), b = uni(rng);
+      if (a + b > 1.0) {
+        a = 1.0 - a;
+        b = 1.0 - b;
+      }
+      out.push_back(c[0] + a * (c[1] - c[0]) + b * (c[2] - c[0]));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<Vec3> dense_surface_samples(const Mesh& mesh, double spacing, double density,
+                                        std::size_t max_samples, std::uint64_t seed, bool fixed_points) {
+  return dense_surface_samples(mesh, fixed_points ? unique_edges(mesh) : std::vector<MeshEdge>(), spacing, density,
+                               max_samples, seed, fixed_points);
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
 /// True if the projected edge pa–pb lies inside the projection of its two triangles:
@@ -762,8 +772,8 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
   // nearly coincident silhouettes of a faceted cylinder. Containment is verified below on
   // an independent set (another seed).
   const std::vector<Vec3> cover_samples =
-      opt.cover_samples ? dense_surface_samples(part.mesh, r.l_max, opt.containment_density,
-                                                opt.containment_max_samples, opt.seed + 2)
+      opt.cover_samples ? dense_surface_samples(part.mesh, edges, r.l_max, opt.containment_density,
+                                                opt.containment_max_samples, opt.seed + 2, true)
                         : std::vector<Vec3>();
 
   // 1–2. Sample each projection (L_max), 3. build its α-shape (planes in parallel).
@@ -851,7 +861,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
     // Random points only: the fixed ones (vertices, edge midpoints, centroids) are among
     // the cover samples, which every repair keeps covered (without cover samples they are
     // tested here too).
-    samples = dense_surface_samples(part.mesh, r.l_max, opt.containment_density, opt.containment_max_samples,
+    samples = dense_surface_samples(part.mesh, edges, r.l_max, opt.containment_density, opt.containment_max_samples,
                                     opt.seed + 3 * static_cast<std::uint64_t>(round), !opt.cover_samples);
     std::vector<std::vector<Vec2>> missed;
     const auto miss = plane_misses(missed);
@@ -1004,8 +1014,8 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
   if (opt.measure) {
     // Containment of the original surface in the output mesh (what indices will use), on
     // a whole dense set (fixed and random points) of a seed no verification round used.
-    samples = dense_surface_samples(part.mesh, r.l_max, opt.containment_density, opt.containment_max_samples,
-                                    opt.seed + 3 * static_cast<std::uint64_t>(kRefineRounds + 1));
+    samples = dense_surface_samples(part.mesh, edges, r.l_max, opt.containment_density, opt.containment_max_samples,
+                                    opt.seed + 3 * static_cast<std::uint64_t>(kRefineRounds + 1), true);
     r.containment_samples = samples.size();
     const EmbreeIndex simplified = mesh_index(out.mesh, true);
     const std::size_t in = count_contained_mesh(simplified, samples, tol);

@@ -12,10 +12,12 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <random>
 #include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 using namespace loom;
 
@@ -933,6 +935,33 @@ TEST(AlphaSim, FacetedCylinderAcrossTheAxesIsNotEroded) {
   EXPECT_GE(sp.result.volume_after, sp.result.volume_before * (1 - 1e-6));
   const auto samples = dense_surface_samples(c.mesh, 4.0, 1.0, 20000, 9);
   EXPECT_DOUBLE_EQ(oracle_containment(sp.mesh, samples, sp.result.tolerance), 1.0);
+}
+
+TEST(AlphaSim, DenseSamplesTakeEachFixedPointOnce) {
+  // A closed box: 8 vertices, 18 edges (12 + 6 diagonals), 12 triangles. Without random
+  // points (fixed_points only, the cap leaves one per triangle) the fixed points are every
+  // vertex, every edge midpoint and every centroid, each exactly once: a shared edge's
+  // midpoint is not taken once per triangle.
+  const Mesh m = box_mesh({0, 0, 0}, {2, 4, 8});
+  const auto with = dense_surface_samples(m, 1.0, 0.0, 0, 11, true);
+  const auto without = dense_surface_samples(m, 1.0, 0.0, 0, 11, false);
+  ASSERT_EQ(without.size(), m.triangles.size());  // one random point per triangle
+  ASSERT_EQ(with.size(), 8 + 18 + 12 + without.size());
+  auto key = [](const Vec3& v) { return std::make_tuple(v.x(), v.y(), v.z()); };
+  std::map<std::tuple<double, double, double>, int> taken;  // how often each point was taken
+  for (const Vec3& v : with) ++taken[key(v)];
+  std::set<std::tuple<double, double, double>> expected;  // vertices, edge midpoints, centroids
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    const auto c = m.corners(t);
+    for (int k = 0; k < 3; ++k) {
+      expected.insert(key(c[k]));
+      expected.insert(key((c[k] + c[(k + 1) % 3]) / 2.0));
+    }
+    expected.insert(key((c[0] + c[1] + c[2]) / 3.0));
+  }
+  ASSERT_EQ(expected.size(), 8u + 18u + 12u);
+  for (const auto& e : expected)
+    EXPECT_EQ(taken[e], 1) << "point (" << std::get<0>(e) << ", " << std::get<1>(e) << ", " << std::get<2>(e) << ")";
 }
 
 TEST(AlphaSim, VerificationRoundsRepairWhatTheFirstRepairMissed) {
