@@ -212,7 +212,7 @@ struct AlphaSimPlaneSamples {
 AlphaSimPlaneSamples alpha_sim_plane_samples(const Mesh& mesh, const AlphaSimPrism& frame, double l_max, double snap,
                                              bool lattice_bitmap = true);
 
-/// Dense samples of a mesh surface: vertices, edge midpoints, centroids (the fixed points,
+/// Dense samples of a mesh surface: vertices and edge midpoints (each once), centroids (the fixed points,
 /// unless fixed_points is false) and random points (≈ density per spacing² of area, at
 /// least two per triangle), capped at max_samples random ones; deterministic for a seed.
 /// World frame.
