@@ -3,7 +3,6 @@
 #include "core/error.hpp"
 #include "index/embree_index.hpp"
 
-
 #include <BRepAlgoAPI_Common.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakePolygon.hxx>

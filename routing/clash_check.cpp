@@ -613,7 +613,7 @@ class StructureTracer {
     // Candidate parts for the secondary check: boxes within the band of this stretch.
     AABB box;
     for (const Vec3& p : ch.p) box.extend(p);
-    ctx_.part_tree->overlapping(box.inflated(thr_ + 1e-9), cand_);
+    ctx_.part_tree->overlapping(box.inflated(thr_ + cut_margin_), cand_);  // + rounding margin
     const double touch = std::max(4.0 * ctx_.abs_err, ctx_.chord_error);
     std::vector<PartObservation> obs;
     for (std::size_t k = 0; k < ch.size(); ++k) {

@@ -453,6 +453,12 @@ TEST(AlphaShape2D, GrowSimplifyOnlyGrowsTheRegion) {
   }
   EXPECT_EQ(total + removed, 4u * 40 + 200u + 4u);
   expect_grown_within(before, after, max_dev, 26.0, 17);
+  // Notch moves here also keep every old vertex within max_dev of the new boundary. Not a
+  // contract of grow_simplify in general: a notch's deviation is its depth below the
+  // chord's line, so an old vertex beyond a chord's end can lie farther from the chord
+  // (the random star rings of the property test find such cases); the growth is bounded.
+  for (const auto& r : before)
+    for (const auto& v : r) EXPECT_LT(distance_to_rings(v, after), max_dev) << v.transpose();
   // A convex ring cannot grow by removing vertices: unchanged.
   std::vector<PolygonWithHoles2> disc(1);
   disc[0].outer = disc_ring(5.0, 48);
