@@ -239,7 +239,7 @@ void gnuplot(const std::string& script) {
 class SplitIndex : public ObstacleIndex {
  public:
   /// The methods timed, in report order.
-  enum Kind { kClosest, kClosestApprox, kSegmentClosest, kClosestOnPart, kInside, kOther, kKinds };
+  enum Kind { kClosest, kClosestApprox, kSegmentClosest, kSegmentApprox, kSegmentOnPart, kClosestOnPart, kInside, kOther, kKinds };
   explicit SplitIndex(const ObstacleIndex& inner) : inner_(inner) {}
   std::string name() const override { return inner_.name(); }
   IndexAccuracy accuracy() const override { return inner_.accuracy(); }
@@ -269,9 +269,16 @@ class SplitIndex : public ObstacleIndex {
   ClosestHit segment_closest(const Vec3& a, const Vec3& b, double r, double* t) const override {
     return timed(kSegmentClosest, [&] { return inner_.segment_closest(a, b, r, t); });
   }
+  ClosestHit segment_closest_approx(const Vec3& a, const Vec3& b, double r, double e, double* t) const override {
+    return timed(kSegmentApprox, [&] { return inner_.segment_closest_approx(a, b, r, e, t); });
+  }
+  ClosestHit segment_closest_on_part(const Vec3& a, const Vec3& b, int part, double r, double* t) const override {
+    return timed(kSegmentOnPart, [&] { return inner_.segment_closest_on_part(a, b, part, r, t); });
+  }
   /// Prints calls and CPU ms per method.
   void print() const {
-    const char* names[kKinds] = {"closest", "closest_approx", "segment_closest", "closest_on_part", "inside", "other"};
+    const char* names[kKinds] = {"closest", "closest_approx", "segment_closest", "segment_approx", "segment_on_part",
+                                 "closest_on_part", "inside", "other"};
     for (int k = 0; k < kKinds; ++k)
       if (calls_[k] > 0)
         std::printf("  %-16s %7lld calls %8.1f cpu ms %6.2f us/call\n", names[k], calls_[k], ms_[k],

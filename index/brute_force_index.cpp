@@ -160,10 +160,22 @@ bool BruteForceIndex::segment_within(const Vec3& a, const Vec3& b, double r) con
 
 ClosestHit BruteForceIndex::segment_closest(const Vec3& a, const Vec3& b, double max_radius,
                                             double* segment_param) const {
+  return segment_scan(a, b, -1, max_radius, segment_param);
+}
+
+ClosestHit BruteForceIndex::segment_closest_on_part(const Vec3& a, const Vec3& b, int part, double max_radius,
+                                                    double* segment_param) const {
+  check_part(part, parts_.size());
+  return segment_scan(a, b, part, max_radius, segment_param);
+}
+
+ClosestHit BruteForceIndex::segment_scan(const Vec3& a, const Vec3& b, int only_part, double max_radius,
+                                         double* segment_param) const {
   ClosestHit best;
   double best2 = max_radius * max_radius;
   double best_s = 0.0;
-  for (int i = 0; i < part_count(); ++i) {
+  const int first = only_part >= 0 ? only_part : 0, last = only_part >= 0 ? only_part + 1 : part_count();
+  for (int i = first; i < last; ++i) {
     const PartTriangles& pt = parts_[i];
     for (std::size_t t = 0; t < pt.triangles.size(); ++t) {
       const auto& c = pt.triangles[t];

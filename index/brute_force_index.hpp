@@ -45,6 +45,8 @@ class BruteForceIndex : public ObstacleIndex {
              double t_max = std::numeric_limits<double>::infinity()) const override;
   bool any_within(const Vec3& p, double r) const override;
   bool segment_within(const Vec3& a, const Vec3& b, double r) const override;
+  ClosestHit segment_closest_on_part(const Vec3& a, const Vec3& b, int part, double max_radius,
+                                     double* segment_param = nullptr) const override;
   ClosestHit segment_closest(const Vec3& a, const Vec3& b,
                              double max_radius = std::numeric_limits<double>::infinity(),
                              double* segment_param = nullptr) const override;
@@ -54,6 +56,8 @@ class BruteForceIndex : public ObstacleIndex {
 
  private:
   void scan_part(int part, const Vec3& p, ClosestHit& best) const;
+  /// segment_closest() over every part (only_part < 0) or one part.
+  ClosestHit segment_scan(const Vec3& a, const Vec3& b, int only_part, double max_radius, double* segment_param) const;
   std::vector<PartTriangles> parts_;
 };
 

@@ -125,7 +125,11 @@ bool point_query_callback(RTCPointQueryFunctionArguments* args) {
   const auto c = pd.corners(args->primID);
   // Cheap rejection first: the triangle's box is farther than what we already have (or
   // than the any-within threshold). Both are lower bounds, so results stay exact.
-  const double limit2 = q->mode == Mode::Closest || q->mode == Mode::Segment ? q->best2 : q->r2;
+  double limit2 = q->mode == Mode::Closest || q->mode == Mode::Segment ? q->best2 : q->r2;
+  // An approximate segment query skips what cannot beat best / (1 + rel_error) once it has
+  // a best (before, best2 is the caller's radius, whose answer must stay exact). Points
+  // need no such test: Embree's sphere already has that radius.
+  if (q->mode == Mode::Segment && q->hit.part >= 0) limit2 *= q->shrink * q->shrink;
   const Vec3 lo = c[0].cwiseMin(c[1]).cwiseMin(c[2]), hi = c[0].cwiseMax(c[1]).cwiseMax(c[2]);
   double d2;
   Vec3 point;
@@ -155,7 +159,9 @@ bool point_query_callback(RTCPointQueryFunctionArguments* args) {
     }
     return false;
   }
-  if (d2 < q->best2 || (d2 == q->best2 && (part < q->hit.part || (part == q->hit.part &&
+  // Equal to the caller's radius with nothing found yet counts as found (a radius of 0
+  // leaves no slack: a segment through a surface is at distance 0 ≤ 0).
+  if (d2 < q->best2 || (d2 == q->best2 && (q->hit.part < 0 || part < q->hit.part || (part == q->hit.part &&
                                                                    static_cast<std::int64_t>(args->primID) < q->hit.triangle)))) {
     q->best2 = d2;
     q->best_s = s;
@@ -519,6 +525,24 @@ bool EmbreeIndex::segment_within(const Vec3& a, const Vec3& b, double r) const {
 
 ClosestHit EmbreeIndex::segment_closest(const Vec3& a, const Vec3& b, double max_radius,
                                         double* segment_param) const {
+  return segment_closest_in(a, b, -1, max_radius, segment_param, 1.0);
+}
+
+ClosestHit EmbreeIndex::segment_closest_approx(const Vec3& a, const Vec3& b, double max_radius, double rel_error,
+                                               double* segment_param) const {
+  if (!(rel_error >= 0.0) || !std::isfinite(rel_error))
+    throw std::invalid_argument("embree index: rel_error must be finite and >= 0, got " + full_precision(rel_error));
+  return segment_closest_in(a, b, -1, max_radius, segment_param, 1.0 / (1.0 + rel_error));
+}
+
+ClosestHit EmbreeIndex::segment_closest_on_part(const Vec3& a, const Vec3& b, int part, double max_radius,
+                                                double* segment_param) const {
+  check_part_id(part, parts_.size());
+  return segment_closest_in(a, b, part, max_radius, segment_param, 1.0);
+}
+
+ClosestHit EmbreeIndex::segment_closest_in(const Vec3& a, const Vec3& b, int filter_part, double max_radius,
+                                           double* segment_param, double shrink) const {
   if (triangle_count_ == 0 || !(max_radius >= 0.0)) return {};
   FlushDenormals ftz;
   const double len = (b - a).norm();
@@ -527,6 +551,8 @@ ClosestHit EmbreeIndex::segment_closest(const Vec3& a, const Vec3& b, double max
   QueryState q;
   q.parts = &parts_;
   q.mode = Mode::Segment;
+  q.filter_part = filter_part;
+  q.shrink = shrink;
   q.best2 = std::isfinite(max_radius) ? max_radius * max_radius * (1.0 + 1e-15) : q.best2;
   // Pieces in order: the shrinking radius carries over from one to the next.
   for (int k = 0; k < n; ++k) {
@@ -537,7 +563,10 @@ ClosestHit EmbreeIndex::segment_closest(const Vec3& a, const Vec3& b, double max
     const Vec3 mid = 0.5 * (q.a + q.b);
     const double half = 0.5 * (q.b - q.a).norm();
     q.radius_offset = half;
-    const double cur = std::isfinite(q.best2) ? std::sqrt(q.best2) : std::numeric_limits<double>::infinity();
+    // Shrunk only once something was found: until then best2 is the caller's radius, and a
+    // "nothing within max_radius" answer must stay exact.
+    const double cur = !std::isfinite(q.best2) ? std::numeric_limits<double>::infinity()
+                                                : std::sqrt(q.best2) * (q.hit.part >= 0 ? shrink : 1.0);
     q.pad = float_pad(mid, half + (std::isfinite(cur) ? cur : 0.0));
     run_point_query(impl_->scene, mid - centre_, half + cur + q.pad, q);
   }

@@ -63,6 +63,10 @@ class EmbreeIndex : public ObstacleIndex {
   ClosestHit segment_closest(const Vec3& a, const Vec3& b,
                              double max_radius = std::numeric_limits<double>::infinity(),
                              double* segment_param = nullptr) const override;
+  ClosestHit segment_closest_approx(const Vec3& a, const Vec3& b, double max_radius, double rel_error,
+                                    double* segment_param = nullptr) const override;
+  ClosestHit segment_closest_on_part(const Vec3& a, const Vec3& b, int part, double max_radius,
+                                     double* segment_param = nullptr) const override;
 
   /// The re-centring offset: Embree sees world − centre() (world frame, scene units).
   const Vec3& centre() const { return centre_; }
@@ -88,6 +92,10 @@ class EmbreeIndex : public ObstacleIndex {
   /// `shrink` = 1 / (1 + rel_error) scales the search radius at each hit (1: exact).
   ClosestHit closest_in(void* scene, int only_part, int filter_part, const Vec3& p, double max_radius,
                         double shrink = 1.0) const;
+  /// Closest point on the segment ab's nearest surface in the main scene (filter_part ≥ 0:
+  /// that part's triangles only), with the search radius shrinking to shrink·best.
+  ClosestHit segment_closest_in(const Vec3& a, const Vec3& b, int filter_part, double max_radius,
+                                double* segment_param, double shrink) const;
   /// Lazily built scene holding only one part (for closest_on_part).
   void* part_scene(int part) const;
 

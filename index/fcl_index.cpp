@@ -197,6 +197,17 @@ ClosestHit FclIndex::closest_on_part(const Vec3& p, int part, double max_radius)
   return h.found() && h.distance <= max_radius ? h : ClosestHit{};
 }
 
+ClosestHit FclIndex::segment_closest_on_part(const Vec3& a, const Vec3& b, int part, double max_radius,
+                                            double* segment_param) const {
+  if (part < 0 || part >= part_count()) throw std::out_of_range("fcl index: part id " + std::to_string(part) + " out of range");
+  if (impl_->parts[part].triangles.empty()) return {};
+  double s = 0.0;
+  const ClosestHit h = part_distance(a, b, part, &s);
+  if (!h.found() || !(h.distance <= max_radius)) return {};
+  if (segment_param) *segment_param = s;
+  return h;
+}
+
 ClosestHit FclIndex::capsule_on_part(const Vec3& a, const Vec3& b, double r, int part, double* segment_param) const {
   if (part < 0 || part >= part_count()) throw std::out_of_range("fcl index: part id " + std::to_string(part) + " out of range");
   if (impl_->parts[part].triangles.empty()) return {};

@@ -43,6 +43,8 @@ class FclIndex : public ObstacleIndex {
              double t_max = std::numeric_limits<double>::infinity()) const override;
   bool any_within(const Vec3& p, double r) const override;
   bool segment_within(const Vec3& a, const Vec3& b, double r) const override;
+  ClosestHit segment_closest_on_part(const Vec3& a, const Vec3& b, int part, double max_radius,
+                                     double* segment_param = nullptr) const override;
   ClosestHit segment_closest(const Vec3& a, const Vec3& b,
                              double max_radius = std::numeric_limits<double>::infinity(),
                              double* segment_param = nullptr) const override;

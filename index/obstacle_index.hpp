@@ -98,6 +98,19 @@ class ObstacleIndex {
                                      double max_radius = std::numeric_limits<double>::infinity(),
                                      double* segment_param = nullptr) const = 0;
 
+  /// (1 + rel_error)-approximate segment_closest(): a surface point within max_radius of ab
+  /// whose distance D from ab is at most (1 + rel_error)·d, d being the exact distance from
+  /// ab to the nearest surface; found() == false only if none lies within max_radius.
+  /// The default implementation answers exactly.
+  virtual ClosestHit segment_closest_approx(const Vec3& a, const Vec3& b, double max_radius, double rel_error,
+                                            double* segment_param = nullptr) const {
+    (void)rel_error;
+    return segment_closest(a, b, max_radius, segment_param);
+  }
+  /// segment_closest() against one given part only (found() == false if farther than
+  /// max_radius). Throws std::out_of_range for a bad part id.
+  virtual ClosestHit segment_closest_on_part(const Vec3& a, const Vec3& b, int part, double max_radius,
+                                             double* segment_param = nullptr) const = 0;
   /// Batch closest(): out[i] for points[i]; parallel over points (TBB), `threads` ≤ 0 = all.
   virtual std::vector<ClosestHit> closest_batch(const std::vector<Vec3>& points, double max_radius,
                                                 int threads = 0) const;

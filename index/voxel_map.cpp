@@ -479,6 +479,13 @@ ClosestHit VoxelMap::closest_on_part(const Vec3& p, int part, double max_radius)
   return closest(p, max_radius);  // a loaded map has a single pseudo-part
 }
 
+ClosestHit VoxelMap::segment_closest_on_part(const Vec3& a, const Vec3& b, int part, double max_radius,
+                                            double* segment_param) const {
+  if (part < 0 || part >= part_count_) throw std::out_of_range("voxel map: part id " + std::to_string(part) + " out of range");
+  if (exact_) return exact_->segment_closest_on_part(a, b, part, max_radius, segment_param);
+  return segment_closest(a, b, max_radius, segment_param);  // a loaded map has a single pseudo-part
+}
+
 bool VoxelMap::inside(const Vec3& p, int* part) const {
   const long c = cell_of(p);
   if (c < 0 || flags_[c] == 0) return false;

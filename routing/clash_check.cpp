@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <map>
@@ -21,6 +22,7 @@
 #include <mutex>
 #include <numeric>
 #include <stdexcept>
+#include <string>
 #include <unordered_map>
 
 namespace loom {
@@ -53,15 +55,22 @@ constexpr double kCutMarginRel = 1e-9;
 
 std::int64_t as_i64(std::size_t v) { return static_cast<std::int64_t>(v); }
 
+/// A point at full precision, for messages that must let a failure be replayed.
+std::string point_text(const Vec3& p) {
+  return "(" + full_precision(p.x()) + ", " + full_precision(p.y()) + ", " + full_precision(p.z()) + ")";
+}
+
 /// Work counters shared by the worker threads.
 struct AtomicCounters {
-  std::atomic<std::int64_t> distance{0}, inside{0}, pairs{0}, samples{0};
+  std::atomic<std::int64_t> distance{0}, inside{0}, pairs{0}, samples{0}, deferred{0}, deferred_measured{0};
   /// Adds a thread's local counts (one atomic add per counter, not one per query).
   void add(const ClashCounters& c) {
     distance += c.distance_queries;
     inside += c.inside_queries;
     pairs += c.pair_tests;
     samples += c.samples;
+    deferred += c.deferred_chords;
+    deferred_measured += c.deferred_measured;
   }
   ClashCounters snapshot() const {
     ClashCounters c;
@@ -69,6 +78,8 @@ struct AtomicCounters {
     c.inside_queries = inside.load();
     c.pair_tests = pairs.load();
     c.samples = samples.load();
+    c.deferred_chords = deferred.load();
+    c.deferred_measured = deferred_measured.load();
     return c;
   }
 };
@@ -96,14 +107,28 @@ struct PartInfo {
 // ---------------------------------------------------------------------------------------
 // Per-part stretch tracking: one entry per contiguous stretch within a part's band.
 
+/// A chord whose distance to one part is known only within bounds: measured exactly only if
+/// it can be the deepest point of its stretch (StretchTracker resolves it at the close).
+struct DeferredChord {
+  Vec3 a = Vec3::Zero(), b = Vec3::Zero();  ///< chord ends
+  double s0 = 0.0, s1 = 0.0;                ///< arc lengths at the ends
+};
+
 /// One observation of a part along the centerline.
 struct PartObservation {
   int part = -1;
   double key = kInf;  ///< clearance, and −r − depth when the axis is inside (ranking)
+  /// While `deferred`: key is the clearance at a surface point found (an upper bound) and
+  /// the exact key lies in [key_lower, key]. Unused otherwise.
+  double key_lower = kInf;
   Vec3 point = Vec3::Zero();
   double s = 0.0;
   bool inside = false;
+  std::optional<DeferredChord> deferred;
 };
+
+/// Replaces a deferred observation's bounds by the exact key, point and arc length.
+using ObservationResolver = std::function<void(PartObservation&)>;
 
 /// True if the cable is attached to `part` at arc length s (see PartAttachment).
 bool is_attached(const std::vector<PartAttachment>& attachments, int part, double s) {
@@ -114,12 +139,16 @@ bool is_attached(const std::vector<PartAttachment>& attachments, int part, doubl
 /// Collects observations in s order. A part's band stretch (clearance < required) ends
 /// when a step no longer sees it; inside it, each contiguous contact stretch (clearance < 0)
 /// becomes one clash at its deepest point, and a band stretch without contact becomes one
-/// clearance violation at its smallest clearance.
+/// clearance violation at its smallest clearance. A deferred observation's bounds must
+/// already decide the band and contact (its key and key_lower on one side of required and
+/// of 0); when its stretch closes it is resolved (measured exactly) only if its lower bound
+/// reaches the stretch's smallest upper bound — only then can it be the deepest.
 class StretchTracker {
  public:
+  /// `resolve` measures deferred observations (may be empty if none are ever stepped).
   StretchTracker(int cable, double radius, const std::vector<PartInfo>& parts,
-                 const std::vector<PartAttachment>& attachments)
-      : cable_(cable), radius_(radius), parts_(parts), attachments_(attachments) {}
+                 const std::vector<PartAttachment>& attachments, ObservationResolver resolve = {})
+      : cable_(cable), radius_(radius), parts_(parts), attachments_(attachments), resolve_(std::move(resolve)) {}
 
   /// One step along the cable (a chord, a sample or a free interval) seeing `obs` (parts
   /// within their band), spanning arc lengths [s0, s1]. Observations of a part the cable
@@ -144,25 +173,31 @@ class StretchTracker {
     }
     for (const auto& o : obs) {
       Open& st = open_[o.part];
-      min_key = std::min(min_key, o.key);
-      if (o.key < st.band.deepest.key) st.band.deepest = o;
+      st.band.take(o);
       if (!st.started) {
         st.started = true;
         st.band.s_begin = s0;
       }
       st.band.s_end = s1;
+      int contact = -1;
       if (o.key < 0.0) {
         if (!st.contact_open) {
-          st.contacts.push_back({o, s0, s1});
+          st.contacts.emplace_back();
+          st.contacts.back().s_begin = s0;
           st.contact_open = true;
-        } else {
-          Stretch& c = st.contacts.back();
-          if (o.key < c.deepest.key) c.deepest = o;
-          c.s_end = s1;
         }
+        Stretch& c = st.contacts.back();
+        c.take(o);
+        c.s_end = s1;
+        contact = static_cast<int>(st.contacts.size()) - 1;
       } else {
         st.contact_open = false;
       }
+      // A deferred observation may turn out the deepest of its band or contact stretch
+      // only if its lower bound reaches that stretch's smallest upper bound so far.
+      if (o.deferred && (o.key_lower <= st.band.deepest.key ||
+                         (contact >= 0 && o.key_lower <= st.contacts[static_cast<std::size_t>(contact)].deepest.key)))
+        st.candidates.push_back({o, contact});
     }
   }
   /// Closes every open stretch (end of the cable or of a proven-clear gap).
@@ -172,20 +207,57 @@ class StretchTracker {
   }
   std::vector<ClashEntry> clashes;
   std::vector<Violation> violations;
-  double min_key = kInf;  ///< smallest key seen in any band
+  double min_key = kInf;  ///< smallest key seen in any band (exact: deferred ones resolved)
 
  private:
   struct Stretch {
-    PartObservation deepest;
+    PartObservation deepest;  ///< smallest key: an upper bound while it is deferred
+    PartObservation exact;    ///< smallest key among the observations measured exactly
     double s_begin = 0.0, s_end = 0.0;
+    void take(const PartObservation& o) {
+      if (o.key < deepest.key) deepest = o;
+      if (!o.deferred && o.key < exact.key) exact = o;
+    }
+    /// After settle(): a measured observation that may be deeper than `exact`; among
+    /// equal keys the one first along the cable, as when all are measured in order.
+    void fold(const PartObservation& o) {
+      if (o.key < exact.key || (o.key == exact.key && o.s < exact.s)) exact = o;
+    }
+  };
+  struct Candidate {
+    PartObservation obs;
+    int contact = -1;  ///< index into Open::contacts, −1 outside a contact stretch
   };
   struct Open {
     bool started = false;
     Stretch band;
     std::vector<Stretch> contacts;
     bool contact_open = false;
+    std::vector<Candidate> candidates;  ///< deferred observations that may be a deepest
   };
-  void close(const Open& st) {
+  /// Measures the deferred observations that can still be the deepest of their band or
+  /// contact stretch and takes the deepest again. An observation left unmeasured has a
+  /// lower bound above a measured key, so the deepest (and its first occurrence among
+  /// equal keys) is the one exact keys everywhere would give.
+  void settle(Open& st) {
+    std::vector<double> contact_upper;
+    for (const Stretch& c : st.contacts) contact_upper.push_back(c.deepest.key);
+    for (Candidate& c : st.candidates) {
+      const std::size_t k = static_cast<std::size_t>(c.contact);
+      if (c.obs.key_lower > st.band.deepest.key && (c.contact < 0 || c.obs.key_lower > contact_upper[k])) continue;
+      if (!resolve_) throw std::logic_error("clash check: a deferred observation without a resolver");
+      resolve_(c.obs);
+      st.band.fold(c.obs);
+      if (c.contact >= 0) st.contacts[k].fold(c.obs);
+    }
+    // Every observation not measured has a lower bound above a measured key (the smallest
+    // upper bound's own observation was measured), so the exact deepest is the deepest.
+    st.band.deepest = st.band.exact;
+    for (Stretch& c : st.contacts) c.deepest = c.exact;
+  }
+  void close(Open& st) {
+    settle(st);
+    min_key = std::min(min_key, st.band.deepest.key);
     for (const Stretch& c : st.contacts) {
       const PartObservation& d = c.deepest;
       ClashEntry e;
@@ -219,6 +291,7 @@ class StretchTracker {
   double radius_;
   const std::vector<PartInfo>& parts_;
   const std::vector<PartAttachment>& attachments_;
+  ObservationResolver resolve_;
   std::vector<PartObservation> kept_;  ///< observations of one step minus attached parts
   std::map<int, Open> open_;
 };
@@ -324,7 +397,11 @@ bool excused(const CableInput& a, double s, const Vec3& p, const CableInput& b, 
 class StructureTracer {
  public:
   StructureTracer(Context& ctx, int cable)
-      : ctx_(ctx), cable_(cable), in_(ctx.cables[cable]), r_(in_.radius), tracker_(cable, r_, ctx.info, in_.attachments) {
+      : ctx_(ctx),
+        cable_(cable),
+        in_(ctx.cables[cable]),
+        r_(in_.radius),
+        tracker_(cable, r_, ctx.info, in_.attachments, [this](PartObservation& o) { measure_deferred(o); }) {
     L_ = in_.curve.length();
     margin_ = ctx.chord_error + ctx.abs_err;
     thr_ = r_ + ctx.band + margin_;
@@ -621,8 +698,8 @@ class StructureTracer {
       const Vec3& b = ch.p[k + 1];
       obs.clear();
       double t = 0.0;
-      ++count_.distance_queries;
-      const ClosestHit h = ctx_.index->segment_closest(a, b, thr_, &t);
+      double lower = 0.0;  // lower bound on the distance from the chord to every part
+      const ClosestHit h = chord_query(a, b, touch, &t, &lower);
       const double sk = ch.s[k] + t * (ch.s[k + 1] - ch.s[k]);
       int primary = -1;
       if (h.found() && h.distance <= touch) {
@@ -636,9 +713,16 @@ class StructureTracer {
         PartObservation o;
         o.part = h.part;
         o.key = h.distance - r_;
+        o.key_lower = lower - r_;
         o.point = a + t * (b - a);
         o.s = sk;
-        if (o.key < ctx_.info[h.part].required) obs.push_back(o);
+        if (o.key < ctx_.info[h.part].required) {
+          if (o.key_lower < o.key) {
+            o.deferred = DeferredChord{a, b, ch.s[k], ch.s[k + 1]};
+            ++count_.deferred_chords;
+          }
+          obs.push_back(o);
+        }
       }
       if (inside_part_ >= 0) {
         // Axis inside a closed part: dist = 0; rank by depth at the chord's end.
@@ -671,40 +755,64 @@ class StructureTracer {
     }
   }
 
-  /// A part other than the nearest: Lipschitz bisection of the chord with closest_on_part
-  /// down to pieces of 2·chord_error (their midpoint distance is then within chord_error).
+  /// The nearest surface to chord ab within thr_, with its parameter on ab in *t and a lower
+  /// bound on the chord's distance to every part in *lower. With approximate queries the
+  /// answer is (1 + ε)-approximate (*lower = D / (1 + ε)) when that interval decides what
+  /// the chord decides — touching (≤ touch), within the hit part's band, in contact — and
+  /// exact otherwise; the tracker measures it exactly later only if it can be the deepest.
+  ClosestHit chord_query(const Vec3& a, const Vec3& b, double touch, double* t, double* lower) {
+    const ObstacleIndex& idx = *ctx_.index;
+    ++count_.distance_queries;
+    if (rel_error_ > 0.0) {
+      const ClosestHit h = idx.segment_closest_approx(a, b, thr_, rel_error_, t);
+      if (!h.found()) return h;  // exact: nothing within thr_
+      const double lo = h.distance / (1.0 + rel_error_);
+      const double band = r_ + ctx_.info[h.part].required;
+      const bool decided = (lo <= touch) == (h.distance <= touch) && (lo < band) == (h.distance < band) &&
+                           (lo < r_) == (h.distance < r_);
+      if (decided) {
+        *lower = lo;
+        return h;
+      }
+      ++count_.distance_queries;
+    }
+    const ClosestHit h = idx.segment_closest(a, b, thr_, t);
+    *lower = h.distance;
+    return h;
+  }
+
+  /// Resolves a deferred chord observation: the chord's exact distance to that part.
+  void measure_deferred(PartObservation& o) {
+    const DeferredChord& c = *o.deferred;
+    double t = 0.0;
+    ++count_.distance_queries;
+    ++count_.deferred_measured;
+    const ClosestHit h = ctx_.index->segment_closest_on_part(c.a, c.b, o.part, thr_, &t);
+    // A point of the part lies within key + r ≤ thr_ of the chord: the query finds it.
+    if (!h.found())
+      throw std::logic_error("clash check: deferred chord " + point_text(c.a) + " - " + point_text(c.b) +
+                             " lost part " + std::to_string(o.part) + " within " + full_precision(thr_));
+    o.key = h.distance - r_;
+    o.key_lower = o.key;
+    o.point = c.a + t * (c.b - c.a);
+    o.s = c.s0 + t * (c.s1 - c.s0);
+    o.deferred.reset();
+  }
+
+  /// A part other than the nearest (or than the one an approximate query found): the
+  /// chord's exact distance to that part alone, an observation if within its band.
   void secondary(const Vec3& a, const Vec3& b, double sa, double sb, int q, std::vector<PartObservation>& obs) {
     const double thr_q = r_ + ctx_.info[q].required + margin_;
-    PartObservation best;
-    best.part = q;
-    struct Piece {
-      Vec3 a, b;
-      double sa, sb;
-    };
-    std::vector<Piece> stack{{a, b, sa, sb}};
-    while (!stack.empty()) {
-      Piece pc = stack.back();
-      stack.pop_back();
-      const double h = (pc.b - pc.a).norm();
-      const Vec3 m = 0.5 * (pc.a + pc.b);
-      ++count_.distance_queries;
-      const ClosestHit hm = ctx_.index->closest_on_part(m, q, thr_q + 0.5 * h);
-      if (!hm.found()) continue;
-      if (hm.distance - 0.5 * h >= thr_q) continue;
-      if (h <= 2.0 * ctx_.chord_error) {
-        const double key = hm.distance - r_;
-        if (key < best.key) {
-          best.key = key;
-          best.point = m;
-          best.s = 0.5 * (pc.sa + pc.sb);
-        }
-        continue;
-      }
-      const double sm = 0.5 * (pc.sa + pc.sb);
-      stack.push_back({m, pc.b, sm, pc.sb});
-      stack.push_back({pc.a, m, pc.sa, sm});
-    }
-    if (best.key < ctx_.info[q].required) obs.push_back(best);
+    double t = 0.0;
+    ++count_.distance_queries;
+    const ClosestHit h = ctx_.index->segment_closest_on_part(a, b, q, thr_q, &t);
+    if (!h.found()) return;
+    PartObservation o;
+    o.part = q;
+    o.key = h.distance - r_;
+    o.point = a + t * (b - a);
+    o.s = sa + t * (sb - sa);
+    if (o.key < ctx_.info[q].required) obs.push_back(o);
   }
 
   Context& ctx_;

@@ -181,6 +181,11 @@ struct ClashCounters {
   std::int64_t inside_queries = 0;    ///< point-in-part tests
   std::int64_t pair_tests = 0;        ///< exact segment–segment (or sample–sample) distances
   std::int64_t samples = 0;           ///< centerline points evaluated
+  /// Certified, approximate queries: chords whose distance was first known within (1 + ε)
+  /// only, and how many of them were then measured exactly (the rest could not be the
+  /// deepest point of their stretch). Not in report.json.
+  std::int64_t deferred_chords = 0;
+  std::int64_t deferred_measured = 0;
 };
 
 /// The outcome of check_clashes().

@@ -385,6 +385,61 @@ TEST(EmbreeIndex, ApproximateClosestIsWithinItsFactorOfBruteForce) {
   EXPECT_EQ(bh.distance, b.closest(pts[0]).distance);
 }
 
+TEST(EmbreeIndex, ApproximateSegmentClosestIsWithinItsFactorOfBruteForce) {
+  // segment_closest_approx against brute force: a surface point whose distance D from the
+  // segment satisfies d ≤ D ≤ (1 + ε)·d, a miss only when nothing lies within the radius
+  // (also for radii just above d, where shrinking the search before any hit would lose it);
+  // segment_closest_on_part: the exact distance to that part alone.
+  MixedSceneDetail detail;
+  detail.sphere_nu = 256;
+  detail.sphere_nv = 128;
+  const auto parts = mixed_scene(Vec3(-3, 2, 1), detail);
+  const EmbreeIndex e(parts);
+  const BruteForceIndex b(parts);
+  std::mt19937_64 rng(78);
+  const AABB box = bounds_of(parts);
+  const auto starts = random_points(rng, box, 10, 150);
+  std::uniform_real_distribution<double> u(-4.0, 4.0);
+  const double err = e.accuracy().abs_error;
+  int approximate = 0;
+  for (const Vec3& a : starts) {
+    const Vec3 c = a + Vec3(u(rng), u(rng), u(rng));
+    const ClosestHit exact = b.segment_closest(a, c);
+    ASSERT_TRUE(exact.found());
+    const std::string where = full_precision(a.x()) + " " + full_precision(a.y()) + " " + full_precision(a.z()) + " - " +
+                              full_precision(c.x()) + " " + full_precision(c.y()) + " " + full_precision(c.z());
+    for (double eps : {0.0, 0.25, 1.0}) {
+      for (double radius : {std::numeric_limits<double>::infinity(), 1.05 * exact.distance + 1e-6, 0.8 * exact.distance}) {
+        double t = -1.0;
+        const ClosestHit h = e.segment_closest_approx(a, c, radius, eps, &t);
+        ASSERT_EQ(h.found(), exact.distance <= radius) << where << " eps " << eps << " radius " << radius;
+        if (!h.found()) continue;
+        EXPECT_GE(h.distance, exact.distance - err) << where;
+        EXPECT_LE(h.distance, (1.0 + eps) * exact.distance + err) << where;
+        ASSERT_GE(t, 0.0);
+        ASSERT_LE(t, 1.0);
+        EXPECT_NEAR((h.point - (a + t * (c - a))).norm(), h.distance, 1e-9 * std::max(1.0, h.distance)) << where;
+        if (eps == 0.0) EXPECT_EQ(h.distance, e.segment_closest(a, c, radius).distance);
+        approximate += eps > 0.0 && h.distance > exact.distance + err ? 1 : 0;
+      }
+    }
+    for (int q = 0; q < static_cast<int>(parts.size()); ++q) {
+      const ClosestHit bq = b.segment_closest_on_part(a, c, q, std::numeric_limits<double>::infinity());
+      ASSERT_TRUE(bq.found());
+      const ClosestHit eq = e.segment_closest_on_part(a, c, q, 1.01 * bq.distance + 1e-6);
+      ASSERT_TRUE(eq.found()) << where << " part " << q;
+      EXPECT_EQ(eq.part, q);
+      EXPECT_NEAR(eq.distance, bq.distance, err) << where << " part " << q;
+      EXPECT_FALSE(e.segment_closest_on_part(a, c, q, 0.9 * bq.distance - err).found()) << where << " part " << q;
+    }
+  }
+  EXPECT_GT(approximate, 0);  // the approximation was used
+  EXPECT_THROW(e.segment_closest_approx(starts[0], starts[1], 1.0, -0.1), std::invalid_argument);
+  EXPECT_THROW(e.segment_closest_on_part(starts[0], starts[1], static_cast<int>(parts.size()), 1.0), std::out_of_range);
+  const EmbreeIndex empty(std::vector<Part>{});
+  EXPECT_FALSE(empty.segment_closest_approx(starts[0], starts[1], 10.0, 0.25).found());
+}
+
 TEST(EmbreeIndex, PartBoundsAreTheMeshBoxes) {
   const auto parts = mixed_scene(Vec3(7, -2, 5));
   const EmbreeIndex e(parts);

@@ -8,7 +8,9 @@
 #include <vector>
 
 #include "core/centerline.hpp"
+#include "core/part.hpp"
 #include "index/box_pairs.hpp"
+#include "index/embree_index.hpp"
 #include "routing/sweep.hpp"
 
 namespace {
@@ -59,6 +61,58 @@ TEST(Regression, BoxPairsTwoEqualPointBoxesDoNotAbortTheBuilder) {
     ASSERT_EQ(pairs.size(), 1u);
     EXPECT_EQ(pairs[0], loom::BoxPair(0, 1));
   }
+}
+
+/// The closed unit box [0, 1]³ as a part (12 triangles, outward).
+loom::Part unit_box_part() {
+  loom::Part p;
+  p.name = "unit_box";
+  p.closed = true;
+  for (int k = 0; k < 8; ++k) p.mesh.vertices.push_back(Vec3(k & 1, (k >> 1) & 1, (k >> 2) & 1));
+  const std::uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : q) {
+    p.mesh.triangles.push_back({f[0], f[1], f[2]});
+    p.mesh.triangles.push_back({f[0], f[2], f[3]});
+  }
+  return p;
+}
+
+// 2026-11-22, session 17: the new segment_closest_approx test (brute force oracle) found
+// that a segment through a surface was "not found" with max_radius 0: the search keeps a
+// hit only if it beats best² = radius², and 0 does not beat 0. A hit equal to the caller's
+// radius counts while nothing has been found (brute force already did so).
+TEST(Regression, EmbreeSegmentThroughASurfaceIsFoundWithRadiusZero) {
+  const loom::EmbreeIndex e({unit_box_part()});
+  const loom::ClosestHit h = e.segment_closest(Vec3(0.5, 0.5, -1.0), Vec3(0.5, 0.5, 2.0), 0.0);
+  ASSERT_TRUE(h.found());
+  EXPECT_EQ(h.distance, 0.0);
+  EXPECT_TRUE(e.segment_closest_on_part(Vec3(0.5, 0.5, -1.0), Vec3(0.5, 0.5, 2.0), 0, 0.0).found());
+}
+
+// 2026-11-22, session 17 (before it was committed): the first segment_closest_approx
+// shrank the search sphere to max_radius / (1 + ε) before any hit, so a surface between
+// the two was lost and "nothing within max_radius" came out wrong (the audit's approximate
+// run then ended a contact stretch early, ClashApproximate.InsideAHull…). A short segment
+// 1.0 above a plate of 8,192 triangles (enough for a BVH below the root: the callback's own
+// box test, unshrunk, would catch it in a root leaf), radius 1.1, ε = 1: the shrunk sphere
+// (0.05 + 0.55) missed the plate.
+TEST(Regression, EmbreeApproximateSegmentQueryKeepsTheCallersRadiusUntilAHit) {
+  loom::Part plate;
+  plate.name = "plate";
+  const int n = 64;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) plate.mesh.vertices.push_back(Vec3(double(i) / n, double(j) / n, 1.0));
+  const auto id = [&](int i, int j) { return static_cast<std::uint32_t>(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      plate.mesh.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      plate.mesh.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  const loom::EmbreeIndex e({plate});
+  const loom::ClosestHit h = e.segment_closest_approx(Vec3(0.5, 0.5, 2.0), Vec3(0.6, 0.5, 2.0), 1.1, 1.0);  // plate at z = 1
+  ASSERT_TRUE(h.found());
+  EXPECT_GE(h.distance, 1.0 - 1e-6);  // a surface point, within the radius
+  EXPECT_LE(h.distance, 1.1);
 }
 
 }  // namespace

@@ -725,13 +725,16 @@ TEST(ClashCutShort, RandomScenesGiveTheSameReport) {
 /// a stretch at constant depth may be another of its points; the smallest clearance of a
 /// cable beyond the band is an upper bound in both (any sampled surface point).
 std::string approximate_difference(const std::vector<CableInput>& cables, const std::vector<Part>& parts,
-                                   double clearance, double rel_error, bool* samples_moved = nullptr) {
+                                   double clearance, double rel_error, bool* samples_moved = nullptr,
+                                   ClashCounters* approximate_counters = nullptr) {
   const EmbreeIndex index(parts);
   ClashRequest req = exact_request(clearance);
   const ClashResult x = check_clashes(cables, parts, &index, req);
   req.distance_rel_error = rel_error;
   const ClashResult y = check_clashes(cables, parts, &index, req);
   if (samples_moved) *samples_moved = x.counters.samples != y.counters.samples;
+  if (approximate_counters) *approximate_counters = y.counters;
+  if (x.counters.deferred_chords != 0) return "the exact audit deferred chords";
   if (x.clashes.size() != y.clashes.size())
     return "clash count " + std::to_string(x.clashes.size()) + " vs " + std::to_string(y.clashes.size());
   for (std::size_t i = 0; i < x.clashes.size(); ++i) {
@@ -775,14 +778,23 @@ TEST(ClashApproximate, RandomScenesGiveTheExactFindings) {
   // The cut-short scenes again, plus finely tessellated spheres (where the approximation
   // saves the most leaves and its bounds are loosest).
   int moved_scenes = 0;
+  std::int64_t deferred = 0, measured = 0;
   for (std::uint32_t seed = 1; seed <= 20; ++seed) {
     const AuditScene sc = random_audit_scene(seed, 3);
     bool moved = false;
-    EXPECT_EQ(approximate_difference(sc.cables, sc.parts, seed % 2 == 0 ? 2.0 : 0.0, 0.25, &moved), "")
+    ClashCounters counters;
+    EXPECT_EQ(approximate_difference(sc.cables, sc.parts, seed % 2 == 0 ? 2.0 : 0.0, 0.25, &moved, &counters), "")
         << "seed " << seed;
     moved_scenes += moved ? 1 : 0;
+    deferred += counters.deferred_chords;
+    measured += counters.deferred_measured;
   }
   EXPECT_GE(moved_scenes, 10);  // the approximation did change the sampling: it was exercised
+  // Chords in band were deferred, and some of them were never measured exactly (they could
+  // not be the deepest of their stretch): the deferral was exercised both ways.
+  EXPECT_GT(deferred, 0);
+  EXPECT_GT(measured, 0);
+  EXPECT_LT(measured, deferred);
 }
 
 TEST(ClashApproximate, RejectsABadRelativeError) {
