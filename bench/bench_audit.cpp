@@ -369,8 +369,10 @@ int probe(int tris_per_part, int threads, int build_quality, double rel_error) {
   req.threads = 1;
   const double c2 = cpu_ms();
   const ClashResult rs = check_clashes(sc.cables, sc.parts, &split, req);
-  std::printf("split (1 thread, timer overhead included): audit cpu %.1f ms, digest %016llx\n", cpu_ms() - c2,
-              static_cast<unsigned long long>(result_digest(rs)));
+  std::printf("split (1 thread, timer overhead included): audit cpu %.1f ms, digest %016llx; %lld chords in band deferred, "
+              "%lld of them measured exactly\n",
+              cpu_ms() - c2, static_cast<unsigned long long>(result_digest(rs)),
+              static_cast<long long>(rs.counters.deferred_chords), static_cast<long long>(rs.counters.deferred_measured));
   split.print();
   return 0;
 }

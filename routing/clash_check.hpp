@@ -110,8 +110,11 @@ struct ClashRequest {
   /// Certified: relative error ε allowed in the sphere trace's free-space distance queries
   /// (ObstacleIndex::closest_approx). Those samples only need a lower bound on the distance,
   /// and D / (1 + ε) is one; it costs steps (1 + ε) shorter at most but spares the BVH
-  /// leaves around the nearest surface, whose number grows with the tessellation. Contact
-  /// decisions, reported distances and the smallest clearance stay exact to the tolerance;
+  /// leaves around the nearest surface, whose number grows with the tessellation. Chords
+  /// near contact take the same (1 + ε) distance first and are measured exactly only where
+  /// [D / (1 + ε), D] leaves a decision open or the chord can be the deepest point of its
+  /// stretch. Contact decisions, reported distances and the smallest clearance stay exact
+  /// to the tolerance;
   /// sample positions, and so the last digits of a report, depend on ε. 0 = exact queries
   /// (then cut_short_queries changes nothing in the report). Must be finite and ≥ 0.
   double distance_rel_error = 0.25;
@@ -197,7 +200,7 @@ struct ClashResult {
   double tolerance = 0.0;          ///< the certified accuracy used (discrete: 0 = not certified)
   std::string tolerance_source;    ///< "request" or the derivation rule
   double chord_error = 0.0;        ///< max distance between the measured chords and the curve
-  double distance_rel_error = 0.0; ///< certified: ε of the free-space queries (ClashRequest)
+  double distance_rel_error = 0.0; ///< certified: ε of the free-space and first chord queries (ClashRequest)
   double spacing = 0.0;            ///< discrete: sample spacing used (0 = per cable 2r)
   std::vector<std::string> notes;  ///< what the user should know (open parts, …)
 };
