@@ -450,6 +450,10 @@ class StructureTracer {
     ctx_.counters.add(count_);
   }
 
+  // The tracker's resolver holds `this`: a tracer is neither copied nor moved.
+  StructureTracer(const StructureTracer&) = delete;
+  StructureTracer& operator=(const StructureTracer&) = delete;
+
   StretchTracker& tracker() { return tracker_; }
   double min_clearance() const { return summary_min_; }
   bool min_exact() const { return summary_min_ < ctx_.band; }
