@@ -171,4 +171,13 @@ RC_GTEST_PROP(FclIndexProps, SegmentDistanceMatchesBruteForce, ()) {
   RC_ASSERT(cap.found());
   RC_ASSERT(std::abs(cap.distance - (exact - r)) <= 1e-9 * std::max(1.0, exact));
   RC_ASSERT(cap.distance + r >= hb.distance - 1e-9);
+  // The per-part segment distance (FCL and brute force) is that part's exact distance, and
+  // a radius below it finds nothing.
+  for (const ObstacleIndex* idx : {static_cast<const ObstacleIndex*>(&f), static_cast<const ObstacleIndex*>(&b)}) {
+    const ClosestHit on = idx->segment_closest_on_part(a, c, part, std::numeric_limits<double>::infinity());
+    RC_ASSERT(on.found());
+    RC_ASSERT(on.part == part);
+    RC_ASSERT(std::abs(on.distance - exact) <= 1e-9 * std::max(1.0, exact));
+    if (exact > 1e-6) RC_ASSERT(!idx->segment_closest_on_part(a, c, part, 0.99 * exact).found());
+  }
 }
