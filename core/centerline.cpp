@@ -14,7 +14,6 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 
 namespace loom {
@@ -51,13 +50,6 @@ constexpr double kFoldAngle = 0.5 * M_PI;
 
 constexpr const auto& kGLx = gauss_legendre8::kNodes;
 constexpr const auto& kGLw = gauss_legendre8::kWeights;
-
-std::string describe(const Vec3& p) {
-  std::ostringstream os;
-  os.precision(17);
-  os << "(" << p.x() << ", " << p.y() << ", " << p.z() << ")";
-  return os.str();
-}
 
 /// ders[k][j] = k-th derivative of N_{span-p+j,p} at u, k = 0..nd (Piegl & Tiller A2.3).
 void basis_derivatives(const double* U, int span, double u, int p, int nd,
@@ -156,7 +148,7 @@ Centerline::Centerline(int degree, std::vector<double> knots, std::vector<Vec3> 
   for (std::size_t i = 0; i < cps_.size(); ++i)
     if (!is_finite(cps_[i]))
       throw std::invalid_argument("Centerline: control point " + std::to_string(i) + " is not finite " +
-                                  describe(cps_[i]));
+                                  full_precision(cps_[i]));
   if (!(u_min() < u_max())) throw std::invalid_argument("Centerline: the knot vector spans an empty domain");
   build_length_table();
 }
@@ -175,7 +167,7 @@ MergedPoints merge_points(const std::vector<Vec3>& points, const char* who) {
   for (std::size_t i = 0; i < points.size(); ++i) {
     if (!is_finite(points[i]))
       throw std::invalid_argument(std::string(who) + ": key point " + std::to_string(i) + " is not finite " +
-                                  describe(points[i]));
+                                  full_precision(points[i]));
     box.extend(points[i]);
   }
   const double tol = kDuplicateRelTol * box.diagonal();
@@ -224,7 +216,7 @@ std::vector<double> key_parameters_for(const std::vector<Vec3>& pts, KnotMethod 
 
 Vec3 unit_tangent(const Vec3& t, const char* which) {
   if (!is_finite(t)) throw std::invalid_argument(std::string("Centerline::interpolate: ") + which +
-                                                 " tangent is not finite " + describe(t));
+                                                 " tangent is not finite " + full_precision(t));
   const double n = t.norm();
   if (!(n > 0.0))
     throw std::invalid_argument(std::string("Centerline::interpolate: ") + which + " tangent is zero");

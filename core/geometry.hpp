@@ -2,15 +2,24 @@
 /// Basic geometric types shared by every loom module. All coordinates are in scene
 /// units (see Scene::units) and in the scene's world frame unless a name says otherwise.
 
+#include "core/error.hpp"
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
 #include <limits>
+#include <string>
 
 namespace loom {
 
 /// A point or vector in world coordinates, scene units.
 using Vec3 = Eigen::Vector3d;
+
+/// "(x, y, z)" with every coordinate at full precision (17 significant digits): messages
+/// that must let a failure be replayed.
+inline std::string full_precision(const Vec3& p) {
+  return "(" + full_precision(p.x()) + ", " + full_precision(p.y()) + ", " + full_precision(p.z()) + ")";
+}
 
 /// Axis-aligned bounding box; empty() until the first point is added.
 struct AABB {

@@ -212,10 +212,10 @@ struct AlphaSimPlaneSamples {
 AlphaSimPlaneSamples alpha_sim_plane_samples(const Mesh& mesh, const AlphaSimPrism& frame, double l_max, double snap,
                                              bool lattice_bitmap = true);
 
-/// Dense samples of a mesh surface: vertices and edge midpoints (each once), centroids (the fixed points,
-/// unless fixed_points is false) and random points (≈ density per spacing² of area, at
-/// least two per triangle), capped at max_samples random ones; deterministic for a seed.
-/// World frame.
+/// Dense samples of a mesh surface: the fixed points — vertices and edge midpoints (each
+/// once) and centroids — unless fixed_points is false, and random points (≈ density per
+/// spacing² of area, at least two per triangle), capped at max_samples random ones;
+/// deterministic for a seed. World frame.
 std::vector<Vec3> dense_surface_samples(const Mesh& mesh, double spacing, double density,
                                         std::size_t max_samples, std::uint64_t seed, bool fixed_points = true);
 

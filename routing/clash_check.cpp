@@ -55,11 +55,6 @@ constexpr double kCutMarginRel = 1e-9;
 
 std::int64_t as_i64(std::size_t v) { return static_cast<std::int64_t>(v); }
 
-/// A point at full precision, for messages that must let a failure be replayed.
-std::string point_text(const Vec3& p) {
-  return "(" + full_precision(p.x()) + ", " + full_precision(p.y()) + ", " + full_precision(p.z()) + ")";
-}
-
 /// Work counters shared by the worker threads.
 struct AtomicCounters {
   std::atomic<std::int64_t> distance{0}, inside{0}, pairs{0}, samples{0}, deferred{0}, deferred_measured{0};
@@ -240,6 +235,8 @@ class StretchTracker {
   /// lower bound above a measured key, so the deepest (and its first occurrence among
   /// equal keys) is the one exact keys everywhere would give.
   void settle(Open& st) {
+    // No candidate: no deferred observation was ever a deepest, so the deepest are exact.
+    if (st.candidates.empty()) return;
     std::vector<double> contact_upper;
     for (const Stretch& c : st.contacts) contact_upper.push_back(c.deepest.key);
     for (Candidate& c : st.candidates) {
@@ -794,7 +791,7 @@ class StructureTracer {
     const ClosestHit h = ctx_.index->segment_closest_on_part(c.a, c.b, o.part, thr_, &t);
     // A point of the part lies within key + r ≤ thr_ of the chord: the query finds it.
     if (!h.found())
-      throw std::logic_error("clash check: deferred chord " + point_text(c.a) + " - " + point_text(c.b) +
+      throw std::logic_error("clash check: deferred chord " + full_precision(c.a) + " - " + full_precision(c.b) +
                              " lost part " + std::to_string(o.part) + " within " + full_precision(thr_));
     o.key = h.distance - r_;
     o.key_lower = o.key;

@@ -232,9 +232,6 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
     req.goal = {b_stub, (a_stub - b_stub).norm() > 0 ? Vec3((a_stub - b_stub).normalized()) : Vec3::UnitX()};
     PlanResult blocked;
     bool branch_blocked = false;
-    auto at = [](const Vec3& p) {
-      return "(" + full_precision(p.x()) + ", " + full_precision(p.y()) + ", " + full_precision(p.z()) + ")";
-    };
     for (const EndFrame* e : {&ea, &eb}) {
       if (!blocked.message.empty()) continue;
       if (!e->is_port) {
@@ -248,7 +245,7 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
         blocked.reason = e == &ea ? NoPathReason::StartInObstacle : NoPathReason::GoalInObstacle;
         blocked.blocked_at = e->position;
         blocked.blocking_part = in ? part : near.part;
-        blocked.message = "branch point " + e->node + " at " + at(e->position) +
+        blocked.message = "branch point " + e->node + " at " + full_precision(e->position) +
                           (in ? " is inside part '" + planning_parts[part].name + "'"
                               : " is " + full_precision(near.distance) + " from part '" + planning_parts[near.part].name +
                                     "', less than the bundle radius " + full_precision(radius));
@@ -259,7 +256,7 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
         blocked.reason = e == &ea ? NoPathReason::StartInObstacle : NoPathReason::GoalInObstacle;
         blocked.blocked_at = e->position;
         blocked.blocking_part = inside_part;
-        blocked.message = "port " + e->node + " at " + at(e->position) + " is inside part '" +
+        blocked.message = "port " + e->node + " at " + full_precision(e->position) + " is inside part '" +
                           planning_parts[inside_part].name + "'";
         continue;
       }

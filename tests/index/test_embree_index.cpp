@@ -419,7 +419,9 @@ TEST(EmbreeIndex, ApproximateSegmentClosestIsWithinItsFactorOfBruteForce) {
         ASSERT_GE(t, 0.0);
         ASSERT_LE(t, 1.0);
         EXPECT_NEAR((h.point - (a + t * (c - a))).norm(), h.distance, 1e-9 * std::max(1.0, h.distance)) << where;
-        if (eps == 0.0) EXPECT_EQ(h.distance, e.segment_closest(a, c, radius).distance);
+        if (eps == 0.0) {
+          EXPECT_EQ(h.distance, e.segment_closest(a, c, radius).distance);
+        }
         approximate += eps > 0.0 && h.distance > exact.distance + err ? 1 : 0;
       }
     }
