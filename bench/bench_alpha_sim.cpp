@@ -9,14 +9,19 @@
 //     translated copies — ribs, boxes — are simplified once, as simplify_parts does);
 //  4. sweep of dim_pre on occt/motor.stl: triangles, Hausdorff, time, query speed;
 //  5. the wing's CAD files at four tessellations (50k -> 420k triangles): throughput and
-//     clearance-query speed-up against the input size (`--tessellation` runs only this).
+//     clearance-query speed-up against the input size (`--tessellation` runs only this);
+//  6. the planner's own queries: every index call OMPL planning makes while routing the
+//     wing's cables port to port on the original parts, logged and replayed on the
+//     original and on the simplified parts (`--planner` runs only this).
 // Writes bench/results/alpha_sim_parts.csv, alpha_sim_sweep.csv, alpha_sim_throughput.csv,
-// alpha_sim_tessellation.csv, alpha_sim.png, alpha_sim_tessellation.png.
+// alpha_sim_tessellation.csv, alpha_sim_planner_queries.csv, alpha_sim.png,
+// alpha_sim_tessellation.png.
 #include "core/io/mesh_read.hpp"
 #include "core/io/scene_load.hpp"
 #include "core/units.hpp"
 #include "index/alpha_sim.hpp"
 #include "index/embree_index.hpp"
+#include "routing/path_planner.hpp"
 
 #include <sys/resource.h>
 #include <tbb/global_control.h>
@@ -26,8 +31,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <algorithm>
+#include <atomic>
+#include <limits>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <mutex>
 #include <random>
 #include <string>
 #include <vector>
@@ -135,6 +144,165 @@ std::vector<Part> scene_files(const Scene& settings_only, double linear, double 
   return parts;
 }
 
+/// One index call planning made, with its arguments, for replay on another index.
+struct LoggedQuery {
+  enum Kind { kAnyWithin, kInside, kClosest, kSegmentWithin, kKinds };
+  Kind kind;
+  Vec3 a, b;  ///< the point, or the segment's ends (world frame, scene units)
+  double r;   ///< the radius asked (0 for inside)
+};
+const char* const kLoggedKindNames[LoggedQuery::kKinds] = {"any_within", "inside", "closest", "segment_within"};
+
+/// Forwards every call to `inner`; logs the four kinds OMPL planning makes (validity:
+/// any_within + inside; clearance and the objective's clearance term: closest; motions:
+/// segment_within) and counts any other call, so a replay knows what it left out.
+/// Thread-safe (one mutex around the log).
+class LoggingIndex : public ObstacleIndex {
+ public:
+  explicit LoggingIndex(const ObstacleIndex& inner) : inner_(inner) {}
+  std::string name() const override { return inner_.name(); }
+  IndexAccuracy accuracy() const override { return inner_.accuracy(); }
+  int part_count() const override { return inner_.part_count(); }
+  std::optional<AABB> part_bounds(int part) const override { return inner_.part_bounds(part); }
+  ClosestHit closest(const Vec3& p, double r) const override {
+    log({LoggedQuery::kClosest, p, p, r});
+    return inner_.closest(p, r);
+  }
+  bool inside(const Vec3& p, int* part) const override {
+    log({LoggedQuery::kInside, p, p, 0.0});
+    return inner_.inside(p, part);
+  }
+  bool any_within(const Vec3& p, double r) const override {
+    log({LoggedQuery::kAnyWithin, p, p, r});
+    return inner_.any_within(p, r);
+  }
+  bool segment_within(const Vec3& a, const Vec3& b, double r) const override {
+    log({LoggedQuery::kSegmentWithin, a, b, r});
+    return inner_.segment_within(a, b, r);
+  }
+  ClosestHit closest_approx(const Vec3& p, double r, double e) const override {
+    ++unlogged_;
+    return inner_.closest_approx(p, r, e);
+  }
+  ClosestHit closest_on_part(const Vec3& p, int part, double r) const override {
+    ++unlogged_;
+    return inner_.closest_on_part(p, part, r);
+  }
+  RayHit ray(const Vec3& o, const Vec3& d, double t) const override {
+    ++unlogged_;
+    return inner_.ray(o, d, t);
+  }
+  ClosestHit segment_closest(const Vec3& a, const Vec3& b, double r, double* t) const override {
+    ++unlogged_;
+    return inner_.segment_closest(a, b, r, t);
+  }
+  ClosestHit segment_closest_on_part(const Vec3& a, const Vec3& b, int part, double r, double* t) const override {
+    ++unlogged_;
+    return inner_.segment_closest_on_part(a, b, part, r, t);
+  }
+  /// The calls logged so far, in call order.
+  std::vector<LoggedQuery> queries() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return log_;
+  }
+  /// Calls of any other method (not replayed).
+  long long unlogged() const { return unlogged_; }
+
+ private:
+  void log(const LoggedQuery& q) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    log_.push_back(q);
+  }
+  const ObstacleIndex& inner_;
+  mutable std::mutex mutex_;
+  mutable std::vector<LoggedQuery> log_;
+  mutable std::atomic<long long> unlogged_{0};
+};
+
+/// Mean time per query (ns) of replaying `qs` through `idx`: one thread, in the logged
+/// order (the planner's own locality), best of three runs.
+double replay_ns(const ObstacleIndex& idx, const std::vector<LoggedQuery>& qs) {
+  if (qs.empty()) return 0.0;
+  double best = std::numeric_limits<double>::infinity();
+  for (int rep = 0; rep < 3; ++rep) {
+    double sum = 0.0;
+    const auto t0 = Clock::now();
+    for (const LoggedQuery& q : qs) switch (q.kind) {
+        case LoggedQuery::kAnyWithin: sum += idx.any_within(q.a, q.r) ? 1.0 : 0.0; break;
+        case LoggedQuery::kInside: sum += idx.inside(q.a) ? 1.0 : 0.0; break;
+        case LoggedQuery::kClosest: {
+          const ClosestHit h = idx.closest(q.a, q.r);
+          sum += h.found() ? h.distance : 0.0;
+          break;
+        }
+        case LoggedQuery::kSegmentWithin: sum += idx.segment_within(q.a, q.b, q.r) ? 1.0 : 0.0; break;
+        case LoggedQuery::kKinds: break;
+      }
+    const double s = seconds_since(t0);
+    volatile double sink = sum;
+    (void)sink;
+    best = std::min(best, 1e9 * s / static_cast<double>(qs.size()));
+  }
+  return best;
+}
+
+/// 6. What routing asks of the index: each cable of the wing scene planned port to port
+/// (Informed RRT*, a fixed iteration count so the log is reproducible) on the original
+/// parts through a LoggingIndex; the log replayed on the original and on the simplified
+/// parts' indices, per kind and all together (the time planning spends in the index).
+void planner_queries(const fs::path& out_dir) {
+  const Scene wing = load_scene(fs::path(LOOM_SOURCE_DIR) / "examples" / "wing-section" / "scene.toml");
+  AlphaSimOptions o;
+  o.dim_pre = wing.simplify.dim_pre.value;
+  o.measure = false;
+  std::vector<AlphaSimResult> res;
+  const std::vector<Part> simplified = simplify_parts(wing.parts, o, &res);
+  const EmbreeIndex original_index(wing.parts), simple_index(simplified);
+  const LoggingIndex logging(original_index);
+  std::map<std::string, const Port*> ports;
+  for (const Port& p : wing.harness.ports) ports[p.id] = &p;
+  int solved = 0;
+  for (std::size_t c = 0; c < wing.harness.cables.size(); ++c) {
+    const Cable& cable = wing.harness.cables[c];
+    const Port* a = ports.at(cable.ports[0]);
+    const Port* b = ports.at(cable.ports[1]);
+    PlanRequest req;
+    req.radius = cable.radius();
+    req.clearance = wing.routing.clearance.value;
+    req.min_bend_radius = cable.physical.min_bend_radius;
+    req.scene_box = wing.bounds();
+    req.planner = "informedrrtstar";
+    req.seed = 20261122u + static_cast<std::uint32_t>(c);
+    req.max_iterations = 500;
+    req.time_limit = 30.0;
+    req.start = {a->position, a->direction};
+    req.goal = {b->position, b->direction};
+    solved += plan_path(logging, req).solved() ? 1 : 0;
+  }
+  const std::vector<LoggedQuery> all = logging.queries();
+  std::ofstream csv(out_dir / "alpha_sim_planner_queries.csv");
+  csv << "kind,queries,original_ns,simplified_ns,speedup,original_ms,simplified_ms\n";
+  std::printf("planner queries: %zu cables planned port to port on the original parts (%d solved), %zu index calls "
+              "logged, %lld others not replayed\n",
+              wing.harness.cables.size(), solved, all.size(), logging.unlogged());
+  auto row = [&](const char* kind, const std::vector<LoggedQuery>& qs) {
+    const double orig = replay_ns(original_index, qs), simp = replay_ns(simple_index, qs);
+    const double n = static_cast<double>(qs.size());
+    const double speedup = simp > 0 ? orig / simp : 0.0;
+    csv << kind << "," << qs.size() << "," << orig << "," << simp << "," << speedup << "," << 1e-6 * orig * n << ","
+        << 1e-6 * simp * n << "\n";
+    std::printf("  %-15s %8zu calls  original %7.0f ns  simplified %7.0f ns  x%.2f\n", kind, qs.size(), orig, simp,
+                speedup);
+  };
+  for (int k = 0; k < LoggedQuery::kKinds; ++k) {
+    std::vector<LoggedQuery> of_kind;
+    for (const LoggedQuery& q : all)
+      if (q.kind == k) of_kind.push_back(q);
+    row(kLoggedKindNames[k], of_kind);
+  }
+  row("all", all);
+}
+
 /// Draws a gnuplot script (the chart is optional: a missing gnuplot is reported, not fatal).
 void run_gnuplot(const fs::path& script) {
   const std::string cmd = "gnuplot '" + script.string() + "'";
@@ -205,9 +373,10 @@ void tessellation_sweep(const fs::path& out_dir, const Scene& wing_settings, int
 }  // namespace
 
 int main(int argc, char** argv) {
-  // `bench_alpha_sim --tessellation [DIR]` runs only part 5.
+  // `bench_alpha_sim --tessellation [DIR]` runs only part 5, `--planner [DIR]` only part 6.
   const bool tessellation_only = argc > 1 && std::string(argv[1]) == "--tessellation";
-  const int arg0 = tessellation_only ? 2 : 1;
+  const bool planner_only = argc > 1 && std::string(argv[1]) == "--planner";
+  const int arg0 = tessellation_only || planner_only ? 2 : 1;
   const fs::path out_dir = argc > arg0 ? fs::path(argv[arg0]) : fs::path(LOOM_SOURCE_DIR) / "bench" / "results";
   fs::create_directories(out_dir);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
@@ -220,6 +389,10 @@ int main(int argc, char** argv) {
       load_scene(fs::path(LOOM_SOURCE_DIR) / "examples" / "wing-section" / "scene.toml", settings_only);
   if (tessellation_only) {
     tessellation_sweep(out_dir, wing_settings, n_queries);
+    return 0;
+  }
+  if (planner_only) {
+    planner_queries(out_dir);
     return 0;
   }
 
@@ -368,6 +541,7 @@ int main(int argc, char** argv) {
   sweep_csv.close();
 
   tessellation_sweep(out_dir, wing_settings, n_queries);
+  if (!quick) planner_queries(out_dir);
 
   // Chart.
   const fs::path gp = out_dir / "alpha_sim.gp";
