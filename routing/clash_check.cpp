@@ -622,16 +622,23 @@ class StructureTracer {
     const double h = b.s - a.s;
     // Lipschitz lower bound on [a, b]; also when a bound stands for d (the value only adds).
     auto proven_clear = [&] { return 0.5 * (a.d + b.d - h) >= thr_; };
+    // The most any values could prove: each distance is at most its surface point's (u), and
+    // at most the other's plus h (1-Lipschitz). Beside a surface within the band (a.u < thr_)
+    // no query can prove [a, b] clear, so with approximate queries none is spent trying.
+    // Exact queries keep them: a value in place of a bound sizes the midpoint's query, and
+    // cut-short exact queries promise the report of full ones bit for bit.
+    const double ua = std::min(a.u, b.u + h), ub = std::min(b.u, a.u + h);
+    const bool provable = rel_error_ == 0.0 || 0.5 * (ua + ub - h) >= thr_;
     // Bounds too low for this decision: raise them to what it needs first, then, if that
     // is not enough, take the values.
-    if (!proven_clear()) {
+    if (!proven_clear() && provable) {
       tighten(a, 2.0 * thr_ + h - b.d);
       tighten(b, 2.0 * thr_ + h - a.d);
     }
     // Values are worth their queries only if the upper bounds could prove it.
     // With approximate bounds a failed proof is cheaper to retry on halves (one approximate
     // query) than to settle with two exact ones, down to the leaves.
-    if (!proven_clear() && 0.5 * (a.u + b.u - h) >= thr_ && (rel_error_ == 0.0 || h <= leaf_)) {
+    if (!proven_clear() && provable && 0.5 * (a.u + b.u - h) >= thr_ && (rel_error_ == 0.0 || h <= leaf_)) {
       resolve(a);
       resolve(b);
     }
