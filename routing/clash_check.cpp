@@ -52,6 +52,11 @@ constexpr double kTouchRel = 1e-9;
 /// (relative to the largest query radius) beyond it, so that rounding does not leave the
 /// bound a hair short of the decision.
 constexpr double kCutMarginRel = 1e-9;
+/// With approximate queries, a leaf stretch whose bounds fell short of a proof that its
+/// samples' surface points could give is retried with queries this much finer than the
+/// request's ε (a lower bound is all a proof needs; exact values cost ~3× more near a
+/// finely tessellated surface).
+constexpr double kProofErrorShare = 0.125;
 
 std::int64_t as_i64(std::size_t v) { return static_cast<std::int64_t>(v); }
 
@@ -478,6 +483,7 @@ class StructureTracer {
     bool resolved = false;
     double d = 0.0;       ///< the sample's d once resolved
     double upper = kInf;  ///< distance of the nearest surface point found so far
+    bool sharpened = false;  ///< sharpen() ran: its bound is as good as it gets short of resolve()
   };
 
   /// Sample at arc length s with a closest-point query of the given radius (the Lipschitz
@@ -593,6 +599,26 @@ class StructureTracer {
     refresh(x);
   }
 
+  /// With approximate queries: raises a pending sample's bound to within a factor
+  /// 1 + kProofErrorShare·ε of its value (one query of its full radius; a miss is the value).
+  void sharpen(Sample& x) {
+    if (x.pending < 0) return;
+    Pending& pd = pending_[x.pending];
+    if (pd.resolved || pd.sharpened) return;
+    pd.sharpened = true;
+    const double e = kProofErrorShare * rel_error_;
+    const ClosestHit h = ctx_.index->closest_approx(pd.p, pd.radius, e);
+    if (!h.found()) {
+      pd.d = take(h, pd.s, pd.radius);
+      pd.resolved = true;
+    } else {
+      note(h, pd.s);
+      pd.reach = std::max(pd.reach, h.distance / (1.0 + e));
+      pd.upper = std::min(pd.upper, h.distance);
+    }
+    refresh(x);
+  }
+
   /// The cut-short samples never resolved count towards the smallest sampled clearance only
   /// if they can lower it: their distance exceeds `reach`, and a query bounded by the
   /// current minimum (+ margin, which covers rounding) finds the same nearest surface as
@@ -639,8 +665,13 @@ class StructureTracer {
     // With approximate bounds a failed proof is cheaper to retry on halves (one approximate
     // query) than to settle with two exact ones, down to the leaves.
     if (!proven_clear() && provable && 0.5 * (a.u + b.u - h) >= thr_ && (rel_error_ == 0.0 || h <= leaf_)) {
-      resolve(a);
-      resolve(b);
+      if (rel_error_ == 0.0) {
+        resolve(a);
+        resolve(b);
+      } else {
+        sharpen(a);
+        sharpen(b);
+      }
     }
     if (proven_clear()) {
       free_.push_back(a);
