@@ -663,7 +663,8 @@ class StructureTracer {
     }
     // Values are worth their queries only if the upper bounds could prove it.
     // With approximate bounds a failed proof is cheaper to retry on halves (one approximate
-    // query) than to settle with two exact ones, down to the leaves.
+    // query) than to settle with two exact ones, down to the leaves; there two finer
+    // approximate queries give bounds close enough to the values.
     if (!proven_clear() && provable && 0.5 * (a.u + b.u - h) >= thr_ && (rel_error_ == 0.0 || h <= leaf_)) {
       if (rel_error_ == 0.0) {
         resolve(a);

@@ -113,8 +113,9 @@ struct ClashRequest {
   /// leaves around the nearest surface, whose number grows with the tessellation. Chords
   /// near contact take the same (1 + ε) distance first and are measured exactly only where
   /// [D / (1 + ε), D] leaves a decision open or the chord can be the deepest point of its
-  /// stretch. Contact decisions, reported distances and the smallest clearance stay exact
-  /// to the tolerance;
+  /// stretch. Where a short stretch's bounds fall short of a proof, its samples are asked
+  /// again at ε/8 rather than exactly. Contact decisions, reported distances and the
+  /// smallest clearance stay exact to the tolerance;
   /// sample positions, and so the last digits of a report, depend on ε. 0 = exact queries
   /// (then cut_short_queries changes nothing in the report). Must be finite and ≥ 0.
   double distance_rel_error = 0.25;
