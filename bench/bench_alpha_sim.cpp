@@ -16,6 +16,7 @@
 // Writes bench/results/alpha_sim_parts.csv, alpha_sim_sweep.csv, alpha_sim_throughput.csv,
 // alpha_sim_tessellation.csv, alpha_sim_planner_queries.csv, alpha_sim.png,
 // alpha_sim_tessellation.png.
+#include "bench/forwarding_index.hpp"
 #include "core/io/mesh_read.hpp"
 #include "core/io/scene_load.hpp"
 #include "core/units.hpp"
@@ -153,17 +154,13 @@ struct LoggedQuery {
 };
 const char* const kLoggedKindNames[LoggedQuery::kKinds] = {"any_within", "inside", "closest", "segment_within"};
 
-/// Forwards every call to `inner`; logs the four kinds OMPL planning makes (validity:
-/// any_within + inside; clearance and the objective's clearance term: closest; motions:
-/// segment_within) and counts any other call, so a replay knows what it left out.
-/// Thread-safe (one mutex around the log).
-class LoggingIndex : public ObstacleIndex {
+/// Logs the four kinds of call OMPL planning makes (validity: any_within + inside;
+/// clearance and the objective's clearance term: closest; motions: segment_within) and
+/// counts any other call, so a replay knows what it left out; forwards every call to the
+/// inner index. Thread-safe (one mutex around the log).
+class LoggingIndex : public ForwardingIndex {
  public:
-  explicit LoggingIndex(const ObstacleIndex& inner) : inner_(inner) {}
-  std::string name() const override { return inner_.name(); }
-  IndexAccuracy accuracy() const override { return inner_.accuracy(); }
-  int part_count() const override { return inner_.part_count(); }
-  std::optional<AABB> part_bounds(int part) const override { return inner_.part_bounds(part); }
+  explicit LoggingIndex(const ObstacleIndex& inner) : ForwardingIndex(inner) {}
   ClosestHit closest(const Vec3& p, double r) const override {
     log({LoggedQuery::kClosest, p, p, r});
     return inner_.closest(p, r);
@@ -196,6 +193,10 @@ class LoggingIndex : public ObstacleIndex {
     ++unlogged_;
     return inner_.segment_closest(a, b, r, t);
   }
+  ClosestHit segment_closest_approx(const Vec3& a, const Vec3& b, double r, double e, double* t) const override {
+    ++unlogged_;
+    return inner_.segment_closest_approx(a, b, r, e, t);
+  }
   ClosestHit segment_closest_on_part(const Vec3& a, const Vec3& b, int part, double r, double* t) const override {
     ++unlogged_;
     return inner_.segment_closest_on_part(a, b, part, r, t);
@@ -213,7 +214,6 @@ class LoggingIndex : public ObstacleIndex {
     std::lock_guard<std::mutex> lock(mutex_);
     log_.push_back(q);
   }
-  const ObstacleIndex& inner_;
   mutable std::mutex mutex_;
   mutable std::vector<LoggedQuery> log_;
   mutable std::atomic<long long> unlogged_{0};

@@ -13,6 +13,7 @@
 //   bench_audit --probe TRIS_PER_PART [THREADS [BUILD_QUALITY [REL_ERROR]]]   (one audit of the
 //                triangle-scaling scene; BUILD_QUALITY as EmbreeOptions, -1 = automatic)
 //   bench_audit --assembly TRIS_PER_PART [MAX_COPIES]   (the assembly series alone, printed)
+#include "bench/forwarding_index.hpp"
 #include "index/embree_index.hpp"
 #include "routing/clash_check.hpp"
 
@@ -236,15 +237,11 @@ void gnuplot(const std::string& script) {
 
 /// Forwards every query to an index and adds up, per method, the calls and the thread CPU
 /// time spent in them (single-threaded probes only: the sums are not synchronised).
-class SplitIndex : public ObstacleIndex {
+class SplitIndex : public ForwardingIndex {
  public:
   /// The methods timed, in report order.
   enum Kind { kClosest, kClosestApprox, kSegmentClosest, kSegmentApprox, kSegmentOnPart, kClosestOnPart, kInside, kOther, kKinds };
-  explicit SplitIndex(const ObstacleIndex& inner) : inner_(inner) {}
-  std::string name() const override { return inner_.name(); }
-  IndexAccuracy accuracy() const override { return inner_.accuracy(); }
-  int part_count() const override { return inner_.part_count(); }
-  std::optional<AABB> part_bounds(int part) const override { return inner_.part_bounds(part); }
+  explicit SplitIndex(const ObstacleIndex& inner) : ForwardingIndex(inner) {}
   ClosestHit closest(const Vec3& p, double r) const override {
     return timed(kClosest, [&] { return inner_.closest(p, r); });
   }
@@ -299,7 +296,6 @@ class SplitIndex : public ObstacleIndex {
     ++calls_[k];
     return out;
   }
-  const ObstacleIndex& inner_;
   mutable double ms_[kKinds] = {};
   mutable long long calls_[kKinds] = {};
 };

@@ -579,9 +579,7 @@ class StructureTracer {
       pd.resolved = true;
       pd.upper = h.distance;
     } else {
-      note(h, pd.s);
-      pd.reach = std::max(pd.reach, h.distance / (1.0 + rel_error_));
-      pd.upper = std::min(pd.upper, h.distance);
+      take_approx(pd, h, rel_error_);
     }
     refresh(x);
   }
@@ -612,11 +610,17 @@ class StructureTracer {
       pd.d = take(h, pd.s, pd.radius);
       pd.resolved = true;
     } else {
-      note(h, pd.s);
-      pd.reach = std::max(pd.reach, h.distance / (1.0 + e));
-      pd.upper = std::min(pd.upper, h.distance);
+      take_approx(pd, h, e);
     }
     refresh(x);
+  }
+
+  /// Takes a (1 + e)-approximate hit of a pending sample's query: counts its surface point
+  /// towards the smallest sampled clearance and narrows the bounds to [D / (1 + e), D].
+  void take_approx(Pending& pd, const ClosestHit& h, double e) {
+    note(h, pd.s);
+    pd.reach = std::max(pd.reach, h.distance / (1.0 + e));
+    pd.upper = std::min(pd.upper, h.distance);
   }
 
   /// The cut-short samples never resolved count towards the smallest sampled clearance only
