@@ -4,6 +4,7 @@
 #include "app/option_checks.hpp"
 
 #include "core/io/atomic_file.hpp"
+#include "core/io/file_stems.hpp"
 #include "core/io/mesh_write.hpp"
 #include "core/io/scene_load.hpp"
 #include "core/progress.hpp"
@@ -17,8 +18,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
-#include <set>
 #include <string>
+#include <vector>
 
 namespace loom::app {
 
@@ -32,18 +33,6 @@ struct SimplifyCommandOptions {
   bool quiet = false;
   bool step = false;
 };
-
-/// A file name for a part: its name with path separators and odd characters replaced,
-/// made unique within the scene.
-std::string file_stem(const std::string& name, std::set<std::string>& used) {
-  std::string s = name.empty() ? "part" : name;
-  for (auto& ch : s)
-    if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_' || ch == '.')) ch = '_';
-  std::string stem = s;
-  for (int k = 2; used.count(stem); ++k) stem = s + "_" + std::to_string(k);
-  used.insert(stem);
-  return stem;
-}
 
 double finite_or_zero(double v) { return std::isfinite(v) ? v : 0.0; }
 
@@ -75,10 +64,12 @@ int run_simplify(const SimplifyCommandOptions& o) {
 
   using nlohmann::json;
   json parts = json::array();
-  std::set<std::string> used;
+  std::vector<std::string> names;
+  for (const auto& p : simple) names.push_back(p.name);
+  const std::vector<std::string> stems = output_file_stems(names);  // as simplify_parts named the STEP files
   for (std::size_t i = 0; i < simple.size(); ++i) {
     const AlphaSimResult& r = results[i];
-    const std::string stem = file_stem(simple[i].name, used);
+    const std::string& stem = stems[i];
     if (!simple[i].mesh.empty()) write_mesh(out_dir / (stem + ".stl"), simple[i].mesh);
     json projections = json::array();
     for (const auto& p : r.projections)

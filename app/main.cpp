@@ -1,6 +1,7 @@
 // loom — the command line. Thin: parses flags, calls the library, maps errors to exit codes.
 #include "app/commands.hpp"
 #include "core/error.hpp"
+#include "core/io/mesh_read.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -13,6 +14,8 @@
 #endif
 
 int main(int argc, char** argv) {
+  // stdout is the command's (reports, --json); OpenCASCADE's transfer statistics would mix in.
+  loom::silence_opencascade_console();
   CLI::App app{"loom — automatic cable-harness routing and clash audits of large assemblies"};
   app.name("loom");
   app.set_version_flag("--version", std::string("loom ") + LOOM_VERSION);

@@ -12,6 +12,11 @@
 
 namespace loom {
 
+/// Largest magnitude loom accepts for a coordinate, length or other number read from a
+/// scene, harness or route file (scene units): Embree's BVH is single precision and squares
+/// distances, and (1e12)² stays far inside float range; 1e12 mm is a million kilometres.
+constexpr double kMaxInputMagnitude = 1e12;
+
 /// A point or vector in world coordinates, scene units.
 using Vec3 = Eigen::Vector3d;
 

@@ -1,5 +1,7 @@
 #include "index/alpha_sim.hpp"
 
+#include "core/io/file_stems.hpp"
+
 #include "core/error.hpp"
 #include "index/embree_index.hpp"
 
@@ -28,10 +30,12 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <exception>
 #include <chrono>
 #include <cmath>
 #include <iterator>
 #include <limits>
+#include <mutex>
 #include <random>
 #include <stdexcept>
 
@@ -612,6 +616,11 @@ Mesh mesh_shape(const TopoDS_Shape& shape, double deflection, int* face_count) {
 void write_step_atomic(const TopoDS_Shape& shape, const std::filesystem::path& path) {
   std::filesystem::create_directories(path.parent_path().empty() ? "." : path.parent_path());
   const std::filesystem::path tmp = path.string() + ".tmp";
+  // OpenCASCADE's STEP writer is not thread-safe (its translation tables and static
+  // parameters are process-wide): two parts written at once by simplify_parts' threads
+  // failed now and then ("cannot write STEP file"). One writer at a time.
+  static std::mutex step_writer;
+  const std::lock_guard<std::mutex> lock(step_writer);
   STEPControl_Writer writer;
   if (writer.Transfer(shape, STEPControl_AsIs) != IFSelect_RetDone ||
       writer.Write(tmp.string().c_str()) != IFSelect_RetDone) {
@@ -619,13 +628,6 @@ void write_step_atomic(const TopoDS_Shape& shape, const std::filesystem::path& p
     throw std::runtime_error("cannot write STEP file " + path.string());
   }
   std::filesystem::rename(tmp, path);
-}
-
-std::string safe_file_name(const std::string& name) {
-  std::string s = name.empty() ? "part" : name;
-  for (auto& ch : s)
-    if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_' || ch == '.')) ch = '_';
-  return s;
 }
 
 /// True for the statuses whose projection was replaced by its convex hull.
@@ -697,7 +699,7 @@ AlphaSimPlaneSamples alpha_sim_plane_samples(const Mesh& mesh, const AlphaSimPri
 
 // ---------------------------------------------------------------------------------------
 
-AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
+AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const std::string& step_stem) {
   const auto t0 = Clock::now();
   if (!(std::isfinite(opt.dim_pre) && opt.dim_pre > 0.0))
     throw std::invalid_argument("alpha-sim: dim_pre must be finite and > 0, got " + full_precision(opt.dim_pre));
@@ -1077,7 +1079,9 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt) {
   }
 
   r.measure_ms = ms_since(t_measure);
-  if (!opt.step_dir.empty()) write_step_atomic(result, opt.step_dir / (safe_file_name(part.name) + ".step"));
+  if (!opt.step_dir.empty())
+    write_step_atomic(result,
+                      opt.step_dir / ((step_stem.empty() ? output_file_stems({part.name})[0] : step_stem) + ".step"));
   return finish();
 }
 
@@ -1126,9 +1130,23 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
   std::vector<Part> out(parts.size());
   std::vector<AlphaSimResult> res(parts.size());
   ProgressCounter simplified(opt.progress, "simplify", parts.size(), "parts");
+  std::vector<std::string> names;
+  for (const auto& p : parts) names.push_back(p.name);
+  const std::vector<std::string> stems = output_file_stems(names);
+  // An exception must not leave a TBB task: it would cancel the task group, and with it
+  // the nested parallel loops of the parts other threads are simplifying, which would then
+  // go on with planes never built. Each part's exception is kept; the first (in part
+  // order) is rethrown once every part has finished.
+  std::vector<std::exception_ptr> failed(parts.size());
   tbb::parallel_for(std::size_t(0), unique.size(), [&](std::size_t u) {
     const std::size_t i = unique[u];
-    AlphaSimPart sp = simplify_part(parts[i], o);
+    AlphaSimPart sp;
+    try {
+      sp = simplify_part(parts[i], o, stems[i]);
+    } catch (...) {
+      failed[i] = std::current_exception();
+      return;
+    }
     Part p = parts[i];
     p.mesh = std::move(sp.mesh);
     p.closed = sp.result.closed_after;
@@ -1137,6 +1155,8 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
     res[i] = std::move(sp.result);
     simplified.add();
   });
+  for (const auto& e : failed)
+    if (e) std::rethrow_exception(e);
   for (std::size_t i = 0; i < parts.size(); ++i) {
     if (source[i] == i) continue;
     const auto t0 = Clock::now();

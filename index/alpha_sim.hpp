@@ -66,7 +66,9 @@ struct AlphaSimOptions {
   bool merge_convex_corners = true;
   bool build_mesh = true;       ///< OpenCASCADE prisms ∩ → triangle mesh (else implicit only)
   bool measure = true;          ///< containment of the mesh + Hausdorff distance
-  std::filesystem::path step_dir;  ///< if set, writes <step_dir>/<part>.step (OpenCASCADE)
+  /// If set, writes <step_dir>/<stem>.step (OpenCASCADE); the stem is simplify_part's
+  /// `step_stem`, in simplify_parts the part's output_file_stems entry.
+  std::filesystem::path step_dir;
   std::uint64_t seed = 1;       ///< random containment samples
   /// simplify_parts: stage "simplify", parts done, one call at a time from TBB workers.
   ProgressFn progress;
@@ -182,7 +184,9 @@ struct AlphaSimPart {
 };
 
 /// Simplifies one part. Throws std::invalid_argument if opt.dim_pre is not finite and > 0.
-AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt);
+/// With opt.step_dir set, the STEP file is <step_dir>/<step_stem>.step (empty: the part's
+/// name made a file name by output_file_stems).
+AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const std::string& step_stem = {});
 
 /// Simplifies every part in parallel (TBB) and returns them with the simplified meshes
 /// (names, roles, clearances kept), ready for any ObstacleIndex. opt.scene_size ≤ 0 is

@@ -43,6 +43,11 @@ constexpr double kLeafRadii = 2.0;
 /// Longest chord, in cable radii (keeps the self rule |s − t| ≥ πr sharp: the paper's
 /// sample spacing 2r).
 constexpr double kMaxChordRadii = 2.0;
+/// Most chords the certified audit accepts for one cable's deviation bound. A routed cable
+/// (bends of at least a few radii) needs a few thousand at the default tolerance, a
+/// 100 m cable at a 1 µm tolerance ~10⁶; beyond this the route wiggles on the scale of the
+/// tolerance (e.g. 200,000 key points 1 µm apart) and flattening it would not end.
+constexpr double kMaxChordsPerCable = 1e7;
 /// Chords per block in the cable–cable narrow phase.
 constexpr std::size_t kBlock = 8;
 /// Arc-length slack (relative to the cable length) when deciding that two chord or sample
@@ -312,6 +317,31 @@ struct Chords {
 /// longer than `hmax`. On a span of a degree ≤ 3 spline C'' is affine, so the deviation
 /// of a chord over Δu is ≤ Δu²/8 · max(|C''| at the ends). Arc lengths at vertices are the
 /// exact span lengths shared out in proportion to the chord lengths.
+/// Chords flatten needs over the span piece [a, b] for the deviation bound `eps` alone:
+/// Δu·sqrt(max|C''| / (8·eps)) (see flatten), at least 1.
+double deviation_chords(const Centerline& c, double a, double b, double eps) {
+  if (c.degree() < 2) return 1.0;
+  const double inset = 1e-9 * (b - a);
+  double m = std::max(c.derivative(a + inset, 2).norm(), c.derivative(b - inset, 2).norm());
+  if (c.degree() > 3) {  // C'' not affine: sample densely and keep a safety factor
+    for (int k = 1; k < 16; ++k) m = std::max(m, c.derivative(a + (b - a) * k / 16.0, 2).norm());
+    m *= 1.5;
+  }
+  return std::max(1.0, (b - a) * std::sqrt(m / (8.0 * eps)));
+}
+
+/// Chords flatten would make for the deviation bound over the whole curve.
+double deviation_chords(const Centerline& c, double eps) {
+  std::vector<double> br{c.u_min()};
+  for (double k : c.knots())
+    if (k > br.back() && k < c.u_max()) br.push_back(k);
+  br.push_back(c.u_max());
+  double n = 0.0;
+  for (std::size_t i = 0; i + 1 < br.size(); ++i)
+    if (br[i + 1] > br[i]) n += deviation_chords(c, br[i], br[i + 1], eps);
+  return n;
+}
+
 void flatten(const Centerline& c, double u0, double u1, double eps, double hmax, Chords& out) {
   std::vector<double> br{u0};
   for (double k : c.knots())
@@ -325,16 +355,7 @@ void flatten(const Centerline& c, double u0, double u1, double eps, double hmax,
     const double a = br[i], b = br[i + 1];
     if (!(b > a)) continue;
     const double sa = out.s.back(), sb = c.arc_length_at(b);
-    double n_dev = 1.0;
-    if (c.degree() >= 2) {
-      const double inset = 1e-9 * (b - a);
-      double m = std::max(c.derivative(a + inset, 2).norm(), c.derivative(b - inset, 2).norm());
-      if (c.degree() > 3) {  // C'' not affine: sample densely and keep a safety factor
-        for (int k = 1; k < 16; ++k) m = std::max(m, c.derivative(a + (b - a) * k / 16.0, 2).norm());
-        m *= 1.5;
-      }
-      n_dev = (b - a) * std::sqrt(m / (8.0 * eps));
-    }
+    const double n_dev = deviation_chords(c, a, b, eps);
     const double n_len = (sb - sa) / hmax;
     const std::size_t n = static_cast<std::size_t>(std::max(1.0, std::ceil(std::max(n_dev, n_len))));
     double acc = 0.0;
@@ -1385,6 +1406,16 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
     throw std::invalid_argument("check_clashes: tolerance " + std::to_string(ctx.tol) +
                                 " is not above twice the index error " + std::to_string(ctx.abs_err));
   ctx.chord_error = kChordShareOfTolerance * (ctx.tol - ctx.abs_err);
+  if (request.method == ClashMethod::Certified)
+    for (const auto& c : cables) {
+      const double n = deviation_chords(c.curve, ctx.chord_error);
+      if (!(n <= kMaxChordsPerCable))
+        throw std::invalid_argument("check_clashes: cable '" + c.id + "' would need " + full_precision(n) +
+                                    " chords to stay within " + full_precision(ctx.chord_error) +
+                                    " of its curve (more than " + full_precision(kMaxChordsPerCable) +
+                                    "): its curvature reaches the scale of the tolerance; smooth the route or "
+                                    "raise --tolerance");
+    }
   res.cables.resize(cables.size());
   std::vector<std::vector<ClashEntry>> per_clash(cables.size());
   std::vector<std::vector<Violation>> per_viol(cables.size());

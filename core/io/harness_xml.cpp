@@ -72,6 +72,9 @@ class Reader {
     if (end == v.c_str() || (end && *end != '\0'))
       fail(n, "attribute '" + attr + "' is not a number: '" + v + "'");
     if (!std::isfinite(d)) fail(n, "attribute '" + attr + "' is not finite: '" + v + "'");
+    if (std::abs(d) > kMaxInputMagnitude)
+      fail(n, "attribute '" + attr + "' = " + v + " is beyond ±" + full_precision(kMaxInputMagnitude) +
+                  " (scene units)");
     return d;
   }
 

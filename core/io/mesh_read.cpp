@@ -6,13 +6,19 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <BRepBndLib.hxx>
 #include <BRepMesh_IncrementalMesh.hxx>
+#include <Bnd_Box.hxx>
 #include <BRep_Tool.hxx>
 #include <IGESCAFControl_Reader.hxx>
 #include <IFSelect_ReturnStatus.hxx>
 #include <Interface_Static.hxx>
+#include <Message.hxx>
+#include <Message_Messenger.hxx>
+#include <Message_PrinterOStream.hxx>
 #include <Poly_Triangulation.hxx>
 #include <STEPCAFControl_Reader.hxx>
+#include <Standard_Failure.hxx>
 #include <TDF_ChildIterator.hxx>
 #include <TDF_Label.hxx>
 #include <TDF_LabelSequence.hxx>
@@ -161,9 +167,31 @@ void collect_leaves(const Handle(XCAFDoc_ShapeTool)& tool, const TDF_Label& labe
   if (name.empty()) name = instance_name;
   out.push_back({name, s.Moved(here)});
 }
+
+/// Smallest linear deflection accepted, as a fraction of the file's bounding-box diagonal.
+/// Below it OpenCASCADE's mesher either throws (Standard_NumericError at ~1e-12 of the size)
+/// or produces more triangles than memory holds; a cable needs nothing that fine.
+constexpr double kMinRelativeDeflection = 1e-6;
+constexpr const char* kMinRelativeDeflectionText = "1e-6";
+
+std::vector<NamedMesh> read_cad_file_occ(const std::filesystem::path& path, const TessellationParams& tp, bool split);
 }  // namespace
 
 std::vector<NamedMesh> read_cad_file(const std::filesystem::path& path, const TessellationParams& tp, bool split) {
+  // OpenCASCADE reports failures of its readers and mesher by exceptions of its own: they
+  // are the file's (or the deflection's) fault, so they become input errors naming both.
+  try {
+    return read_cad_file_occ(path, tp, split);
+  } catch (const Standard_Failure& e) {
+    throw InputError({path.string(), 0, ""}, std::string("OpenCASCADE failed (") + e.DynamicType()->Name() +
+                                                 "): " + (e.GetMessageString() ? e.GetMessageString() : "") +
+                                                 " (tessellation deflection " + full_precision(tp.linear_deflection) +
+                                                 " scene units)");
+  }
+}
+
+namespace {
+std::vector<NamedMesh> read_cad_file_occ(const std::filesystem::path& path, const TessellationParams& tp, bool split) {
   require_readable(path);
   if (!is_cad_file(path))
     throw InputError({path.string(), 0, ""}, "not a STEP/IGES file: '" + path.extension().string() + "'");
@@ -201,6 +229,20 @@ std::vector<NamedMesh> read_cad_file(const std::filesystem::path& path, const Te
   const double scale = 1.0 / tp.unit_in_mm;
   // Deflection is given in scene units; OpenCASCADE meshes in the file's (mm) frame.
   const double lin_mm = tp.linear_deflection * tp.unit_in_mm;
+  {
+    Bnd_Box bb;
+    for (const auto& l : leaves) BRepBndLib::Add(l.shape, bb);
+    if (!bb.IsVoid()) {
+      const double diag_mm = std::sqrt(bb.SquareExtent());
+      if (lin_mm < kMinRelativeDeflection * diag_mm)
+        throw InputError({path.string(), 0, ""},
+                         "tessellation deflection " + full_precision(tp.linear_deflection) + " scene units is below " +
+                             kMinRelativeDeflectionText + " of the file's size (" +
+                             full_precision(diag_mm * scale) +
+                             " scene units): raise tessellation.linear_deflection, or the smallest cable diameter "
+                             "its default follows");
+    }
+  }
   const double ang = tp.angular_deflection_deg * M_PI / 180.0;
   std::vector<NamedMesh> out;
   if (!split) {
@@ -231,6 +273,12 @@ std::vector<NamedMesh> read_cad_file(const std::filesystem::path& path, const Te
   }
   if (out.empty()) throw InputError({path.string(), 0, ""}, "tessellation produced no triangles");
   return out;
+}
+
+}  // namespace
+
+void silence_opencascade_console() {
+  Message::DefaultMessenger()->RemovePrinters(STANDARD_TYPE(Message_PrinterOStream));
 }
 
 }  // namespace loom

@@ -41,4 +41,10 @@ Mesh read_mesh_file(const std::filesystem::path& path);
 std::vector<NamedMesh> read_cad_file(const std::filesystem::path& path, const TessellationParams& tp,
                                      bool split);
 
+/// Removes OpenCASCADE's console printers from its default messenger, for the whole
+/// process: its STEP/IGES readers and writers otherwise print transfer statistics on stdout,
+/// which the command line keeps for its own output. Call once at start-up, before any
+/// thread uses OpenCASCADE.
+void silence_opencascade_console();
+
 }  // namespace loom

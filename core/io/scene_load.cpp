@@ -49,6 +49,8 @@ class TomlReader {
     else if (auto f = n->as_floating_point()) v = f->get();
     else fail(n, where + "." + key, "expected a number");
     if (!std::isfinite(v)) fail(n, where + "." + key, "must be finite, got " + full_precision(v));
+    if (std::abs(v) > kMaxInputMagnitude)
+      fail(n, where + "." + key, "must be within ±" + full_precision(kMaxInputMagnitude) + ", got " + full_precision(v));
     return v;
   }
 
@@ -70,6 +72,8 @@ class TomlReader {
       else if (auto f = e->as_floating_point()) v[i] = f->get();
       else fail(e, key, "expected numbers");
       if (!std::isfinite(v[i])) fail(e, key, "must be finite");
+      if (std::abs(v[i]) > kMaxInputMagnitude)
+        fail(e, key, "must be within ±" + full_precision(kMaxInputMagnitude) + ", got " + full_precision(v[i]));
     }
     return v;
   }
@@ -296,6 +300,13 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
         p.name = pieces.size() == 1 ? pname : pname + "/" + piece.name;
         p.mesh = std::move(piece.mesh);
         p.mesh.transform(xf);
+        // The mesh file's own coordinates, or a transform's scale and translation, can put the
+        // part where single-precision queries lose it (or overflow).
+        for (const Vec3& v : p.mesh.vertices)
+          if (!(v.cwiseAbs().maxCoeff() <= kMaxInputMagnitude))
+            r.fail(pt->get("file"), pwhere,
+                   "a vertex lands at " + full_precision(v) + ", beyond ±" + full_precision(kMaxInputMagnitude) +
+                       " scene units (check the file's units and the part's transform)");
         p.role = role;
         p.clearance = extra;
         p.source_file = fpath.string();

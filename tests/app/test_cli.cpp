@@ -335,4 +335,91 @@ TEST(CliRegression, GivenOptionValuesAreCheckedNotTakenForDefaults) {
   }
 }
 
+// Regressions (2026-11-22, session 19, a scripted sweep of bad inputs): numbers far beyond
+// any scene (a transform scale or translation of 1e300, a clearance of 1e300, a route's
+// control point at x = 1e300) were accepted — the audit of that route ran out of memory —
+// and a vertex pushed past single precision's useful range by a transform passed too.
+// Each is exit 2 naming the key, element or part.
+TEST(CliRegression, NumbersBeyondAnySceneAreRefused) {
+  const auto dir = fresh_dir("magnitudes");
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy_file(kRouteData + "/box.obj", dir / "box.obj");
+  const std::string around = slurp(kRouteData + "/around.toml");
+  const std::string harness = slurp(kRouteData + "/harness_around.xml");
+  auto with = [&](std::string text, const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return at == std::string::npos ? text : text.replace(at, from.size(), to);
+  };
+  std::ofstream(dir / "harness_around.xml") << harness;
+  const std::vector<std::pair<std::string, std::string>> scenes = {
+      {with(around, "scale = 5.0", "scale = 1e300"), "transform.scale"},
+      {with(around, "translate = [-20, -20, -20]", "translate = [-20, 1e18, -20]"), "transform.translate"},
+      {with(around, "scale = 5.0", "scale = 1e12"), "a vertex lands at"},
+      {with(around, "clearance  = 3.0", "clearance  = 1e300"), "routing.clearance"}};
+  for (const auto& [text, key] : scenes) {
+    std::ofstream(dir / "scene.toml") << text;
+    const auto r = loom("info " + (dir / "scene.toml").string());
+    EXPECT_EQ(r.status, 2) << key << "\n" << r.out;
+    EXPECT_NE(r.out.find(key), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("scene.toml"), std::string::npos) << r.out;
+  }
+  std::ofstream(dir / "scene.toml") << around;
+  std::ofstream(dir / "harness_around.xml") << with(harness, "diameter=\"2\"", "diameter=\"1e300\"");
+  const auto d = loom("info " + (dir / "scene.toml").string());
+  EXPECT_EQ(d.status, 2) << d.out;
+  EXPECT_NE(d.out.find("harness_around.xml"), std::string::npos) << d.out;
+  EXPECT_NE(d.out.find("'diameter'"), std::string::npos) << d.out;
+}
+
+// Regression (2026-11-22, session 19): a tessellation deflection of 1e-9 mm (given, or the
+// default r/10 of a cable 1e-300 mm thick) made OpenCASCADE's mesher throw
+// Standard_NumericError, which nothing caught: the process aborted. A deflection below 1e-6
+// of the file's size is now refused before meshing, and OpenCASCADE's own exceptions
+// become input errors naming the file.
+TEST(CliRegression, TessellationFinerThanTheFileCanHoldIsExitTwo) {
+  const auto dir = fresh_dir("deflection");
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy_file(kExamples + "/wing-section/spar.step", dir / "spar.step");
+  std::ofstream(dir / "scene.toml") << "[scene]\nname = \"fine\"\nunits = \"mm\"\n[[part]]\nname = \"spar\"\n"
+                                       "file = \"spar.step\"\n[tessellation]\nlinear_deflection = 1e-9\n";
+  const auto r = loom("info " + (dir / "scene.toml").string());
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("spar.step"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("below 1e-6 of the file's size"), std::string::npos) << r.out;
+}
+
+// Regression (2026-11-22, session 19): a part named with 100,000 characters made `simplify
+// --step` fail to create its files ("File name too long") after other parts' files were
+// written, and the exception, thrown inside a TBB task, cancelled the nested loops of the
+// parts other threads were simplifying (UBSan: a member call on a null shape). OpenCASCADE's
+// STEP writer also printed its statistics on stdout under --quiet, and two parts' STEP
+// files written at once by different threads failed now and then ("cannot write STEP
+// file": the writer is not thread-safe). Stems are now cut to a valid length (with a hash
+// of the whole name), exceptions wait until every part is done, one STEP file is written
+// at a time, and stdout stays empty.
+TEST(CliRegression, LongPartNamesGiveValidFilesAndQuietStaysQuiet) {
+  const auto dir = fresh_dir("long_name");
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy_file(kRouteData + "/box.obj", dir / "box.obj");
+  const std::string name(100000, 'x');
+  std::ofstream(dir / "scene.toml") << "[scene]\nname = \"long\"\nunits = \"mm\"\n[[part]]\nname = \"" << name
+                                    << "\"\nfile = \"box.obj\"\ntransform = { scale = 5.0 }\n[[part]]\nname = \"b\"\n"
+                                       "file = \"box.obj\"\ntransform = { translate = [100, 0, 0], scale = 5.0 }\n"
+                                       "[simplify]\ndim_pre = 4.0\n";
+  const auto out = dir / "out";
+  const auto r = loom("simplify " + (dir / "scene.toml").string() + " --step --quiet --out " + out.string());
+  EXPECT_EQ(r.status, 0) << r.out.substr(0, 2000);
+  EXPECT_TRUE(r.out.empty()) << r.out.substr(0, 2000);
+  int stl = 0, step = 0;
+  for (const auto& e : std::filesystem::directory_iterator(out)) {
+    const std::string f = e.path().filename().string();
+    EXPECT_LE(f.size(), 120u) << f;
+    stl += e.path().extension() == ".stl";
+    step += e.path().extension() == ".step";
+  }
+  EXPECT_EQ(stl, 2);
+  EXPECT_EQ(step, 2);
+}
+
 }  // namespace

@@ -1,5 +1,6 @@
 // Harness XML: lossless round trip and the bad-input catalogue (each error names the line).
 #include "core/error.hpp"
+#include "core/geometry.hpp"
 #include "core/harness_topology.hpp"
 #include "core/io/harness_xml.hpp"
 
@@ -139,14 +140,22 @@ TEST(HarnessXml, RoundTripThroughFile) {
 // Full-precision numbers survive the round trip bit for bit.
 RC_GTEST_PROP(HarnessXmlProps, CoordinatesRoundTripExactly, ()) {
   Harness a = parse_harness_xml(kSample, "sample.xml");
-  const auto x = *rc::gen::arbitrary<double>();
-  const auto y = *rc::gen::arbitrary<double>();
+  // Any double within the accepted magnitude (fmod keeps every mantissa bit of small ones).
+  const auto x = std::fmod(*rc::gen::arbitrary<double>(), kMaxInputMagnitude);
+  const auto y = std::fmod(*rc::gen::arbitrary<double>(), kMaxInputMagnitude);
   RC_PRE(std::isfinite(x) && std::isfinite(y));
   a.ports[0].position = Vec3(x, y, x * 0.1);
   a.segments[0].path[0] = Vec3(y, x, 1e-300);
   Harness b = parse_harness_xml(harness_to_xml(a), "w.xml");
   RC_ASSERT(b.ports[0].position == a.ports[0].position);
   RC_ASSERT(b.segments[0].path[0] == a.segments[0].path[0]);
+}
+
+RC_GTEST_PROP(HarnessXmlProps, CoordinatesBeyondTheInputMagnitudeAreRefused, ()) {
+  Harness a = parse_harness_xml(kSample, "sample.xml");
+  const double x = *rc::gen::inRange(1, 1000000) * 1e-3 + 1.0;  // (1, 1001]
+  a.ports[0].position = Vec3(0.0, (x > 500.0 ? -1.0 : 1.0) * x * kMaxInputMagnitude, 0.0);
+  RC_ASSERT_THROWS_AS(parse_harness_xml(harness_to_xml(a), "w.xml"), InputError);
 }
 
 /// Replaces the first occurrence of `from` in the sample and expects an InputError whose

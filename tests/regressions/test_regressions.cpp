@@ -2,6 +2,10 @@
 // case replays without the generator or seed that found it. Name: area, what broke.
 // Bugs of the command line are replayed where the command runs: tests/app/test_cli.cpp,
 // CliRegression.* (e.g. given option values taken for "use the default").
+// Session 19's sweep of bad inputs: CliRegression.NumbersBeyondAnySceneAreRefused,
+// .TessellationFinerThanTheFileCanHoldIsExitTwo, .LongPartNamesGiveValidFilesAndQuietStaysQuiet
+// (tests/app/test_cli.cpp) and ClashCheck.ARouteWigglingAtTheToleranceIsRefusedNotFlattened
+// (tests/routing/test_clash_check.cpp).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -471,6 +471,31 @@ TEST(ClashCheck, BadInputIsRejected) {
   EXPECT_TRUE(check_clashes({}, parts, &idx, req).clashes.empty());
 }
 
+// Regression (2026-11-22, session 19, a sweep of bad inputs): a route wiggling on the scale
+// of the tolerance (2,000 key points 1 µm apart, or a fine tolerance on a tight zigzag) made
+// the certified audit flatten it into chords without end. It is refused up front, naming
+// the cable and the chord count, before any chord is made.
+TEST(ClashCheck, ARouteWigglingAtTheToleranceIsRefusedNotFlattened) {
+  const std::vector<Part> parts{box_part("box", {0, 0, 0}, {1, 1, 1})};
+  BruteForceIndex idx(parts);
+  std::vector<Vec3> cps;
+  for (int i = 0; i < 40; ++i) cps.emplace_back(10.0 + 1e-4 * i, (i % 2) ? 1.0 : -1.0, 0.0);
+  CableInput c;
+  c.id = "wiggle";
+  c.curve = cubic_from_controls(cps);
+  c.radius = 1.0;
+  ClashRequest req;
+  req.tolerance = 1e-12;
+  try {
+    check_clashes({c}, parts, &idx, req);
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'wiggle' would need"), std::string::npos) << e.what();
+  }
+  req.tolerance = 0.0;  // the default (r/100): a few thousand chords, audited
+  EXPECT_NO_THROW(check_clashes({c}, parts, &idx, req));
+}
+
 TEST(ClashCheck, DiscreteWithAndWithoutIndexAgree) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> U(-20, 20);
