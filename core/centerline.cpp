@@ -48,6 +48,13 @@ constexpr double kFoldSampleAngle = 0.25 * M_PI;
 /// A tangent turn that survives bisection down to the parameter resolution is a fold.
 constexpr double kFoldAngle = 0.5 * M_PI;
 
+/// Binomial coefficient C(n, k) for the small n of a curve's degree.
+double binomial(int n, int k) {
+  double c = 1.0;
+  for (int i = 1; i <= k; ++i) c = c * (n - k + i) / i;
+  return c;
+}
+
 constexpr const auto& kGLx = gauss_legendre8::kNodes;
 constexpr const auto& kGLw = gauss_legendre8::kWeights;
 
@@ -465,6 +472,76 @@ double Centerline::curvature(double u) const {
   return curvature_from(d[1], d[2]);
 }
 
+std::vector<Vec3> Centerline::hull_points(double a, double b) const {
+  std::vector<Vec3> out;
+  if (cps_.empty()) return out;
+  a = std::clamp(a, u_min(), u_max());
+  b = std::clamp(b, u_min(), u_max());
+  if (a > b) std::swap(a, b);
+  // Breakpoint intervals holding a and b (b at an interval's left end belongs to the one
+  // before: the piece ends there).
+  const std::size_t last = span_index_.size() - 1;
+  std::size_t ka = std::upper_bound(span_u_.begin(), span_u_.end(), a) - span_u_.begin();
+  std::size_t kb = std::lower_bound(span_u_.begin(), span_u_.end(), b) - span_u_.begin();
+  ka = std::min(ka == 0 ? 0 : ka - 1, last);
+  kb = std::max(std::min(kb == 0 ? 0 : kb - 1, last), ka);
+  const int p = degree_;
+  out.reserve((kb - ka + 1) * static_cast<std::size_t>(p + 1));
+  for (std::size_t k = ka; k <= kb; ++k) {
+    if (p > kMaxDerivative) {  // no derivatives that high: the span's control points
+      for (int q = span_index_[k] - p; q <= span_index_[k]; ++q) out.push_back(cps_[static_cast<std::size_t>(q)]);
+      continue;
+    }
+    // Bézier points of the piece [s, t] of interval k, from the derivatives at s:
+    // B_j = Σ_{i ≤ j} C(j,i)/C(p,i) · hⁱ/i! · C⁽ⁱ⁾(s). Unlike the B-spline's control
+    // points, which reach about an interval beyond, they end exactly at C(s) and C(t).
+    const double s0 = k == ka ? a : span_u_[k], t0 = k == kb ? b : span_u_[k + 1];
+    Vec3 d[kMaxDerivative + 1];
+    evaluate_on_span(static_cast<int>(k), s0, p, d);
+    const double h = t0 - s0;
+    for (int j = 0; j <= p; ++j) {
+      Vec3 bj = Vec3::Zero();
+      double term = 1.0;  // hⁱ / i!
+      for (int i = 0; i <= j; ++i) {
+        if (i > 0) term *= h / i;
+        bj += binomial(j, i) / binomial(p, i) * term * d[i];
+      }
+      out.push_back(bj);
+    }
+  }
+  return out;
+}
+
+double Centerline::hull_deviation(double a, double b) const {
+  if (cps_.empty()) return 0.0;
+  const Vec3 pa = position(a), pb = position(b);
+  double worst2 = 0.0;
+  for (const Vec3& q : hull_points(a, b)) worst2 = std::max(worst2, point_segment_dist2(q, pa, pb));
+  return std::sqrt(worst2);
+}
+
+double Centerline::hull_turn_sine(double a, double b) const {
+  if (cps_.empty()) return 1.0;
+  const Vec3 chord = position(std::max(a, b)) - position(std::min(a, b));
+  const double len = chord.norm();
+  if (!(len > 0.0)) return 1.0;
+  const Vec3 dir = chord / len;
+  const std::vector<Vec3> h = hull_points(a, b);
+  const std::size_t stride = static_cast<std::size_t>(degree_ + 1);
+  double worst = 0.0;
+  for (std::size_t q = 0; q + 1 < h.size(); ++q) {
+    if ((q + 1) % stride == 0) continue;  // the next span's points start here
+    // On each span C' is a Bézier curve whose control points are positive multiples of
+    // these differences; a zero difference adds nothing to their hull.
+    const Vec3 d = h[q + 1] - h[q];
+    const double n = d.norm();
+    if (!(n > 0.0)) continue;
+    if (!(d.dot(dir) > 0.0)) return 1.0;  // C' may turn against the chord
+    worst = std::max(worst, d.cross(dir).norm() / n);
+  }
+  return worst;
+}
+
 // ---------------------------------------------------------------------------------------
 // Arc length
 
@@ -497,9 +574,12 @@ double Centerline::span_length(int piece, double a, double b) const {
     return d[1].norm();
   };
   const double whole = gauss8(speed, a, b);
-  // Tolerance relative to the chord-based scale of this piece (never zero).
+  // Tolerance relative to the larger of this piece's scale and the whole curve's (never
+  // zero). Why the curve's: a piece a micrometre long on a metre-long cable (key points
+  // from a dense export) need not be resolved to 1e-13 of itself; near a cusp of a wiggly
+  // piece that took the bisection to its deepest level at every call (seconds per cable).
   const double chord = (position(b) - position(a)).norm();
-  const double tol = kArcLengthRelTol * std::max({whole, chord, 1e-300});
+  const double tol = kArcLengthRelTol * std::max({whole, chord, scale_length_, 1e-300});
   return adaptive_length(speed, a, b, whole, tol, 0);
 }
 

@@ -139,6 +139,16 @@ class Centerline {
   double arc_length_at(double u) const;
   /// Inverse of arc_length_at: the u where the arc length from the start is s (clamped).
   double parameter_at_length(double s) const;
+  /// Upper bound on the distance of C(u), u ∈ [a, b] (clamped to the domain), from the
+  /// segment C(a)C(b), scene units: the largest distance from it of the control points that
+  /// act on [a, b] (each span lies in the convex hull of its p + 1 control points). Costs
+  /// one pass over those control points.
+  double hull_deviation(double a, double b) const;
+  /// Upper bound on the sine of the angle between the tangent C'(u), u ∈ [a, b], and the
+  /// chord from C(a) to C(b), from the differences of the control points acting on [a, b]
+  /// (C' lies in the convex hull of positive multiples of them); 1 if C' may vanish or turn
+  /// against the chord there.
+  double hull_turn_sine(double a, double b) const;
   /// Points at equal arc spacing ≤ `spacing`, first and last included; with their s.
   std::vector<std::pair<double, Vec3>> sample_by_arc_length(double spacing) const;
   /// Smallest bend radius and where it occurs (dense search + local refinement); 0 at a
@@ -177,6 +187,10 @@ class Centerline {
   double typical_speed_ = 1.0;    ///< control-polygon length / parameter range
   double scale_length_ = 1.0;     ///< control-polygon length
   void build_length_table();
+  /// degree + 1 points per breakpoint interval meeting [a, b] (clamped), in order: the
+  /// Bézier points of the curve's piece in it (degree ≤ 3; above, the span's control
+  /// points), whose convex hull holds that piece.
+  std::vector<Vec3> hull_points(double a, double b) const;
   int find_span(double u) const;
   std::vector<Vec3> poly_;        ///< Taylor coefficients of each piece about its start
   std::size_t piece_of(double u, bool left_limit) const;

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <limits>
 #include <string>
 
@@ -65,5 +66,13 @@ struct AABB {
 
 /// True if every component is finite (no NaN, no inf).
 inline bool is_finite(const Vec3& v) { return v.allFinite(); }
+
+/// Squared distance from p to the closed segment ab (scene units²; a point if a == b).
+inline double point_segment_dist2(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).squaredNorm();
+}
 
 }  // namespace loom

@@ -43,6 +43,9 @@ constexpr double kLeafRadii = 2.0;
 /// Longest chord, in cable radii (keeps the self rule |s − t| ≥ πr sharp: the paper's
 /// sample spacing 2r).
 constexpr double kMaxChordRadii = 2.0;
+/// Knot spans shorter than this many cable radii may be merged into one chord with their
+/// short neighbours (ChordPlan): routes hold no key points this close on purpose.
+constexpr double kShortSpanRadii = 0.25;
 /// Most chords the certified audit accepts for one cable's deviation bound. A routed cable
 /// (bends of at least a few radii) needs a few thousand at the default tolerance, a
 /// 100 m cable at a 1 µm tolerance ~10⁶; beyond this the route wiggles on the scale of the
@@ -313,12 +316,9 @@ struct Chords {
   std::size_t size() const { return p.empty() ? 0 : p.size() - 1; }
 };
 
-/// Appends to `out` chords of c over [u0, u1] deviating at most `eps` from the curve and no
-/// longer than `hmax`. On a span of a degree ≤ 3 spline C'' is affine, so the deviation
-/// of a chord over Δu is ≤ Δu²/8 · max(|C''| at the ends). Arc lengths at vertices are the
-/// exact span lengths shared out in proportion to the chord lengths.
-/// Chords flatten needs over the span piece [a, b] for the deviation bound `eps` alone:
-/// Δu·sqrt(max|C''| / (8·eps)) (see flatten), at least 1.
+/// Chords the deviation bound alone asks of the span piece [a, b] (at least 1): on a span of
+/// a degree ≤ 3 spline C'' is affine, so the deviation of a chord over Δu is
+/// ≤ Δu²/8 · max(|C''| at the ends), and Δu·sqrt(max|C''| / (8·eps)) chords suffice.
 double deviation_chords(const Centerline& c, double a, double b, double eps) {
   if (c.degree() < 2) return 1.0;
   const double inset = 1e-9 * (b - a);
@@ -330,37 +330,110 @@ double deviation_chords(const Centerline& c, double a, double b, double eps) {
   return std::max(1.0, (b - a) * std::sqrt(m / (8.0 * eps)));
 }
 
-/// Chords flatten would make for the deviation bound over the whole curve.
-double deviation_chords(const Centerline& c, double eps) {
-  std::vector<double> br{c.u_min()};
-  for (double k : c.knots())
-    if (k > br.back() && k < c.u_max()) br.push_back(k);
-  br.push_back(c.u_max());
+/// The chords of a stretch [u0, u1] of a centerline, piece by piece: each piece [a, b] is
+/// cut uniformly in u into n chords that deviate at most eps from the curve and are no
+/// longer than hmax. A piece is one knot span, cut by the deviation bound above, or a run
+/// of consecutive short spans (each shorter than short_len) taken as one chord: the convex
+/// hull property puts each span inside the hull of its p + 1 control points, so the run
+/// lies within the largest distance of their control points from the chord, and where that
+/// is ≤ eps the one chord is certified. Why: key points far closer together than the cable
+/// is thick (a dense export, a scan) give thousands of spans within a few radii, one chord
+/// each at least, and every chord pair among them a broad-phase candidate; their hull shows
+/// how little the curve moves there.
+class ChordPlan {
+ public:
+  ChordPlan(const Centerline& c, double u0, double u1, double eps, double hmax, double short_len)
+      : c_(c), eps_(eps), hmax_(hmax), short_len_(short_len) {
+    br_.push_back(u0);
+    for (double k : c.knots())
+      if (k > br_.back() && k < u1) br_.push_back(k);
+    br_.push_back(u1);
+    s_.assign(br_.size(), -1.0);
+  }
+
+  /// Calls piece(a, b, sa, sb, n) for each piece in order (sa, sb: exact arc lengths at
+  /// its ends, n ≥ 1 chords).
+  template <class F>
+  void visit(F&& piece) {
+    for (std::size_t i = 0; i + 1 < br_.size();) {
+      if (!(br_[i + 1] > br_[i])) {
+        ++i;
+        continue;
+      }
+      const std::size_t j = merged_end(i);
+      if (j > i + 1 || (j == i + 1 && short_span(i))) {
+        piece(br_[i], br_[j], s(i), s(j), std::size_t(1));
+        i = j;
+        continue;
+      }
+      const double a = br_[i], b = br_[i + 1];
+      const double n_dev = deviation_chords(c_, a, b, eps_);
+      const double n_len = (s(i + 1) - s(i)) / hmax_;
+      piece(a, b, s(i), s(i + 1), static_cast<std::size_t>(std::max(1.0, std::ceil(std::max(n_dev, n_len)))));
+      ++i;
+    }
+  }
+
+ private:
+  /// Exact arc length at break i (cached).
+  double s(std::size_t i) {
+    if (s_[i] < 0.0) s_[i] = c_.arc_length_at(br_[i]);
+    return s_[i];
+  }
+  bool short_span(std::size_t i) { return s(i + 1) - s(i) < short_len_; }
+
+  /// True if the pieces i..j−1 are short, no longer than hmax together, and their control
+  /// points lie within eps of the chord from br_[i] to br_[j].
+  bool one_chord(std::size_t i, std::size_t j) {
+    if (!(s(j) - s(i) <= hmax_)) return false;
+    for (std::size_t k = i; k < j; ++k)
+      if (!short_span(k)) return false;
+    return c_.hull_deviation(br_[i], br_[j]) <= eps_;
+  }
+
+  /// A j > i with one_chord(i, j), by doubling the run from i + 1 while the test passes
+  /// (every answer checked, so it is certified even where the test is not monotone in j;
+  /// no bisection after the first failure: the next run starts there), or i if not even
+  /// the piece i alone passes. Work: about twice the pieces merged.
+  std::size_t merged_end(std::size_t i) {
+    const std::size_t last = br_.size() - 1;
+    if (!short_span(i) || !one_chord(i, i + 1)) return i;
+    std::size_t ok = i + 1;
+    for (std::size_t step = 1; ok < last; step *= 2) {
+      const std::size_t t = std::min(last, ok + step);
+      if (!one_chord(i, t)) break;
+      ok = t;
+    }
+    return ok;
+  }
+
+  const Centerline& c_;
+  double eps_, hmax_, short_len_;
+  std::vector<double> br_;
+  std::vector<double> s_;
+};
+
+/// Chords flatten makes over the whole curve (the certified audit's refusal of a curve
+/// that wiggles on the scale of the tolerance counts them before making them).
+double planned_chords(const Centerline& c, double eps, double hmax, double short_len) {
   double n = 0.0;
-  for (std::size_t i = 0; i + 1 < br.size(); ++i)
-    if (br[i + 1] > br[i]) n += deviation_chords(c, br[i], br[i + 1], eps);
+  ChordPlan(c, c.u_min(), c.u_max(), eps, hmax, short_len)
+      .visit([&](double, double, double, double, std::size_t k) { n += static_cast<double>(k); });
   return n;
 }
 
-void flatten(const Centerline& c, double u0, double u1, double eps, double hmax, Chords& out) {
-  std::vector<double> br{u0};
-  for (double k : c.knots())
-    if (k > br.back() && k < u1) br.push_back(k);
-  br.push_back(u1);
+/// Appends to `out` the chords of ChordPlan over [u0, u1]. Arc lengths at vertices are
+/// exact at piece ends and shared out within a piece in proportion to the chord lengths.
+void flatten(const Centerline& c, double u0, double u1, double eps, double hmax, double short_len, Chords& out) {
   if (out.p.empty()) {
     out.p.push_back(c.position(u0));
     out.s.push_back(c.arc_length_at(u0));
   }
-  for (std::size_t i = 0; i + 1 < br.size(); ++i) {
-    const double a = br[i], b = br[i + 1];
-    if (!(b > a)) continue;
-    const double sa = out.s.back(), sb = c.arc_length_at(b);
-    const double n_dev = deviation_chords(c, a, b, eps);
-    const double n_len = (sb - sa) / hmax;
-    const std::size_t n = static_cast<std::size_t>(std::max(1.0, std::ceil(std::max(n_dev, n_len))));
+  std::vector<double> lens;
+  ChordPlan(c, u0, u1, eps, hmax, short_len).visit([&](double a, double b, double, double sb, std::size_t n) {
+    const double sa = out.s.back();
     double acc = 0.0;
-    std::vector<double> lens;
-    lens.reserve(n);
+    lens.clear();
     for (std::size_t k = 1; k <= n; ++k) {
       const double u = k == n ? b : a + (b - a) * static_cast<double>(k) / static_cast<double>(n);
       out.p.push_back(c.position(u));
@@ -369,7 +442,7 @@ void flatten(const Centerline& c, double u0, double u1, double eps, double hmax,
     }
     for (std::size_t k = 0; k < n; ++k)
       out.s.push_back(acc > 0.0 ? sa + (sb - sa) * lens[k] / acc : sa + (sb - sa) * (k + 1.0) / n);
-  }
+  });
 }
 
 // ---------------------------------------------------------------------------------------
@@ -749,8 +822,8 @@ class StructureTracer {
     flush_free();
     Chords ch;
     const Centerline& c = in_.curve;
-    flatten(c, c.parameter_at_length(s0), c.parameter_at_length(s1), ctx_.chord_error,
-            kMaxChordRadii * r_, ch);
+    flatten(c, c.parameter_at_length(s0), c.parameter_at_length(s1), ctx_.chord_error, kMaxChordRadii * r_,
+            kShortSpanRadii * r_, ch);
     count_.samples += as_i64(ch.p.size());
     // Candidate parts for the secondary check: boxes within the band of this stretch.
     AABB box;
@@ -992,49 +1065,38 @@ void group_pair_contacts(std::vector<PairContact>& contacts, const std::vector<C
   }
 }
 
-/// One B-spline span of one cable, flattened to chords, with a box per block of kBlock
-/// chords (inflated by the cable radius + chord error: two blocks whose boxes do not meet
-/// hold no pair of chords closer than the radii sum).
-struct SpanChords {
+/// One cable flattened to chords, with a box per block of kBlock chords (inflated by the
+/// cable radius + chord error: two blocks whose boxes do not meet hold no pair of chords
+/// closer than the radii sum).
+struct CableChords {
   int cable = -1;
   Chords ch;
   std::vector<AABB> blocks;  ///< box of chords [k·kBlock, (k+1)·kBlock)
 };
 
-/// Every non-empty knot span of every cable, flattened (in parallel).
-std::vector<SpanChords> flatten_spans(Context& ctx) {
-  struct SpanRef {
-    int cable;
-    double u0, u1;
-  };
-  std::vector<SpanRef> refs;
-  for (std::size_t c = 0; c < ctx.cables.size(); ++c) {
-    const Centerline& curve = ctx.cables[c].curve;
-    const auto& K = curve.knots();
-    const int p = curve.degree();
-    for (int k = p; k + 1 < static_cast<int>(K.size()) && k < static_cast<int>(curve.control_points().size()); ++k)
-      if (K[k + 1] > K[k]) refs.push_back({static_cast<int>(c), K[k], K[k + 1]});
-  }
-  std::vector<SpanChords> spans(refs.size());
-  parallel_indices(refs.size(), ctx.req.threads, [&](std::size_t k) {
-    const CableInput& c = ctx.cables[refs[k].cable];
-    SpanChords& sc = spans[k];
-    sc.cable = refs[k].cable;
-    flatten(c.curve, refs[k].u0, refs[k].u1, ctx.chord_error, kMaxChordRadii * c.radius, sc.ch);
-    ctx.counters.samples += as_i64(sc.ch.p.size());
+/// Every cable, flattened (cables in parallel).
+std::vector<CableChords> flatten_cables(Context& ctx) {
+  std::vector<CableChords> out(ctx.cables.size());
+  parallel_indices(ctx.cables.size(), ctx.req.threads, [&](std::size_t k) {
+    const CableInput& c = ctx.cables[k];
+    CableChords& cc = out[k];
+    cc.cable = static_cast<int>(k);
+    flatten(c.curve, c.curve.u_min(), c.curve.u_max(), ctx.chord_error, kMaxChordRadii * c.radius,
+            kShortSpanRadii * c.radius, cc.ch);
+    ctx.counters.samples += as_i64(cc.ch.p.size());
     const double infl = c.radius + ctx.chord_error;
-    for (std::size_t b = 0; b * kBlock < sc.ch.size(); ++b) {
+    for (std::size_t b = 0; b * kBlock < cc.ch.size(); ++b) {
       AABB box;
-      for (std::size_t v = b * kBlock; v <= std::min(sc.ch.size(), (b + 1) * kBlock); ++v) box.extend(sc.ch.p[v]);
-      sc.blocks.push_back(box.inflated(infl));
+      for (std::size_t v = b * kBlock; v <= std::min(cc.ch.size(), (b + 1) * kBlock); ++v) box.extend(cc.ch.p[v]);
+      cc.blocks.push_back(box.inflated(infl));
     }
   });
-  return spans;
+  return out;
 }
 
 /// Exact chord–chord narrow phase of block ba of span A against block bb of span B (a block
 /// against itself when A and B are one span and ba == bb). Returns the segment tests made.
-std::int64_t narrow_phase(const Context& ctx, const SpanChords& A, std::size_t ba, const SpanChords& B, std::size_t bb,
+std::int64_t narrow_phase(const Context& ctx, const CableChords& A, std::size_t ba, const CableChords& B, std::size_t bb,
                           std::vector<PairContact>& out) {
   const CableInput& ca = ctx.cables[A.cable];
   const CableInput& cb = ctx.cables[B.cable];
@@ -1078,25 +1140,25 @@ constexpr std::size_t kPairsPerTask = 256;
 
 void certified_cable_pairs(Context& ctx, std::vector<ClashEntry>& out) {
   if (!ctx.req.check_cable_cable && !ctx.req.check_self) return;
-  const std::vector<SpanChords> spans = flatten_spans(ctx);
+  const std::vector<CableChords> cc = flatten_cables(ctx);
   // Broad phase over the block boxes of all cables together (a BVH, Embree's rtcCollide):
-  // the candidates are local chord groups, not whole spans, so their number follows the
+  // the candidates are local chord groups, not whole cables, so their number follows the
   // chords that really come near each other as cables are added.
   struct BlockRef {
-    std::uint32_t span, block;
+    std::uint32_t cable, block;
   };
   std::vector<BlockRef> blocks;
   std::vector<AABB> boxes;
-  for (std::size_t i = 0; i < spans.size(); ++i)
-    for (std::size_t b = 0; b < spans[i].blocks.size(); ++b) {
+  for (std::size_t i = 0; i < cc.size(); ++i)
+    for (std::size_t b = 0; b < cc[i].blocks.size(); ++b) {
       blocks.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(b)});
-      boxes.push_back(spans[i].blocks[b]);
+      boxes.push_back(cc[i].blocks[b]);
     }
   std::vector<BoxPair> pairs = overlapping_box_pairs(boxes, ctx.req.threads);
   // Keep the kinds asked for; a block against itself (self check) is not a box pair.
   pairs.erase(std::remove_if(pairs.begin(), pairs.end(),
                              [&](const BoxPair& pr) {
-                               const bool same = spans[blocks[pr.first].span].cable == spans[blocks[pr.second].span].cable;
+                               const bool same = blocks[pr.first].cable == blocks[pr.second].cable;
                                return same ? !ctx.req.check_self : !ctx.req.check_cable_cable;
                              }),
               pairs.end());
@@ -1111,7 +1173,7 @@ void certified_cable_pairs(Context& ctx, std::vector<ClashEntry>& out) {
     for (std::size_t k = t * kPairsPerTask; k < std::min(pairs.size(), (t + 1) * kPairsPerTask); ++k) {
       const BlockRef& x = blocks[pairs[k].first];
       const BlockRef& y = blocks[pairs[k].second];
-      tests += narrow_phase(ctx, spans[x.span], x.block, spans[y.span], y.block, local);
+      tests += narrow_phase(ctx, cc[x.cable], x.block, cc[y.cable], y.block, local);
     }
     ctx.counters.pairs += tests;
     if (!local.empty()) {
@@ -1408,7 +1470,8 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
   ctx.chord_error = kChordShareOfTolerance * (ctx.tol - ctx.abs_err);
   if (request.method == ClashMethod::Certified)
     for (const auto& c : cables) {
-      const double n = deviation_chords(c.curve, ctx.chord_error);
+      const double n =
+          planned_chords(c.curve, ctx.chord_error, kMaxChordRadii * c.radius, kShortSpanRadii * c.radius);
       if (!(n <= kMaxChordsPerCable))
         throw std::invalid_argument("check_clashes: cable '" + c.id + "' would need " + full_precision(n) +
                                     " chords to stay within " + full_precision(ctx.chord_error) +

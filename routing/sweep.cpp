@@ -42,6 +42,9 @@ constexpr std::size_t kMaxRings = 1u << 22;
 /// A step never exceeds this fraction of its knot span, so that curvature sampled at the
 /// step's ends and middle sees every feature of the (cubic) span.
 constexpr double kMaxSpanFraction = 0.25;
+/// Knot intervals shorter than this many tube radii may be crossed several at a time (see
+/// the hull jump in sections()).
+constexpr double kShortIntervalRadii = 1.0;
 /// Attempts to shrink one step until the curvature inside it is consistent with its length.
 constexpr int kStepShrinkIterations = 4;
 /// Newton iterations of the step prediction (from above: each brings it closer to the step
@@ -257,6 +260,14 @@ double sections(const Centerline& c, const RadiusFn& radius_at, bool variable_ra
     out.finish(min_speed);
   };
   Sample dm, de;  // at the middle and the end of a step
+  // The ring at (u, s) from the sample d, its frame carried on.
+  auto add_ring = [&]() {
+    rings.push_back(make_ring(u, std::min(s, L), d, rings.back().tangent));
+    frame_next();
+    if (rings.size() > kMaxRings)
+      throw std::invalid_argument(std::string(who) + ": chord tolerance " + std::to_string(opt.chord_tolerance) +
+                                  " needs more than " + std::to_string(kMaxRings) + " rings");
+  };
   while (u < u1) {
     while (bpi + 2 < bp.size() && u >= bp[bpi + 1]) ++bpi;
     const double span_w = bp[bpi + 1] - bp[bpi];
@@ -283,6 +294,36 @@ double sections(const Centerline& c, const RadiusFn& radius_at, bool variable_ra
       if (du <= allowed * 1.0000001 || it >= kStepShrinkIterations) break;
       du = std::max(allowed, kMinStepRel * (u1 - u0));
     }
+    // Hull jump. Why: key points far closer together than the tube is thick (a dense export)
+    // make knot intervals so short that a quarter of one is a needless ring, millions of
+    // them per cable. Where such intervals lie within half the axial tolerance of the chord
+    // to a breakpoint ahead (hull_deviation) and every tangent there leans from the chord by
+    // less than that much at the tube's radius (hull_turn_sine), the canal surface over them
+    // is within the axial tolerance of a straight tube: one step crosses them all.
+    if (!variable_radius && bpi + 2 < bp.size() && span_w * speed0 < kShortIntervalRadii * r0) {
+      auto straight_to = [&](std::size_t j) {
+        return bp[j] > u + du && c.hull_deviation(u, bp[j]) <= 0.5 * tol_axial &&
+               r0 * c.hull_turn_sine(u, bp[j]) <= 0.5 * tol_axial;
+      };
+      // Doubling from the second breakpoint ahead while the test passes (no bisection after
+      // the first failure: the next step starts there); `ok` is the farthest passed, 0: none.
+      std::size_t ok = 0;
+      for (std::size_t off = 1;; off *= 2) {
+        const std::size_t j = std::min(bpi + 1 + off, bp.size() - 1);
+        if (!straight_to(j)) break;
+        ok = j;
+        if (j + 1 == bp.size()) break;
+      }
+      if (ok != 0) {
+        const double un = bp[ok];
+        sample_ahead(un, de, 3);
+        s = un == u1 ? L : std::min(c.arc_length_at(un) - c.arc_length_at(u0), L);
+        u = un;
+        d = de;
+        add_ring();
+        continue;
+      }
+    }
     // Simpson on |C'| (the three derivatives we have) advances s for the radius law.
     const double un = (u1 - (u + du) <= 1e-12 * (u1 - u0)) ? u1 : u + du;
     if (un == u1 && un != u + du) sample_ahead(un, de, 3);
@@ -290,11 +331,7 @@ double sections(const Centerline& c, const RadiusFn& radius_at, bool variable_ra
     if (un == u1) s = L;
     u = un;
     d = de;
-    rings.push_back(make_ring(u, std::min(s, L), d, rings.back().tangent));
-    frame_next();
-    if (rings.size() > kMaxRings)
-      throw std::invalid_argument(std::string(who) + ": chord tolerance " + std::to_string(opt.chord_tolerance) +
-                                  " needs more than " + std::to_string(kMaxRings) + " rings");
+    add_ring();
   }
 
   return worst.radians();

@@ -240,6 +240,47 @@ TEST(Centerline, ArcLengthMatchesOpenCascadeAndInverts) {
   }
 }
 
+// Regression (2026-11-25, session 20): key points a micrometre apart on a metre-scale route
+// (a dense export) made every span's quadrature aim at 1e-13 of its own micrometre, and on
+// the wiggles of noisy points bisect to its deepest level: 0.5 s per curve, and a 200,000
+// point route took hours to audit. The tolerance is now relative to the whole curve; the
+// lengths must still agree with OpenCASCADE's.
+TEST(Centerline, DenseNoisyKeyPointsKeepTheirArcLength) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> noise(-1e-3, 1e-3);
+  std::vector<Vec3> pts{Vec3(0, 0, 0), Vec3(100, 20, 0)};
+  for (int i = 1; i <= 2000; ++i) pts.emplace_back(100.0 + 1e-3 * i, 20.0 + noise(rng), noise(rng));
+  pts.emplace_back(200, 0, 30);
+  pts.emplace_back(300, 10, 30);
+  const Centerline c = Centerline::interpolate(pts);
+  GeomAdaptor_Curve ga(to_occt(c));
+  const double Locc = GCPnts_AbscissaPoint::Length(ga, c.u_min(), c.u_max(), 1e-12);
+  EXPECT_NEAR(c.length(), Locc, 1e-9 * Locc);
+  for (int k = 1; k < 10; ++k) {
+    const double u = c.u_min() + (c.u_max() - c.u_min()) * k / 10.0;
+    EXPECT_NEAR(c.arc_length_at(u), GCPnts_AbscissaPoint::Length(ga, c.u_min(), u, 1e-12), 1e-9 * Locc);
+  }
+}
+
+TEST(Centerline, HullBoundsAreZeroOnAStraightRunAndHoldOnAnArc) {
+  std::vector<Vec3> line;
+  for (int i = 0; i <= 50; ++i) line.emplace_back(1.0 + 2.0 * i, -3.0 + 1.0 * i, 0.5 * i);
+  const Centerline straight = Centerline::interpolate(line);
+  const double a = straight.key_parameters()[3], b = straight.key_parameters()[40];
+  EXPECT_LE(straight.hull_deviation(a, b), 1e-12 * straight.length());
+  EXPECT_LE(straight.hull_turn_sine(a, b), 1e-12);
+  // A half circle of radius 10: its middle stands 10 off the chord, its ends are
+  // perpendicular to it.
+  std::vector<Vec3> arc;
+  for (int i = 0; i <= 16; ++i) arc.emplace_back(10.0 * std::cos(M_PI * i / 16), 10.0 * std::sin(M_PI * i / 16), 0.0);
+  const Centerline half = Centerline::interpolate(arc);
+  EXPECT_GE(half.hull_deviation(half.u_min(), half.u_max()), 10.0 * (1 - 1e-3));
+  EXPECT_GE(half.hull_turn_sine(half.u_min(), half.u_max()), 0.99);  // end tangents near ⟂ the chord
+  const double q = half.key_parameters()[4];
+  EXPECT_GT(half.hull_turn_sine(half.u_min(), q), 0.3);
+  EXPECT_LT(half.hull_turn_sine(half.u_min(), q), 1.0);
+}
+
 TEST(Centerline, ArcLengthTableIsBuiltOnceOnFirstUseAndTravelsWithCopies) {
   // The arc-length table is built on first use: copies taken before and after it exists,
   // moved-from and moved-to curves, and threads asking for it at the same time all see
@@ -541,4 +582,33 @@ RC_GTEST_PROP(CenterlineProperty, InterpolatesFiniteAndLongerThanItsPolygon, ())
   const loom::BendExtremum b = c.min_bend_radius();
   RC_ASSERT(!std::isnan(b.radius));
   RC_ASSERT(b.radius >= 0.0);
+}
+
+RC_GTEST_PROP(CenterlineProperty, HullBoundsHoldOnDenseSamples, ()) {
+  const int n = *rc::gen::inRange(2, 12);
+  const auto coords = *rc::gen::container<std::vector<int>>(3 * n, rc::gen::inRange(-1000, 1000));
+  std::vector<Vec3> p;
+  for (int i = 0; i < n; ++i) p.emplace_back(coords[3 * i] * 0.01, coords[3 * i + 1] * 0.01, coords[3 * i + 2] * 0.01);
+  std::vector<Vec3> distinct;
+  for (const Vec3& q : p)
+    if (distinct.empty() || (q - distinct.back()).norm() > 1e-6) distinct.push_back(q);
+  RC_PRE(distinct.size() >= 2u);
+  const Centerline c = Centerline::interpolate(distinct);
+  const double t0 = *rc::gen::inRange(0, 1000) / 1000.0, t1 = *rc::gen::inRange(0, 1000) / 1000.0;
+  const double a = c.u_min() + (c.u_max() - c.u_min()) * std::min(t0, t1);
+  const double b = c.u_min() + (c.u_max() - c.u_min()) * std::max(t0, t1);
+  RC_PRE(b > a);
+  const Vec3 pa = c.position(a), pb = c.position(b);
+  const double dev = c.hull_deviation(a, b), turn = c.hull_turn_sine(a, b);
+  const double scale = scale_of(distinct);
+  const Vec3 chord = pb - pa;
+  for (int k = 0; k <= 256; ++k) {
+    const double u = a + (b - a) * k / 256.0;
+    RC_ASSERT(std::sqrt(loom::point_segment_dist2(c.position(u), pa, pb)) <= dev + 1e-12 * scale);
+    if (turn < 1.0) {
+      const Vec3 t = c.derivative(u, 1);
+      RC_ASSERT(t.dot(chord) > 0.0);
+      RC_ASSERT(t.cross(chord).norm() / (t.norm() * chord.norm()) <= turn + 1e-9);
+    }
+  }
 }

@@ -17,13 +17,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-double point_segment_dist2(const Vec3& p, const Vec3& a, const Vec3& b) {
-  const Vec3 d = b - a;
-  const double l2 = d.squaredNorm();
-  const double t = l2 > 0 ? std::clamp((p - a).dot(d) / l2, 0.0, 1.0) : 0.0;
-  return (p - (a + t * d)).squaredNorm();
-}
-
 // Independent oracle: projection onto the plane if it falls inside (barycentric solve),
 // otherwise the nearest edge.
 double oracle_point_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {

@@ -496,6 +496,55 @@ TEST(ClashCheck, ARouteWigglingAtTheToleranceIsRefusedNotFlattened) {
   EXPECT_NO_THROW(check_clashes({c}, parts, &idx, req));
 }
 
+// Regression (2026-11-25, session 20): key points far closer together than the cable is
+// thick (2,000 points 1 µm apart on one bundle segment of the wing harness, shared by 11
+// cables) gave every cable a chord per knot span, and the pair pass's broad phase 26,000
+// mutually overlapping chord blocks: 288 million candidate pairs, 34 s and 4.6 GB for an
+// audit that takes 0.3 s without them. Runs of short spans whose control points stay within
+// the chord error are now one chord (ChordPlan). The findings must still match the oracle,
+// with about as many chords as the same curves need without the dense points.
+TEST(ClashCheck, DenseKeyPointsAuditLikeTheOracleWithFewChords) {
+  auto route = [](double z, int dense) {
+    std::vector<Vec3> pts;
+    auto at = [z](double x) { return Vec3(x, 5.0 * std::sin(x / 30.0), z); };
+    for (double x = 0.0; x < 40.0; x += 10.0) pts.push_back(at(x));
+    for (int i = 0; i <= dense; ++i) pts.push_back(at(40.0 + 2.0 * i / std::max(dense, 1)));
+    for (double x = 50.0; x <= 100.0; x += 10.0) pts.push_back(at(x));
+    return Centerline::interpolate(pts);
+  };
+  const std::vector<Part> parts{box_part("wall", {60, -10, -3}, {62, 10, 3})};
+  auto cables_with = [&](int dense) {
+    std::vector<CableInput> cs(3);
+    for (int i = 0; i < 3; ++i) {
+      cs[i].id = "C" + std::to_string(i);
+      cs[i].curve = route(1.5 * i, dense);
+      cs[i].radius = 1.0;
+    }
+    return cs;
+  };
+  const auto packed = cables_with(2000), sparse = cables_with(1);
+  const double tol = 0.01;
+  const ClashResult rd = run(packed, parts, ClashMethod::Certified, tol);
+  const ClashResult rs = run(sparse, parts, ClashMethod::Certified, tol);
+  std::printf("samples: dense key points %lld, sparse %lld\n", static_cast<long long>(rd.counters.samples), static_cast<long long>(rs.counters.samples));
+  EXPECT_LT(rd.counters.samples, 2 * rs.counters.samples + 100)
+      << "dense " << rd.counters.samples << " sparse " << rs.counters.samples;
+  const double oracle_err = 0.001;
+  for (int c = 0; c < 3; ++c) {
+    const OracleCable oc = dense(packed[c].curve, 0.05);
+    const double truth = oracle_structure(oc, 1.0, parts[0]);
+    ASSERT_LT(truth, -tol - oracle_err);  // every cable crosses the wall
+    EXPECT_TRUE(has_structure_clash(rd, c, 0)) << "cable " << c;
+    for (int d = c + 1; d < 3; ++d) {
+      const double pair = oracle_pair(oc, 1.0, dense(packed[d].curve, 0.05), 1.0, false, 5.0);
+      const bool hit = find_clash(rd, ClashKind::CableCable, c, d) != nullptr;
+      EXPECT_EQ(hit, pair < 0.0) << c << "/" << d << " oracle " << pair;
+      EXPECT_TRUE(std::abs(pair) > tol + oracle_err) << "ambiguous scene";
+    }
+  }
+  EXPECT_EQ(rd.clashes.size(), rs.clashes.size());
+}
+
 TEST(ClashCheck, DiscreteWithAndWithoutIndexAgree) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> U(-20, 20);

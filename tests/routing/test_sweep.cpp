@@ -83,6 +83,22 @@ double distance_to_curve(const Centerline& c, const Dense& d, const Vec3& q) {
 
 double angle(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
 
+/// Largest |distance to the curve − r| over the centroid and edge midpoints of the tube's
+/// side facets (the caps left out): how far the facets stand off the exact tube.
+double worst_facet_error(const Centerline& c, const Dense& d, const loom::SweepResult& res, double r) {
+  const std::size_t ring_vertices = static_cast<std::size_t>(res.rings) * res.circumferential;
+  double worst = 0.0;
+  for (std::size_t t = 0; t < res.mesh.triangles.size(); ++t) {
+    const auto& f = res.mesh.triangles[t];
+    if (f[0] >= ring_vertices || f[1] >= ring_vertices || f[2] >= ring_vertices) continue;  // caps
+    const auto q = res.mesh.corners(t);
+    for (const Vec3& p : {Vec3((q[0] + q[1] + q[2]) / 3.0), Vec3(0.5 * (q[0] + q[1])), Vec3(0.5 * (q[1] + q[2])),
+                          Vec3(0.5 * (q[0] + q[2]))})
+      worst = std::max(worst, std::abs(distance_to_curve(c, d, p) - r));
+  }
+  return worst;
+}
+
 /// Volume per unit length of a straight stack of regular n-gons of circumradius r, each
 /// rotated by π/n against its neighbours and joined by triangles (an antiprism stack): the
 /// prismatoid formula h/6·(A + A + 4·A_mid), exact since the section area is quadratic in
@@ -119,15 +135,7 @@ TEST(Sweep, TubeSurfaceIsWithinChordToleranceOfTheExactTube) {
     worst_vertex = std::max(worst_vertex, std::abs(distance_to_curve(c, d, res.mesh.vertices[i]) - r));
   EXPECT_LE(worst_vertex, 1e-6);  // vertices lie on the exact tube
   // Points inside the facets: within the chord tolerance of the exact tube.
-  double worst_facet = 0.0;
-  for (std::size_t t = 0; t < res.mesh.triangles.size(); ++t) {
-    const auto& f = res.mesh.triangles[t];
-    if (f[0] >= ring_vertices || f[1] >= ring_vertices || f[2] >= ring_vertices) continue;  // caps
-    const auto q = res.mesh.corners(t);
-    for (const Vec3& p : {Vec3((q[0] + q[1] + q[2]) / 3.0), Vec3(0.5 * (q[0] + q[1])), Vec3(0.5 * (q[1] + q[2])),
-                          Vec3(0.5 * (q[0] + q[2]))})
-      worst_facet = std::max(worst_facet, std::abs(distance_to_curve(c, d, p) - r));
-  }
+  const double worst_facet = worst_facet_error(c, d, res, r);
   EXPECT_LE(worst_facet, tol);
   EXPECT_GT(worst_facet, 0.05 * tol);  // and not absurdly finer than asked
 }
@@ -217,6 +225,27 @@ TEST(Sweep, ResolutionFollowsTheChordTolerance) {
   EXPECT_THROW(loom::sweep_tube(c, -1.0, {}), std::invalid_argument);
   EXPECT_THROW(loom::sweep_tube(c, std::nan(""), {}), std::invalid_argument);
   EXPECT_THROW(loom::sweep_tube(Centerline(), 1.0, {}), std::invalid_argument);
+}
+
+// Regression (2026-11-25, session 20): a route with 200,000 key points 10 nm apart made the
+// render's tube sweep place at least four rings per knot span (15 GB, 50 s). A run of
+// intervals that stays within half the axial tolerance of a straight tube is now crossed in
+// one step; the tube must stay within the chord tolerance of the exact one.
+TEST(Sweep, DenseKeyPointsAreCrossedInFewRingsWithinTolerance) {
+  auto route = [](int dense) {
+    std::vector<Vec3> pts;
+    auto at = [](double x) { return Vec3(x, 5.0 * std::sin(x / 30.0), 0.0); };
+    for (double x = 0.0; x < 40.0; x += 10.0) pts.push_back(at(x));
+    for (int i = 0; i <= dense; ++i) pts.push_back(at(40.0 + 2.0 * i / std::max(dense, 1)));
+    for (double x = 50.0; x <= 100.0; x += 10.0) pts.push_back(at(x));
+    return Centerline::interpolate(pts);
+  };
+  const Centerline packed = route(2000), sparse = route(1);
+  const double r = 1.0, tol = 0.01;
+  const loom::SweepResult rp = loom::sweep_tube(packed, r, {tol, true});
+  const loom::SweepResult rs = loom::sweep_tube(sparse, r, {tol, true});
+  EXPECT_LT(rp.rings, 2 * rs.rings) << "dense " << rp.rings << " sparse " << rs.rings;
+  EXPECT_LE(worst_facet_error(packed, dense(packed, 40000), rp, r), tol);
 }
 
 TEST(Sweep, CanalSurfaceTouchesEveryMovingSphere) {
