@@ -107,6 +107,7 @@ std::vector<std::string> attach_ports(const Harness& h, const std::vector<Part>&
 
 std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCable>& cables) {
   HarnessTopology topo(h);
+  SegmentCurves curves(topo);
   std::vector<CableInput> out;
   cables.clear();
   for (std::size_t c = 0; c < h.cables.size(); ++c) {
@@ -114,7 +115,7 @@ std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCa
     ac.id = h.cables[c].id;
     std::optional<Centerline> curve;
     try {
-      curve = cable_centerline(topo, static_cast<int>(c));
+      curve = curves.cable(static_cast<int>(c));
     } catch (const std::invalid_argument& e) {
       throw InputError({h.source_file, h.cables[c].line, "cable " + h.cables[c].id},
                        std::string("its route does not make a curve: ") + e.what());
@@ -154,7 +155,7 @@ std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCa
         in.junctions.push_back({n, *pos, rad});
       }
     }
-    for (auto& piece : cable_pieces(topo, static_cast<int>(c))) in.bend_pieces.emplace_back(piece.s0, std::move(piece.curve));
+    for (auto& piece : curves.pieces(static_cast<int>(c))) in.bend_pieces.emplace_back(piece.s0, std::move(piece.curve));
     ac.routed = true;
     ac.check_index = static_cast<int>(out.size());
     cables.push_back(ac);

@@ -85,29 +85,53 @@ double breakout_length(const HarnessTopology& topo, const std::string& node) {
   return len;
 }
 
-std::vector<CablePiece> cable_pieces(const HarnessTopology& topo, int cable) {
-  const Harness& h = topo.harness();
+SegmentCurves::SegmentCurves(const HarnessTopology& topo)
+    : topo_(topo), built_(topo.harness().segments.size(), {false, false}),
+      curves_(topo.harness().segments.size()) {}
+
+const std::optional<Centerline>& SegmentCurves::segment(int s, bool backwards) {
+  const std::size_t i = static_cast<std::size_t>(s);
+  const int b = backwards ? 1 : 0;
+  if (!built_.at(i)[b]) {
+    const std::optional<Centerline>& fwd = backwards ? segment(s, false) : curves_[i][0];
+    std::optional<Centerline> c = backwards ? (fwd ? std::optional<Centerline>(reversed(*fwd)) : std::nullopt)
+                                            : segment_centerline(topo_.harness(), s);
+    if (c) c->length();  // the arc-length table, built once here, travels with every copy
+    curves_[i][b] = std::move(c);
+    built_[i][b] = true;
+  }
+  return curves_[i][b];
+}
+
+std::vector<CablePiece> SegmentCurves::pieces(int cable) {
   std::vector<CablePiece> out;
   double s0 = 0.0;
-  for (const SegmentUse& u : topo.cable_chain(cable)) {
-    auto c = segment_centerline(h, u.segment);
+  for (const SegmentUse& u : topo_.cable_chain(cable)) {
+    const std::optional<Centerline>& c = segment(u.segment, u.reversed);
     if (!c) return {};
-    CablePiece p{u.segment, s0, u.reversed ? reversed(*c) : *c};
-    s0 += p.curve.length();
-    out.push_back(std::move(p));
+    out.push_back(CablePiece{u.segment, s0, *c});
+    s0 += out.back().curve.length();
   }
   return out;
 }
 
-std::optional<Centerline> cable_centerline(const HarnessTopology& topo, int cable) {
+std::optional<Centerline> SegmentCurves::cable(int cable) {
   std::optional<Centerline> out;
-  const auto pieces = cable_pieces(topo, cable);
+  const auto pieces = this->pieces(cable);
   if (pieces.empty()) return std::nullopt;
   for (const CablePiece& p : pieces) {
     Centerline cubic = as_cubic(p.curve);
     out = out ? join(*out, cubic) : cubic;
   }
   return out;
+}
+
+std::vector<CablePiece> cable_pieces(const HarnessTopology& topo, int cable) {
+  return SegmentCurves(topo).pieces(cable);
+}
+
+std::optional<Centerline> cable_centerline(const HarnessTopology& topo, int cable) {
+  return SegmentCurves(topo).cable(cable);
 }
 
 }  // namespace loom

@@ -195,8 +195,9 @@ Image render_scene(const Scene& scene, const Harness& harness, const nlohmann::j
   std::vector<std::size_t> tube_cable;
   AABB harness_box;
   const HarnessTopology topo(harness);
+  SegmentCurves curves(topo);
   for (std::size_t c = 0; c < harness.cables.size(); ++c) {
-    const auto cl = cable_centerline(topo, static_cast<int>(c));
+    const auto cl = curves.cable(static_cast<int>(c));
     const double r = harness.cables[c].radius();
     if (!cl || !(r > 0.0)) continue;
     SweepOptions so;

@@ -112,8 +112,9 @@ void write_route_outputs(const RouteReport& rep, const std::filesystem::path& di
   std::vector<std::array<std::uint8_t, 3>> colors;
   SweepOptions so;
   so.chord_tolerance = chord_tolerance;
+  SegmentCurves curves(topo);
   for (std::size_t c = 0; c < rep.routed.cables.size(); ++c) {
-    auto curve = cable_centerline(topo, static_cast<int>(c));
+    auto curve = curves.cable(static_cast<int>(c));
     if (!curve) continue;
     const SweepResult tube = sweep_tube(*curve, rep.routed.cables[c].radius(), so);
     all.append(tube.mesh);

@@ -214,10 +214,11 @@ std::string view_data_json(const Scene& scene, const Harness& harness, const nlo
   // Cables: sampled centerlines.
   s += "],\"cables\":[";
   const HarnessTopology topo(harness);
+  SegmentCurves curves(topo);
   for (std::size_t c = 0; c < harness.cables.size(); ++c) {
     const Cable& cab = harness.cables[c];
     std::vector<Vec3> pts;
-    if (auto cl = cable_centerline(topo, static_cast<int>(c))) {
+    if (auto cl = curves.cable(static_cast<int>(c))) {
       const double len = cl->length();
       const double spacing = len / static_cast<double>(std::max<std::size_t>(2, opt.max_cable_samples));
       if (spacing > 0.0)

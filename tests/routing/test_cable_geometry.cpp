@@ -96,5 +96,47 @@ TEST(CableGeometry, UnplacedBranchMeansNotRouted) {
   EXPECT_FALSE(cable_centerline(topo, 1).has_value());
 }
 
+TEST(CableGeometry, SegmentCurvesBuildEachDirectionOnceAndMatchTheSegmentCurve) {
+  Harness h = parse_harness_xml(kHarness, "h.xml");
+  HarnessTopology topo(h);
+  SegmentCurves curves(topo);
+  for (int s = 0; s < static_cast<int>(h.segments.size()); ++s) {
+    const auto want = segment_centerline(h, s);
+    const std::optional<Centerline>& fwd = curves.segment(s, false);
+    const std::optional<Centerline>& back = curves.segment(s, true);
+    ASSERT_TRUE(want && fwd && back);
+    EXPECT_EQ(&fwd, &curves.segment(s, false));  // cached, not rebuilt
+    EXPECT_EQ(&back, &curves.segment(s, true));
+    EXPECT_EQ(fwd->control_points(), want->control_points());
+    EXPECT_EQ(fwd->knots(), want->knots());
+    EXPECT_NEAR(back->length(), want->length(), 1e-9 * want->length());
+    for (double t : {0.0, 0.3, 1.0}) {
+      const double u = want->u_min() + t * (want->u_max() - want->u_min());
+      const double v = back->u_max() - (u - want->u_min());
+      EXPECT_LT((back->position(v) - want->position(u)).norm(), 1e-9);
+    }
+  }
+  // Cable curves through the cache are those of the free functions (C1 runs segment 0
+  // backwards, C2 segment 2), piece by piece.
+  for (int c = 0; c < 2; ++c) {
+    const auto a = curves.cable(c), b = cable_centerline(topo, c);
+    ASSERT_TRUE(a && b);
+    EXPECT_EQ(a->control_points(), b->control_points());
+    EXPECT_EQ(a->knots(), b->knots());
+    const auto pa = curves.pieces(c), pb = cable_pieces(topo, c);
+    ASSERT_EQ(pa.size(), pb.size());
+    for (std::size_t k = 0; k < pa.size(); ++k) {
+      EXPECT_EQ(pa[k].segment, pb[k].segment);
+      EXPECT_EQ(pa[k].s0, pb[k].s0);
+    }
+  }
+  h.branches[0].position.reset();  // unplaced: not routed, through the cache too
+  HarnessTopology unplaced(h);
+  SegmentCurves none(unplaced);
+  EXPECT_FALSE(none.segment(0, true).has_value());
+  EXPECT_FALSE(none.cable(1).has_value());
+  EXPECT_TRUE(none.pieces(1).empty());
+}
+
 }  // namespace
 }  // namespace loom
