@@ -32,6 +32,8 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 /// Default tolerance as a fraction of the smallest cable radius (DESIGN §7).
 constexpr double kDefaultToleranceOfRadius = 0.01;
+/// The tolerance reported when there is no cable to derive it from (nothing is checked).
+constexpr double kNoCableTolerance = 0.01;
 /// Default longest sphere-tracing step, in cable radii.
 constexpr double kDefaultMaxStepRadii = 50.0;
 /// Share of the tolerance left to the chords' distance from the curve; the rest covers the
@@ -1425,8 +1427,12 @@ const char* violation_kind_name(ViolationKind k) {
 double default_clash_tolerance(const std::vector<CableInput>& cables, std::string* source) {
   double rmin = kInf;
   for (const auto& c : cables) rmin = std::min(rmin, c.radius);
+  if (!std::isfinite(rmin)) {
+    if (source) *source = "no cables to derive it from";
+    return kNoCableTolerance;
+  }
   if (source) *source = "smallest cable radius / 100";
-  return std::isfinite(rmin) ? kDefaultToleranceOfRadius * rmin : 0.01;
+  return kDefaultToleranceOfRadius * rmin;
 }
 
 ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vector<Part>& parts,

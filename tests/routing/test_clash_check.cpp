@@ -545,6 +545,18 @@ TEST(ClashCheck, DenseKeyPointsAuditLikeTheOracleWithFewChords) {
   EXPECT_EQ(rd.clashes.size(), rs.clashes.size());
 }
 
+TEST(ClashCheck, DefaultToleranceSaysWhereItCameFrom) {
+  std::string source;
+  const std::vector<CableInput> cables{straight_cable("A", {0, 0, 0}, {10, 0, 0}, 2.0),
+                                       straight_cable("B", {0, 5, 0}, {10, 5, 0}, 0.5)};
+  EXPECT_DOUBLE_EQ(default_clash_tolerance(cables, &source), 0.005);
+  EXPECT_EQ(source, "smallest cable radius / 100");
+  // No cable: nothing is checked, and the report must not claim a derivation.
+  const double t = default_clash_tolerance({}, &source);
+  EXPECT_GT(t, 0.0);
+  EXPECT_EQ(source, "no cables to derive it from");
+}
+
 TEST(ClashCheck, DiscreteWithAndWithoutIndexAgree) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> U(-20, 20);
