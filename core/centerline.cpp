@@ -512,21 +512,18 @@ std::vector<Vec3> Centerline::hull_points(double a, double b) const {
   return out;
 }
 
-double Centerline::hull_deviation(double a, double b) const {
-  if (cps_.empty()) return 0.0;
-  const Vec3 pa = position(a), pb = position(b);
-  double worst2 = 0.0;
-  for (const Vec3& q : hull_points(a, b)) worst2 = std::max(worst2, point_segment_dist2(q, pa, pb));
-  return std::sqrt(worst2);
-}
-
-double Centerline::hull_turn_sine(double a, double b) const {
-  if (cps_.empty()) return 1.0;
-  const Vec3 chord = position(std::max(a, b)) - position(std::min(a, b));
-  const double len = chord.norm();
-  if (!(len > 0.0)) return 1.0;
-  const Vec3 dir = chord / len;
+Centerline::HullBounds Centerline::hull_bounds(double a, double b) const {
+  HullBounds out;
+  if (cps_.empty()) return out;
+  const Vec3 pa = position(std::min(a, b)), pb = position(std::max(a, b));
   const std::vector<Vec3> h = hull_points(a, b);
+  double worst2 = 0.0;
+  for (const Vec3& q : h) worst2 = std::max(worst2, point_segment_dist2(q, pa, pb));
+  out.deviation = std::sqrt(worst2);
+  const Vec3 chord = pb - pa;
+  const double len = chord.norm();
+  if (!(len > 0.0)) return out;  // turn_sine stays 1: no direction to compare with
+  const Vec3 dir = chord / len;
   const std::size_t stride = static_cast<std::size_t>(degree_ + 1);
   double worst = 0.0;
   for (std::size_t q = 0; q + 1 < h.size(); ++q) {
@@ -536,10 +533,11 @@ double Centerline::hull_turn_sine(double a, double b) const {
     const Vec3 d = h[q + 1] - h[q];
     const double n = d.norm();
     if (!(n > 0.0)) continue;
-    if (!(d.dot(dir) > 0.0)) return 1.0;  // C' may turn against the chord
+    if (!(d.dot(dir) > 0.0)) return out;  // C' may turn against the chord: turn_sine 1
     worst = std::max(worst, d.cross(dir).norm() / n);
   }
-  return worst;
+  out.turn_sine = worst;
+  return out;
 }
 
 // ---------------------------------------------------------------------------------------

@@ -139,16 +139,16 @@ class Centerline {
   double arc_length_at(double u) const;
   /// Inverse of arc_length_at: the u where the arc length from the start is s (clamped).
   double parameter_at_length(double s) const;
-  /// Upper bound on the distance of C(u), u ∈ [a, b] (clamped to the domain), from the
-  /// segment C(a)C(b), scene units: the largest distance from it of the control points that
-  /// act on [a, b] (each span lies in the convex hull of its p + 1 control points). Costs
-  /// one pass over those control points.
-  double hull_deviation(double a, double b) const;
-  /// Upper bound on the sine of the angle between the tangent C'(u), u ∈ [a, b], and the
-  /// chord from C(a) to C(b), from the differences of the control points acting on [a, b]
-  /// (C' lies in the convex hull of positive multiples of them); 1 if C' may vanish or turn
-  /// against the chord there.
-  double hull_turn_sine(double a, double b) const;
+  /// Bounds on C over [a, b] (clamped to the domain) from the convex hulls of its pieces'
+  /// Bézier points (hull_points), relative to the chord from C(a) to C(b).
+  struct HullBounds {
+    double deviation = 0.0;  ///< upper bound on the distance of C(u) from the chord, scene units
+    /// Upper bound on the sine of the angle between C'(u) and the chord; 1 if C' may vanish
+    /// or turn against it (the hodograph's Bézier points, differences of those above).
+    double turn_sine = 1.0;
+  };
+  /// Both bounds of HullBounds, from one pass over the pieces' Bézier points.
+  HullBounds hull_bounds(double a, double b) const;
   /// Points at equal arc spacing ≤ `spacing`, first and last included; with their s.
   std::vector<std::pair<double, Vec3>> sample_by_arc_length(double spacing) const;
   /// Smallest bend radius and where it occurs (dense search + local refinement); 0 at a

@@ -336,8 +336,8 @@ double deviation_chords(const Centerline& c, double a, double b, double eps) {
 /// cut uniformly in u into n chords that deviate at most eps from the curve and are no
 /// longer than hmax. A piece is one knot span, cut by the deviation bound above, or a run
 /// of consecutive short spans (each shorter than short_len) taken as one chord: the convex
-/// hull property puts each span inside the hull of its p + 1 control points, so the run
-/// lies within the largest distance of their control points from the chord, and where that
+/// hull property puts each piece inside the hull of its Bézier points, so the run lies
+/// within their largest distance from the chord (Centerline::hull_bounds), and where that
 /// is ≤ eps the one chord is certified. Why: key points far closer together than the cable
 /// is thick (a dense export, a scan) give thousands of spans within a few radii, one chord
 /// each at least, and every chord pair among them a broad-phase candidate; their hull shows
@@ -363,7 +363,7 @@ class ChordPlan {
         continue;
       }
       const std::size_t j = merged_end(i);
-      if (j > i + 1 || (j == i + 1 && short_span(i))) {
+      if (j > i) {  // a run of short spans (perhaps one) that is one chord
         piece(br_[i], br_[j], s(i), s(j), std::size_t(1));
         i = j;
         continue;
@@ -390,7 +390,7 @@ class ChordPlan {
     if (!(s(j) - s(i) <= hmax_)) return false;
     for (std::size_t k = i; k < j; ++k)
       if (!short_span(k)) return false;
-    return c_.hull_deviation(br_[i], br_[j]) <= eps_;
+    return c_.hull_bounds(br_[i], br_[j]).deviation <= eps_;
   }
 
   /// A j > i with one_chord(i, j), by doubling the run from i + 1 while the test passes

@@ -297,13 +297,14 @@ double sections(const Centerline& c, const RadiusFn& radius_at, bool variable_ra
     // Hull jump. Why: key points far closer together than the tube is thick (a dense export)
     // make knot intervals so short that a quarter of one is a needless ring, millions of
     // them per cable. Where such intervals lie within half the axial tolerance of the chord
-    // to a breakpoint ahead (hull_deviation) and every tangent there leans from the chord by
-    // less than that much at the tube's radius (hull_turn_sine), the canal surface over them
+    // to a breakpoint ahead and every tangent there leans from the chord by less than that
+    // much at the tube's radius (Centerline::hull_bounds), the canal surface over them
     // is within the axial tolerance of a straight tube: one step crosses them all.
     if (!variable_radius && bpi + 2 < bp.size() && span_w * speed0 < kShortIntervalRadii * r0) {
       auto straight_to = [&](std::size_t j) {
-        return bp[j] > u + du && c.hull_deviation(u, bp[j]) <= 0.5 * tol_axial &&
-               r0 * c.hull_turn_sine(u, bp[j]) <= 0.5 * tol_axial;
+        if (!(bp[j] > u + du)) return false;
+        const Centerline::HullBounds hb = c.hull_bounds(u, bp[j]);
+        return hb.deviation <= 0.5 * tol_axial && r0 * hb.turn_sine <= 0.5 * tol_axial;
       };
       // Doubling from the second breakpoint ahead while the test passes (no bisection after
       // the first failure: the next step starts there); `ok` is the farthest passed, 0: none.

@@ -267,18 +267,18 @@ TEST(Centerline, HullBoundsAreZeroOnAStraightRunAndHoldOnAnArc) {
   for (int i = 0; i <= 50; ++i) line.emplace_back(1.0 + 2.0 * i, -3.0 + 1.0 * i, 0.5 * i);
   const Centerline straight = Centerline::interpolate(line);
   const double a = straight.key_parameters()[3], b = straight.key_parameters()[40];
-  EXPECT_LE(straight.hull_deviation(a, b), 1e-12 * straight.length());
-  EXPECT_LE(straight.hull_turn_sine(a, b), 1e-12);
+  EXPECT_LE(straight.hull_bounds(a, b).deviation, 1e-12 * straight.length());
+  EXPECT_LE(straight.hull_bounds(a, b).turn_sine, 1e-12);
   // A half circle of radius 10: its middle stands 10 off the chord, its ends are
   // perpendicular to it.
   std::vector<Vec3> arc;
   for (int i = 0; i <= 16; ++i) arc.emplace_back(10.0 * std::cos(M_PI * i / 16), 10.0 * std::sin(M_PI * i / 16), 0.0);
   const Centerline half = Centerline::interpolate(arc);
-  EXPECT_GE(half.hull_deviation(half.u_min(), half.u_max()), 10.0 * (1 - 1e-3));
-  EXPECT_GE(half.hull_turn_sine(half.u_min(), half.u_max()), 0.99);  // end tangents near ⟂ the chord
+  EXPECT_GE(half.hull_bounds(half.u_min(), half.u_max()).deviation, 10.0 * (1 - 1e-3));
+  EXPECT_GE(half.hull_bounds(half.u_min(), half.u_max()).turn_sine, 0.99);  // end tangents near ⟂ the chord
   const double q = half.key_parameters()[4];
-  EXPECT_GT(half.hull_turn_sine(half.u_min(), q), 0.3);
-  EXPECT_LT(half.hull_turn_sine(half.u_min(), q), 1.0);
+  EXPECT_GT(half.hull_bounds(half.u_min(), q).turn_sine, 0.3);
+  EXPECT_LT(half.hull_bounds(half.u_min(), q).turn_sine, 1.0);
 }
 
 TEST(Centerline, ArcLengthTableIsBuiltOnceOnFirstUseAndTravelsWithCopies) {
@@ -599,7 +599,8 @@ RC_GTEST_PROP(CenterlineProperty, HullBoundsHoldOnDenseSamples, ()) {
   const double b = c.u_min() + (c.u_max() - c.u_min()) * std::max(t0, t1);
   RC_PRE(b > a);
   const Vec3 pa = c.position(a), pb = c.position(b);
-  const double dev = c.hull_deviation(a, b), turn = c.hull_turn_sine(a, b);
+  const Centerline::HullBounds hb = c.hull_bounds(a, b);
+  const double dev = hb.deviation, turn = hb.turn_sine;
   const double scale = scale_of(distinct);
   const Vec3 chord = pb - pa;
   for (int k = 0; k <= 256; ++k) {
