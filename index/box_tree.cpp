@@ -1,6 +1,8 @@
 // Box BVH with Embree user geometry: point queries for overlap, rtcCollide for pairs.
 #include "index/box_tree.hpp"
 
+#include <atomic>
+
 #include <embree3/rtcore.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_sort.h>
@@ -88,23 +90,55 @@ void bounds_function(const RTCBoundsFunctionArguments* args) {
 struct OverlapQuery {
   const BoxTree::Impl* im = nullptr;
   AABB query;
-  std::vector<std::uint32_t>* out = nullptr;
+  std::vector<std::uint32_t>* out = nullptr;  ///< null: count only
+  std::size_t count = 0;                      ///< boxes found (counting)
+  std::size_t cap = std::numeric_limits<std::size_t>::max();
 };
 
 bool overlap_callback(RTCPointQueryFunctionArguments* args) {
   auto* q = static_cast<OverlapQuery*>(args->userPtr);
+  if (q->count >= q->cap) return false;
   const std::uint32_t i = q->im->ids[args->primID];
-  if (boxes_overlap(q->im->boxes[i], q->query)) q->out->push_back(i);
-  return false;  // the search sphere never shrinks: every overlapping box is wanted
+  if (!boxes_overlap(q->im->boxes[i], q->query)) return false;
+  if (q->out) {
+    q->out->push_back(i);
+    return false;  // the search sphere never shrinks: every overlapping box is wanted
+  }
+  if (++q->count < q->cap) return false;
+  args->query->radius = 0.0f;  // enough counted: let the traversal end
+  return true;
+}
+
+/// Runs q over the tree: a point query whose sphere holds q.query.
+void run_overlap_query(const BoxTree::Impl& im, OverlapQuery& q) {
+  // The sphere around the query's centre through its corners holds the query box; its
+  // radius is padded for the float rounding of the centre (relative to the larger of the
+  // centre's and the radius' magnitude) so that no overlapping float box is culled.
+  const Vec3 c = q.query.center() - im.centre;
+  const double half = 0.5 * q.query.diagonal();
+  const double pad = 4.0 * kRelPad * (c.cwiseAbs().maxCoeff() + half) + kMinPad;
+  RTCPointQuery pq;
+  pq.x = static_cast<float>(c.x());
+  pq.y = static_cast<float>(c.y());
+  pq.z = static_cast<float>(c.z());
+  pq.time = 0.0f;
+  pq.radius = std::nextafter(static_cast<float>(half + pad), std::numeric_limits<float>::infinity());
+  RTCPointQueryContext ctx;
+  rtcInitPointQueryContext(&ctx);
+  rtcPointQuery(im.scene, &pq, &ctx, overlap_callback, &q);
 }
 
 struct CollideState {
   const BoxTree::Impl* im = nullptr;
+  const BoxTree::PairFilter* filter = nullptr;
+  std::atomic<std::size_t> kept{0};
+  std::atomic<bool> overflow{false};
   tbb::enumerable_thread_specific<std::vector<BoxPair>> found;
 };
 
 void collide_callback(void* user, RTCCollision* collisions, unsigned count) {
   auto* st = static_cast<CollideState*>(user);
+  if (st->overflow.load(std::memory_order_relaxed)) return;  // Embree cannot be stopped: skip
   const BoxTree::Impl& im = *st->im;
   std::vector<BoxPair>& out = st->found.local();
   for (unsigned k = 0; k < count; ++k) {
@@ -112,7 +146,13 @@ void collide_callback(void* user, RTCCollision* collisions, unsigned count) {
     // One scene against itself: Embree visits every ordered pair of overlapping leaves, so
     // (i, j) and (j, i) both arrive; keeping i < j reports each pair once. Leaves pair all
     // their primitives, so most candidates fail the exact box test.
-    if (i < j && boxes_overlap(im.boxes[i], im.boxes[j])) out.emplace_back(i, j);
+    if (!(i < j && boxes_overlap(im.boxes[i], im.boxes[j]))) continue;
+    if (st->filter->keep && !st->filter->keep(i, j)) continue;
+    if (st->kept.fetch_add(1, std::memory_order_relaxed) >= st->filter->max_pairs) {
+      st->overflow.store(true, std::memory_order_relaxed);
+      return;
+    }
+    out.emplace_back(i, j);
   }
 }
 
@@ -167,38 +207,41 @@ void BoxTree::overlapping(const AABB& query, std::vector<std::uint32_t>& out) co
   check_box(query, "query");
   const Impl& im = *impl_;
   if (box_is_unset(query) || im.ids.empty()) return;
-  // The sphere around the query's centre through its corners holds the query box; its
-  // radius is padded for the float rounding of the centre (relative to the larger of the
-  // centre's and the radius' magnitude) so that no overlapping float box is culled.
-  const Vec3 c = query.center() - im.centre;
-  const double half = 0.5 * query.diagonal();
-  const double pad = 4.0 * kRelPad * (c.cwiseAbs().maxCoeff() + half) + kMinPad;
-  RTCPointQuery pq;
-  pq.x = static_cast<float>(c.x());
-  pq.y = static_cast<float>(c.y());
-  pq.z = static_cast<float>(c.z());
-  pq.time = 0.0f;
-  pq.radius = std::nextafter(static_cast<float>(half + pad), std::numeric_limits<float>::infinity());
-  RTCPointQueryContext ctx;
-  rtcInitPointQueryContext(&ctx);
   OverlapQuery q;
   q.im = &im;
   q.query = query;
   q.out = &out;
-  rtcPointQuery(im.scene, &pq, &ctx, overlap_callback, &q);
+  run_overlap_query(im, q);
   // Leaves report their primitives in tree order; callers want a stable, ascending list.
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
 }
 
-std::vector<BoxPair> BoxTree::self_pairs() const {
+std::size_t BoxTree::count_overlapping(const AABB& query, std::size_t cap) const {
+  check_box(query, "query");
+  const Impl& im = *impl_;
+  if (box_is_unset(query) || im.ids.empty() || cap == 0) return 0;
+  OverlapQuery q;
+  q.im = &im;
+  q.query = query;
+  q.cap = cap;
+  run_overlap_query(im, q);
+  return std::min(q.count, cap);
+}
+
+std::vector<BoxPair> BoxTree::self_pairs() const { return self_pairs(PairFilter{}); }
+
+std::vector<BoxPair> BoxTree::self_pairs(const PairFilter& filter) const {
   std::vector<BoxPair> pairs;
   const Impl& im = *impl_;
   if (im.ids.size() < 2) return pairs;
   CollideState state;
   state.im = &im;
+  state.filter = &filter;
   rtcCollide(im.scene, im.scene, collide_callback, &state);
   if (!im.error.empty()) throw std::runtime_error("box tree: " + im.error);
+  if (state.overflow)
+    throw std::length_error("box tree: more than " + std::to_string(filter.max_pairs) + " overlapping pairs kept");
   std::size_t total = 0;
   for (const auto& v : state.found) total += v.size();
   pairs.reserve(total);

@@ -5,6 +5,7 @@
 #include "core/geometry.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <utility>
@@ -51,9 +52,24 @@ class BoxTree {
   /// std::invalid_argument if the query is not finite.
   void overlapping(const AABB& query, std::vector<std::uint32_t>& out) const;
 
+  /// The number of boxes that overlap the closed box `query` (as overlapping() would list
+  /// them), or `cap` if there are at least that many: the traversal stops there. Throws
+  /// std::invalid_argument if the query is not finite.
+  std::size_t count_overlapping(const AABB& query, std::size_t cap) const;
+
   /// Every pair {i, j}, i < j, of overlapping boxes, sorted, without duplicates (Embree's
   /// rtcCollide of the tree with itself). Runs on the calling thread's TBB arena.
   std::vector<BoxPair> self_pairs() const;
+
+  /// Which overlapping pairs self_pairs keeps, and how many at most.
+  struct PairFilter {
+    /// Called (from any thread) for each overlapping pair i < j; false drops it. Empty: keep all.
+    std::function<bool(std::uint32_t, std::uint32_t)> keep;
+    /// Most pairs kept; beyond it self_pairs stops storing and throws std::length_error.
+    std::size_t max_pairs = std::numeric_limits<std::size_t>::max();
+  };
+  /// As self_pairs(), keeping the pairs `filter` keeps (memory follows the kept pairs).
+  std::vector<BoxPair> self_pairs(const PairFilter& filter) const;
 
   /// The boxes, their float copies and the Embree scene (public for the callbacks in the
   /// .cpp; not part of the API). Held by pointer so that its address, which Embree keeps,

@@ -3,7 +3,6 @@
 #include "routing/clash_check.hpp"
 
 #include "core/error.hpp"
-#include "index/box_pairs.hpp"
 #include "index/box_tree.hpp"
 #include "index/triangle_distance.hpp"
 
@@ -15,11 +14,13 @@
 #include <atomic>
 #include <cmath>
 #include <functional>
+#include <tuple>
 #include <limits>
 #include <optional>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <random>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -55,6 +56,15 @@ constexpr double kShortSpanRadii = 0.25;
 constexpr double kMaxChordsPerCable = 1e7;
 /// Chords per block in the cable–cable narrow phase.
 constexpr std::size_t kBlock = 8;
+/// Blocks drawn (fixed seed) to estimate the broad phase's overlapping pairs; with fewer
+/// blocks all are counted. The estimate's relative standard error is ~1/√(blocks drawn
+/// that overlap many), well under the factor the limits leave to spare.
+constexpr std::size_t kOverlapSampleBlocks = 1024;
+/// Seed of that draw (the estimate, and so a refusal, is reproducible).
+constexpr std::uint64_t kOverlapSampleSeed = 0x6c6f6f6d;  // "loom"
+/// Smallest cap on one drawn block's counted overlaps (the cap is 4 · max_block_overlaps /
+/// blocks, at least this): a block in a large bundle meets a few blocks of every cable in it.
+constexpr std::size_t kMinOverlapCountCap = 1000;
 /// Arc-length slack (relative to the cable length) when deciding that two chord or sample
 /// intervals touch.
 constexpr double kTouchRel = 1e-9;
@@ -73,6 +83,8 @@ std::int64_t as_i64(std::size_t v) { return static_cast<std::int64_t>(v); }
 /// Work counters shared by the worker threads.
 struct AtomicCounters {
   std::atomic<std::int64_t> distance{0}, inside{0}, pairs{0}, samples{0}, deferred{0}, deferred_measured{0};
+  // Written once, by the cable–cable pass.
+  std::atomic<std::int64_t> block_overlaps_estimate{0}, block_pairs{0}, pair_contacts{0};
   /// Adds a thread's local counts (one atomic add per counter, not one per query).
   void add(const ClashCounters& c) {
     distance += c.distance_queries;
@@ -90,6 +102,9 @@ struct AtomicCounters {
     c.samples = samples.load();
     c.deferred_chords = deferred.load();
     c.deferred_measured = deferred_measured.load();
+    c.block_overlaps_estimate = block_overlaps_estimate.load();
+    c.block_pairs = block_pairs.load();
+    c.pair_contacts = pair_contacts.load();
     return c;
   }
 };
@@ -1006,13 +1021,25 @@ struct PairContact {
 };
 
 /// One entry per connected group of contacts (intervals touching on both cables).
+/// Contacts of one cable pair are taken in cells of equal interval on cable a; within a
+/// cell, contacts whose b-intervals touch are chained by a sweep over tb0, giving disjoint
+/// b-ranges; cells whose a-intervals touch then join the ranges that overlap, by a merge of
+/// the two sorted lists. Why not every pair of contacts: a cable folding back on itself
+/// gives each chord thousands of contacts, and comparing them pairwise took a minute.
 void group_pair_contacts(std::vector<PairContact>& contacts, const std::vector<CableInput>& cables,
                          std::vector<ClashEntry>& out) {
   std::sort(contacts.begin(), contacts.end(), [](const PairContact& x, const PairContact& y) {
-    if (x.a != y.a) return x.a < y.a;
-    if (x.b != y.b) return x.b < y.b;
-    return x.sa0 < y.sa0;
+    return std::tie(x.a, x.b, x.sa0, x.sa1, x.tb0) < std::tie(y.a, y.b, y.sa0, y.sa1, y.tb0);
   });
+  /// A run of contacts of one cell whose b-intervals touch: their b-range and one member.
+  struct Range {
+    double lo, hi;
+    std::size_t member;
+  };
+  struct Cell {
+    double sa0, sa1;
+    std::vector<Range> ranges;  ///< disjoint, by lo
+  };
   std::size_t i = 0;
   while (i < contacts.size()) {
     std::size_t j = i;
@@ -1020,21 +1047,41 @@ void group_pair_contacts(std::vector<PairContact>& contacts, const std::vector<C
     const std::size_t n = j - i;
     std::vector<std::size_t> parent(n);
     std::iota(parent.begin(), parent.end(), 0);
-    std::function<std::size_t(std::size_t)> find = [&](std::size_t x) {
+    auto find = [&](std::size_t x) {
       while (parent[x] != x) x = parent[x] = parent[parent[x]];
       return x;
     };
+    auto unite = [&](std::size_t x, std::size_t y) { parent[find(x)] = find(y); };
     const double slack_a = kTouchRel * (1.0 + cables[contacts[i].a].curve.length());
     const double slack_b = kTouchRel * (1.0 + cables[contacts[i].b].curve.length());
-    for (std::size_t x = 0; x < n; ++x) {
-      const PairContact& cx = contacts[i + x];
-      for (std::size_t y = x + 1; y < n; ++y) {
-        const PairContact& cy = contacts[i + y];
-        if (cy.sa0 > cx.sa1 + slack_a) break;  // sorted by sa0: nothing later touches x on a
-        const bool touch_b = cy.tb0 <= cx.tb1 + slack_b && cx.tb0 <= cy.tb1 + slack_b;
-        if (touch_b) parent[find(x)] = find(y);
+    std::vector<Cell> cells;
+    for (std::size_t x = 0; x < n;) {
+      const PairContact& first = contacts[i + x];
+      Cell cell{first.sa0, first.sa1, {}};
+      std::size_t y = x;
+      for (; y < n && contacts[i + y].sa0 == first.sa0 && contacts[i + y].sa1 == first.sa1; ++y) {
+        const PairContact& cy = contacts[i + y];  // sorted by tb0 within the cell
+        if (!cell.ranges.empty() && cy.tb0 <= cell.ranges.back().hi + slack_b) {
+          unite(y, cell.ranges.back().member);
+          cell.ranges.back().hi = std::max(cell.ranges.back().hi, cy.tb1);
+        } else {
+          cell.ranges.push_back({cy.tb0, cy.tb1, y});
+        }
       }
+      cells.push_back(std::move(cell));
+      x = y;
     }
+    // Cells are sorted by sa0: the ones touching cell c on a follow it until one starts
+    // beyond its end.
+    for (std::size_t c = 0; c < cells.size(); ++c)
+      for (std::size_t d = c + 1; d < cells.size() && cells[d].sa0 <= cells[c].sa1 + slack_a; ++d) {
+        const auto& rc = cells[c].ranges;
+        const auto& rd = cells[d].ranges;
+        for (std::size_t u = 0, v = 0; u < rc.size() && v < rd.size();) {
+          if (rc[u].lo <= rd[v].hi + slack_b && rd[v].lo <= rc[u].hi + slack_b) unite(rc[u].member, rd[v].member);
+          (rc[u].hi < rd[v].hi ? u : v) += 1;  // drop the range that ends first
+        }
+      }
     std::map<std::size_t, std::size_t> best;  // root → index of deepest
     std::map<std::size_t, std::pair<double, double>> range;
     for (std::size_t x = 0; x < n; ++x) {
@@ -1137,6 +1184,57 @@ std::int64_t narrow_phase(const Context& ctx, const CableChords& A, std::size_t 
   return tests;
 }
 
+/// Why the pair passes refuse an audit that reaches a ClashLimits limit.
+const char* const kFoldBack = "a route folds back on itself or runs over another along great lengths";
+
+/// Refuses the audit: more pairs of `what` (chords, samples) in contact than
+/// ClashLimits::max_pair_contacts; `c` is one of them.
+[[noreturn]] void refuse_contacts(const Context& ctx, const PairContact& c, const char* what) {
+  const std::string among = c.a == c.b ? "cable '" + ctx.cables[c.a].id + "' with itself"
+                                       : "cables '" + ctx.cables[c.a].id + "' and '" + ctx.cables[c.b].id + "'";
+  throw std::invalid_argument("check_clashes: more than " +
+                              full_precision(static_cast<double>(ctx.req.limits.max_pair_contacts)) + " pairs of " +
+                              what + " are in contact (" + among + " among them): " + kFoldBack);
+}
+
+/// The broad phase's overlapping box pairs, estimated before Embree enumerates them.
+struct OverlapEstimate {
+  double pairs = 0.0;     ///< estimated unordered pairs {i, j}, i ≠ j, of overlapping boxes
+  std::size_t worst = 0;  ///< the counted box with the most overlaps (for the message)
+};
+
+/// Estimates the overlapping pairs among `boxes` (indexed by `tree`) from at most
+/// kOverlapSampleBlocks of them drawn with a fixed seed, each counting its overlaps up to a
+/// cap that lets the estimate reach twice `budget`; exact (up to the cap) when all are
+/// counted. Why a sample: counting every box's overlaps costs what enumerating them does.
+OverlapEstimate estimate_overlaps(const BoxTree& tree, const std::vector<AABB>& boxes, std::size_t budget,
+                                  int threads) {
+  OverlapEstimate est;
+  const std::size_t n = boxes.size();
+  if (n < 2) return est;
+  std::vector<std::size_t> drawn(std::min(n, kOverlapSampleBlocks));
+  if (drawn.size() == n) {
+    std::iota(drawn.begin(), drawn.end(), std::size_t{0});
+  } else {
+    std::mt19937_64 rng(kOverlapSampleSeed);
+    std::uniform_int_distribution<std::size_t> pick(0, n - 1);
+    for (std::size_t& k : drawn) k = pick(rng);
+  }
+  const std::size_t cap = std::max(kMinOverlapCountCap, 4 * (budget / n + 1));
+  std::vector<std::size_t> count(drawn.size());
+  parallel_indices(drawn.size(), threads,
+                   [&](std::size_t k) { count[k] = tree.count_overlapping(boxes[drawn[k]], cap); });
+  double sum = 0.0;
+  for (std::size_t k = 0; k < drawn.size(); ++k) {
+    sum += static_cast<double>(count[k] > 0 ? count[k] - 1 : 0);  // a box overlaps itself
+    if (count[k] > count[est.worst]) est.worst = k;
+  }
+  est.worst = drawn[est.worst];
+  // Each pair is counted from both its boxes.
+  est.pairs = 0.5 * sum * static_cast<double>(n) / static_cast<double>(drawn.size());
+  return est;
+}
+
 /// Block pairs handed to one narrow-phase task (amortises task and lock overhead).
 constexpr std::size_t kPairsPerTask = 256;
 
@@ -1156,14 +1254,61 @@ void certified_cable_pairs(Context& ctx, std::vector<ClashEntry>& out) {
       blocks.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(b)});
       boxes.push_back(cc[i].blocks[b]);
     }
-  std::vector<BoxPair> pairs = overlapping_box_pairs(boxes, ctx.req.threads);
-  // Keep the kinds asked for; a block against itself (self check) is not a box pair.
-  pairs.erase(std::remove_if(pairs.begin(), pairs.end(),
-                             [&](const BoxPair& pr) {
-                               const bool same = blocks[pr.first].cable == blocks[pr.second].cable;
-                               return same ? !ctx.req.check_self : !ctx.req.check_cable_cable;
-                             }),
-              pairs.end());
+  // Arc-length range of a block and the one harness segment it lies in (−1: several).
+  auto block_s = [&](const BlockRef& r) {
+    const Chords& ch = cc[r.cable].ch;
+    return std::make_pair(ch.s[r.block * kBlock], ch.s[std::min(ch.size(), (r.block + 1) * kBlock)]);
+  };
+  std::vector<int> block_segment(blocks.size());
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    const auto [s0, s1] = block_s(blocks[k]);
+    const CableInput& c = ctx.cables[blocks[k].cable];
+    const int seg = segment_at(c, s0);
+    block_segment[k] = seg >= 0 && seg == segment_at(c, s1) ? seg : -1;
+  }
+  // Keep the kinds asked for, and only pairs with a contact that could count: not two
+  // cables' blocks both inside one harness segment (bundled there on purpose: every
+  // contact is excused), not a cable's blocks closer in s than π r. Why here: a large
+  // bundle puts every block beside the blocks of every other cable in it.
+  BoxTree::PairFilter filter;
+  filter.keep = [&](std::uint32_t i, std::uint32_t j) {
+    const BlockRef& x = blocks[i];
+    const BlockRef& y = blocks[j];
+    if (x.cable == y.cable) {
+      if (!ctx.req.check_self) return false;
+      const auto [a0, a1] = block_s(x);
+      const auto [b0, b1] = block_s(y);
+      return std::max(std::abs(b1 - a0), std::abs(a1 - b0)) >= M_PI * ctx.cables[x.cable].radius;
+    }
+    return ctx.req.check_cable_cable && !(block_segment[i] >= 0 && block_segment[i] == block_segment[j]);
+  };
+  // Bound the broad phase's own time first: Embree enumerates every overlapping pair,
+  // kept or not, and cannot be stopped.
+  const ClashLimits& lim = ctx.req.limits;
+  filter.max_pairs = lim.max_block_pairs;
+  std::vector<BoxPair> pairs;
+  {
+    std::unique_ptr<BoxTree> tree;
+    tbb::task_arena arena(ctx.req.threads > 0 ? ctx.req.threads : tbb::task_arena::automatic);
+    arena.execute([&] { tree = std::make_unique<BoxTree>(boxes); });
+    const OverlapEstimate est = estimate_overlaps(*tree, boxes, lim.max_block_overlaps, ctx.req.threads);
+    ctx.counters.block_overlaps_estimate = static_cast<std::int64_t>(std::llround(std::min(est.pairs, 9e18)));
+    if (est.pairs > static_cast<double>(lim.max_block_overlaps))
+      throw std::invalid_argument("check_clashes: about " + full_precision(std::round(est.pairs)) +
+                                  " pairs of chord blocks come within reach of each other (limit " +
+                                  full_precision(static_cast<double>(lim.max_block_overlaps)) + "; cable '" +
+                                  ctx.cables[blocks[est.worst].cable].id + "' among them): " + kFoldBack);
+    try {
+      arena.execute([&] { pairs = tree->self_pairs(filter); });
+    } catch (const std::length_error&) {
+      throw std::invalid_argument("check_clashes: more than " +
+                                  full_precision(static_cast<double>(lim.max_block_pairs)) +
+                                  " pairs of chord blocks of different cables, or of one cable πr apart, come "
+                                  "within reach of each other: " +
+                                  kFoldBack);
+    }
+    ctx.counters.block_pairs = as_i64(pairs.size());
+  }
   if (ctx.req.check_self)
     for (std::uint32_t i = 0; i < blocks.size(); ++i) pairs.emplace_back(i, i);
   std::mutex mu;
@@ -1181,8 +1326,10 @@ void certified_cable_pairs(Context& ctx, std::vector<ClashEntry>& out) {
     if (!local.empty()) {
       std::lock_guard<std::mutex> lock(mu);
       contacts.insert(contacts.end(), local.begin(), local.end());
+      if (contacts.size() > lim.max_pair_contacts) refuse_contacts(ctx, local.front(), "chords");
     }
   });
+  ctx.counters.pair_contacts = as_i64(contacts.size());
   group_pair_contacts(contacts, ctx.cables, out);
 }
 
@@ -1308,6 +1455,12 @@ void discrete_cable_pairs(Context& ctx, const std::vector<DiscreteSamples>& ds, 
     if (!self && excused(cables[a], s, p, cables[b], t, q)) return;
     const double ha = ds[a].spacing, hb = ds[b].spacing;
     local.push_back(PairContact::ordered(a, s, s - ha, s + ha, p, b, t, t - hb, t + hb, q, d));
+    if (local.size() > ctx.req.limits.max_pair_contacts) refuse_contacts(ctx, local.back(), "samples");
+  };
+  auto merge = [&](std::vector<PairContact>& local) {
+    std::lock_guard<std::mutex> lock(mu);
+    contacts.insert(contacts.end(), local.begin(), local.end());
+    if (contacts.size() > ctx.req.limits.max_pair_contacts) refuse_contacts(ctx, local.back(), "samples");
   };
   auto want = [&](int a, int b) { return a == b ? ctx.req.check_self : ctx.req.check_cable_cable; };
   if (!ctx.req.use_index) {
@@ -1326,8 +1479,7 @@ void discrete_cable_pairs(Context& ctx, const std::vector<DiscreteSamples>& ds, 
         }
       }
       ctx.counters.pairs += tests;
-      std::lock_guard<std::mutex> lock(mu);
-      contacts.insert(contacts.end(), local.begin(), local.end());
+      if (!local.empty()) merge(local);
     });
   } else {
     // Uniform grid of samples, cell = the largest contact distance.
@@ -1348,6 +1500,30 @@ void discrete_cable_pairs(Context& ctx, const std::vector<DiscreteSamples>& ds, 
     std::unordered_map<std::array<std::int64_t, 3>, std::vector<std::pair<int, std::size_t>>, KeyHash> grid;
     for (std::size_t c = 0; c < cables.size(); ++c)
       for (std::size_t k = 0; k < ds[c].p.size(); ++k) grid[key(ds[c].p[k])].emplace_back(static_cast<int>(c), k);
+    // Bound the work before doing it: every sample (and midpoint) meets the samples of the
+    // 27 cells around its own. Routes stay far below the limit; one folding back on itself
+    // thousands of times packs its samples into a few cells.
+    double candidates = 0.0, worst = -1.0;
+    int worst_cable = 0;  // a cable in the most crowded neighbourhood, for the message
+    for (const auto& [k, members] : grid) {
+      double near = 0.0;
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dz = -1; dz <= 1; ++dz) {
+            const auto it = grid.find({k[0] + dx, k[1] + dy, k[2] + dz});
+            if (it != grid.end()) near += static_cast<double>(it->second.size());
+          }
+      candidates += 2.0 * static_cast<double>(members.size()) * near;
+      if (near > worst) {
+        worst = near;
+        worst_cable = members.front().first;
+      }
+    }
+    if (candidates > static_cast<double>(ctx.req.limits.max_sample_pairs))
+      throw std::invalid_argument("check_clashes: the discrete method would compare about " +
+                                  full_precision(std::round(candidates)) + " pairs of samples (limit " +
+                                  full_precision(static_cast<double>(ctx.req.limits.max_sample_pairs)) + "; cable '" +
+                                  cables[worst_cable].id + "' among them): " + kFoldBack);
     parallel_indices(cables.size(), ctx.req.threads, [&](std::size_t ai) {
       const int a = static_cast<int>(ai);
       std::vector<PairContact> local;
@@ -1371,10 +1547,10 @@ void discrete_cable_pairs(Context& ctx, const std::vector<DiscreteSamples>& ds, 
         }
       }
       ctx.counters.pairs += tests;
-      std::lock_guard<std::mutex> lock(mu);
-      contacts.insert(contacts.end(), local.begin(), local.end());
+      if (!local.empty()) merge(local);
     });
   }
+  ctx.counters.pair_contacts = as_i64(contacts.size());
   group_pair_contacts(contacts, cables, out);
 }
 

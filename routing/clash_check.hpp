@@ -85,6 +85,28 @@ struct CableInput {
   std::vector<PartAttachment> attachments;
 };
 
+/// Work the cable–cable and self passes may take on before it refuses the audit
+/// (std::invalid_argument, exit 2) instead of running for hours or out of memory. Routed
+/// harnesses stay far below them (the bench's 10× scene, 1,000 cables: 6·10⁴ overlapping
+/// block pairs and at most 1.6·10⁴ contacts); a route that folds back on itself or over
+/// another cable thousands of times reaches them (2,000 zigzags of a 50 mm route on the
+/// wing harness ran out of 24 GB before them, and is refused in 0.7 s with them).
+struct ClashLimits {
+  /// Most overlapping pairs of chord-block boxes (8 chords each) the broad phase may have
+  /// to enumerate, estimated before it runs from a fixed-seed sample of the blocks (the
+  /// enumeration itself cannot be stopped).
+  std::size_t max_block_overlaps = 50'000'000;
+  /// Most block pairs kept for the narrow phase (64 exact segment distances each).
+  std::size_t max_block_pairs = 5'000'000;
+  /// Most chord (certified) or sample (discrete, also without an index) pairs in contact
+  /// kept for grouping into stretches (~112 bytes each).
+  std::size_t max_pair_contacts = 4'000'000;
+  /// Discrete method with an index: most sample pairs its grid may hand to the distance
+  /// test (counted from the grid's occupancy before testing; a few ns each). The
+  /// brute-force baseline (no index) compares every pair by design and is not limited.
+  std::size_t max_sample_pairs = 4'000'000'000;
+};
+
 /// Everything the checker needs to know. Tolerances are named, documented and derived
 /// from the cables when left at 0 (DESIGN §7).
 struct ClashRequest {
@@ -119,6 +141,8 @@ struct ClashRequest {
   /// sample positions, and so the last digits of a report, depend on ε. 0 = exact queries
   /// (then cut_short_queries changes nothing in the report). Must be finite and ≥ 0.
   double distance_rel_error = 0.25;
+  /// Work limits of the cable–cable and self passes (see ClashLimits).
+  ClashLimits limits;
   /// Worker threads (≤ 0: all cores).
   int threads = 0;
   bool check_structure = true;    ///< cable–structure clashes and clearance violations
@@ -190,6 +214,12 @@ struct ClashCounters {
   /// deepest point of their stretch). Not in report.json.
   std::int64_t deferred_chords = 0;
   std::int64_t deferred_measured = 0;
+  /// Certified cable–cable and self pass, against ClashLimits: the estimated overlapping
+  /// chord-block pairs, the block pairs kept for the narrow phase, the chord pairs in
+  /// contact. Not in report.json.
+  std::int64_t block_overlaps_estimate = 0;
+  std::int64_t block_pairs = 0;
+  std::int64_t pair_contacts = 0;
 };
 
 /// The outcome of check_clashes().

@@ -121,6 +121,41 @@ TEST(BoxTree, SelfPairsMatchBruteForce) {
   EXPECT_EQ(BoxTree(boxes).self_pairs(), want);
 }
 
+TEST(BoxTree, CountOverlappingIsTheListSizeUpToItsCap) {
+  for (unsigned seed : {4u, 5u}) {
+    const auto boxes = random_boxes(seed, 2000, 1.0, 0.05);
+    const BoxTree tree(boxes);
+    for (const AABB& q : random_boxes(seed + 40, 100, 1.0, 0.1)) {
+      const std::size_t want = brute_overlapping(boxes, q).size();
+      EXPECT_EQ(tree.count_overlapping(q, 1'000'000), want);
+      for (std::size_t cap : {std::size_t{0}, std::size_t{1}, std::size_t{3}, want, want + 1})
+        EXPECT_EQ(tree.count_overlapping(q, cap), std::min(want, cap)) << "cap " << cap;
+    }
+  }
+  // Degenerate: all boxes equal, and no boxes.
+  const std::vector<AABB> same(50, box(Vec3::Zero(), Vec3::Ones()));
+  EXPECT_EQ(BoxTree(same).count_overlapping(box(Vec3::Ones(), Vec3::Constant(2)), 1000), 50u);
+  EXPECT_EQ(BoxTree(std::vector<AABB>{}).count_overlapping(box(Vec3::Zero(), Vec3::Ones()), 1000), 0u);
+}
+
+TEST(BoxTree, FilteredSelfPairsMatchBruteForceAndStopAtTheirLimit) {
+  const auto boxes = random_boxes(11, 2000, 1.0, 0.03);
+  auto keep = [](std::uint32_t i, std::uint32_t j) { return (i + j) % 3 != 0; };
+  std::vector<BoxPair> want;
+  for (std::uint32_t i = 0; i < boxes.size(); ++i)
+    for (std::uint32_t j = i + 1; j < boxes.size(); ++j)
+      if (boxes_overlap(boxes[i], boxes[j]) && keep(i, j)) want.emplace_back(i, j);
+  ASSERT_GT(want.size(), 100u);
+  const BoxTree tree(boxes);
+  BoxTree::PairFilter filter;
+  filter.keep = keep;
+  EXPECT_EQ(tree.self_pairs(filter), want);
+  filter.max_pairs = want.size();  // exactly enough
+  EXPECT_EQ(tree.self_pairs(filter), want);
+  filter.max_pairs = want.size() - 1;
+  EXPECT_THROW(tree.self_pairs(filter), std::length_error);
+}
+
 TEST(BoxTree, BadInputIsNamed) {
   std::vector<AABB> boxes = random_boxes(3, 10, 1.0, 0.1);
   boxes[4].min.x() = std::numeric_limits<double>::quiet_NaN();

@@ -545,6 +545,113 @@ TEST(ClashCheck, DenseKeyPointsAuditLikeTheOracleWithFewChords) {
   EXPECT_EQ(rd.clashes.size(), rs.clashes.size());
 }
 
+std::string report_difference(const ClashResult& x, const ClashResult& y);  // below
+
+/// A polyline that folds back on itself `folds` times: key points 1 µm apart along x,
+/// alternating between y = 0 and y = amplitude.
+Centerline folded_route(int folds, double amplitude) {
+  std::vector<Vec3> pts;
+  for (int i = 0; i <= folds; ++i) pts.emplace_back(1e-3 * i, (i % 2) ? amplitude : 0.0, 0.0);
+  return Centerline::polyline(pts);
+}
+
+/// check_clashes' refusal message, or "" if the audit ran.
+std::string refusal(const std::vector<CableInput>& cables, const std::vector<Part>& parts, const ClashRequest& req) {
+  BruteForceIndex idx(parts);
+  try {
+    check_clashes(cables, parts, &idx, req);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Regression (2026-11-25, sessions 20–21): a route folding back on itself thousands of
+// times (2,000 zigzags of 50 mm on a wing-harness segment shared by 11 cables) made the
+// certified pair pass enumerate ~10⁹ overlapping chord-block pairs (Embree's allocation
+// failed at 17 GB; at 20,000 zigzags the process was killed at 24 GB) and the discrete
+// grid store contacts until 20 GB. Both now bound their work before doing it
+// (ClashLimits) and refuse with a message naming a cable; this scene is refused by the
+// default limits in about a second.
+TEST(ClashLimits, ARouteFoldingBackThousandsOfTimesIsRefusedBeforeItsPairsAreMade) {
+  const std::vector<Part> parts{box_part("box", {0, 100, 0}, {1, 101, 1})};
+  CableInput c;
+  c.id = "fold";
+  c.curve = folded_route(6000, 50.0);
+  c.radius = 1.0;
+  ClashRequest req;
+  req.threads = 2;
+  req.check_structure = false;
+  std::string why = refusal({c}, parts, req);
+  EXPECT_NE(why.find("cable 'fold' among them"), std::string::npos) << why;
+  EXPECT_NE(why.find("pairs of chord blocks come within reach"), std::string::npos) << why;
+  EXPECT_NE(why.find("folds back"), std::string::npos) << why;
+  req.method = ClashMethod::Discrete;  // refused by its contacts here, by its sample pairs for more folds
+  why = refusal({c}, parts, req);
+  EXPECT_NE(why.find("'fold'"), std::string::npos) << why;
+  EXPECT_NE(why.find("folds back"), std::string::npos) << why;
+}
+
+// Each limit refuses the audit as soon as the work passes it, and at exactly the work
+// done the audit runs and reports what it reports without limits.
+TEST(ClashLimits, EachLimitRefusesJustBelowTheWorkAndAllowsItAtTheWork) {
+  const std::vector<Part> parts{box_part("box", {0, 100, 0}, {1, 101, 1})};
+  std::vector<CableInput> cables(2);
+  for (int i = 0; i < 2; ++i) {
+    cables[i].id = "F" + std::to_string(i);
+    cables[i].curve = folded_route(60, 20.0);
+    cables[i].radius = 1.0;
+  }
+  cables[1].curve = Centerline::polyline({Vec3(-5, 10, 0.5), Vec3(5, 10, 0.5)});  // crosses every fold
+  ClashRequest req;
+  req.threads = 2;
+  BruteForceIndex idx(parts);
+  const ClashResult full = check_clashes(cables, parts, &idx, req);
+  const ClashCounters& n = full.counters;
+  ASSERT_GT(n.block_pairs, 0);
+  ASSERT_GT(n.pair_contacts, 0);
+  ASSERT_GE(n.block_overlaps_estimate, n.block_pairs);  // few blocks: every one counted
+  ASSERT_FALSE(full.clashes.empty());
+  auto same = [&](const ClashRequest& r) {
+    const ClashResult got = check_clashes(cables, parts, &idx, r);
+    return report_difference(full, got);
+  };
+  ClashRequest lim = req;
+  lim.limits.max_block_overlaps = static_cast<std::size_t>(n.block_overlaps_estimate);
+  EXPECT_EQ(same(lim), "");
+  lim.limits.max_block_overlaps -= 1;
+  EXPECT_NE(refusal(cables, parts, lim).find("pairs of chord blocks come within reach"), std::string::npos);
+  lim = req;
+  lim.limits.max_block_pairs = static_cast<std::size_t>(n.block_pairs);
+  EXPECT_EQ(same(lim), "");
+  lim.limits.max_block_pairs -= 1;
+  EXPECT_NE(refusal(cables, parts, lim).find("more than " + std::to_string(n.block_pairs - 1) + " pairs of chord blocks"),
+            std::string::npos);
+  lim = req;
+  lim.limits.max_pair_contacts = static_cast<std::size_t>(n.pair_contacts);
+  EXPECT_EQ(same(lim), "");
+  lim.limits.max_pair_contacts -= 1;
+  EXPECT_NE(refusal(cables, parts, lim).find(" pairs of chords are in contact"), std::string::npos);
+  // The discrete method: its sample-pair bound and its contacts, with and without an index.
+  ClashRequest disc = req;
+  disc.method = ClashMethod::Discrete;
+  const ClashResult dfull = check_clashes(cables, parts, &idx, disc);
+  ASSERT_GT(dfull.counters.pair_contacts, 0);
+  ASSERT_GT(dfull.counters.pair_tests, 0);
+  for (bool use_index : {true, false}) {
+    ClashRequest d = disc;
+    d.use_index = use_index;
+    d.limits.max_pair_contacts = static_cast<std::size_t>(dfull.counters.pair_contacts) - 1;
+    EXPECT_NE(refusal(cables, parts, d).find("pairs of samples are in contact"), std::string::npos) << use_index;
+  }
+  // The bound counts each sample's whole neighbourhood, so at least the pairs tested.
+  ClashRequest d = disc;
+  d.limits.max_sample_pairs = static_cast<std::size_t>(dfull.counters.pair_tests) / 2;
+  EXPECT_NE(refusal(cables, parts, d).find("the discrete method would compare about"), std::string::npos);
+  d.limits.max_sample_pairs = static_cast<std::size_t>(dfull.counters.pair_tests) * 100;
+  EXPECT_EQ(report_difference(dfull, check_clashes(cables, parts, &idx, d)), "");
+}
+
 TEST(ClashCheck, DefaultToleranceSaysWhereItCameFrom) {
   std::string source;
   const std::vector<CableInput> cables{straight_cable("A", {0, 0, 0}, {10, 0, 0}, 2.0),
@@ -976,6 +1083,42 @@ TEST(AuditCli, BadInputExitsTwoAndWritesNothing) {
   EXPECT_EQ(loom_audit(kAuditData + "clean.toml --method certified --no-index", "noidx").status, 2);
   EXPECT_EQ(loom_audit(kAuditData + "clean.toml --spacing -1", "spacing").status, 2);
   EXPECT_EQ(loom_audit(kAuditData + "clean.toml --routes " + kAuditData + "missing.xml", "noroutes").status, 2);
+}
+
+// Regression (sessions 20–21): the CLI ran out of memory on a route folding back on
+// itself thousands of times; it now exits 2 with the reason and writes no report.
+TEST(AuditCli, ARouteFoldingBackOnItselfExitsTwoAndWritesNothing) {
+  const fs::path dir = fs::temp_directory_path() / ("loom-test-fold-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  {
+    std::ofstream x(dir / "fold.xml");
+    x << R"(<?xml version="1.0" encoding="UTF-8"?>
+<harness name="fold" units="mm">
+  <attributes>
+    <cable id="C1">
+      <electrical><port id="J1"/><port id="J2"/></electrical>
+      <physical type="AWG20" color="red" diameter="2" min_bend_radius="10"/>
+    </cable>
+  </attributes>
+  <structure>
+    <port id="J1" x="-20" y="30" z="40" dx="1" dy="0" dz="0"/>
+    <port id="J2" x="30" y="30" z="40" dx="-1" dy="0" dz="0"/>
+    <segment from="J1" to="J2">
+      <path interp="polyline">)";
+    for (int i = 0; i <= 6000; ++i) x << "<pt x=\"" << 1e-3 * i << "\" y=\"" << ((i % 2) ? 80 : 30) << "\" z=\"40\"/>";
+    x << R"(</path>
+    </segment>
+  </structure>
+</harness>
+)";
+  }
+  for (const char* method : {"certified", "discrete"}) {
+    const CliRun r = loom_audit(kAuditData + "clean.toml --routes " + (dir / "fold.xml").string() + " --method " + method,
+                                std::string("fold-") + method);
+    EXPECT_EQ(r.status, 2) << method;
+    EXPECT_TRUE(r.report.empty()) << method;
+  }
+  fs::remove_all(dir);
 }
 
 }  // namespace
