@@ -1652,14 +1652,20 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
   ctx.chord_error = kChordShareOfTolerance * (ctx.tol - ctx.abs_err);
   if (request.method == ClashMethod::Certified)
     for (const auto& c : cables) {
-      const double n =
-          planned_chords(c.curve, ctx.chord_error, kMaxChordRadii * c.radius, kShortSpanRadii * c.radius);
-      if (!(n <= kMaxChordsPerCable))
-        throw std::invalid_argument("check_clashes: cable '" + c.id + "' would need " + full_precision(n) +
-                                    " chords to stay within " + full_precision(ctx.chord_error) +
-                                    " of its curve (more than " + full_precision(kMaxChordsPerCable) +
-                                    "): its curvature reaches the scale of the tolerance; smooth the route or "
-                                    "raise --tolerance");
+      const double hmax = kMaxChordRadii * c.radius;
+      const double n = planned_chords(c.curve, ctx.chord_error, hmax, kShortSpanRadii * c.radius);
+      if (n <= kMaxChordsPerCable) continue;
+      // Say which bound asked for the chords: the longest chord (a route thousands of
+      // kilometres long is a units or key-point mistake) or the chord error (a wiggle).
+      const double by_length = c.curve.length() / hmax;
+      const std::string reason =
+          by_length >= 0.5 * n
+              ? "it is " + full_precision(c.curve.length()) + " long, " + full_precision(std::ceil(by_length)) +
+                    " chords of at most 2r = " + full_precision(hmax) + "; check its key points and units"
+              : "its curvature reaches the scale of the tolerance; smooth the route or raise --tolerance";
+      throw std::invalid_argument("check_clashes: cable '" + c.id + "' would need " + full_precision(n) +
+                                  " chords to stay within " + full_precision(ctx.chord_error) +
+                                  " of its curve (more than " + full_precision(kMaxChordsPerCable) + "): " + reason);
     }
   res.cables.resize(cables.size());
   std::vector<std::vector<ClashEntry>> per_clash(cables.size());

@@ -496,6 +496,20 @@ TEST(ClashCheck, ARouteWigglingAtTheToleranceIsRefusedNotFlattened) {
   EXPECT_NO_THROW(check_clashes({c}, parts, &idx, req));
 }
 
+// A route 10⁸ long (a key point typed in the wrong units) needs its chords for its
+// length, not its curvature, and the refusal says so.
+TEST(ClashCheck, AFarTooLongRouteIsRefusedForItsLength) {
+  const std::vector<Part> parts{box_part("box", {0, 0, 0}, {1, 1, 1})};
+  BruteForceIndex idx(parts);
+  try {
+    check_clashes({straight_cable("far", {0, 5, 0}, {1e8, 5, 0}, 1.0)}, parts, &idx, ClashRequest{});
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'far' would need 5000000"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("check its key points and units"), std::string::npos) << e.what();
+  }
+}
+
 // Regression (2026-11-25, session 20): key points far closer together than the cable is
 // thick (2,000 points 1 µm apart on one bundle segment of the wing harness, shared by 11
 // cables) gave every cable a chord per knot span, and the pair pass's broad phase 26,000
