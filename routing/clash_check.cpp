@@ -1188,13 +1188,25 @@ std::int64_t narrow_phase(const Context& ctx, const CableChords& A, std::size_t 
 const char* const kFoldBack = "a route folds back on itself or runs over another along great lengths";
 
 /// Refuses the audit: more pairs of `what` (chords, samples) in contact than
-/// ClashLimits::max_pair_contacts; `c` is one of them.
-[[noreturn]] void refuse_contacts(const Context& ctx, const PairContact& c, const char* what) {
-  const std::string among = c.a == c.b ? "cable '" + ctx.cables[c.a].id + "' with itself"
-                                       : "cables '" + ctx.cables[c.a].id + "' and '" + ctx.cables[c.b].id + "'";
+/// ClashLimits::max_pair_contacts. The message names the cable pair with the most of the
+/// `found` contacts (lowest ids on a tie): which contacts were stored when the limit was
+/// passed depends on thread timing, the pair that dominates them hardly does.
+[[noreturn]] void refuse_contacts(const Context& ctx, const std::vector<PairContact>& found, const char* what) {
+  std::map<std::pair<int, int>, std::size_t> per_pair;
+  for (const PairContact& c : found) ++per_pair[{c.a, c.b}];
+  std::pair<int, int> top{0, 0};
+  std::size_t most = 0;
+  for (const auto& [ab, n] : per_pair)
+    if (n > most) {
+      most = n;
+      top = ab;
+    }
+  const std::string among = top.first == top.second
+                                ? "cable '" + ctx.cables[top.first].id + "' with itself"
+                                : "cables '" + ctx.cables[top.first].id + "' and '" + ctx.cables[top.second].id + "'";
   throw std::invalid_argument("check_clashes: more than " +
                               full_precision(static_cast<double>(ctx.req.limits.max_pair_contacts)) + " pairs of " +
-                              what + " are in contact (" + among + " among them): " + kFoldBack);
+                              what + " are in contact (" + among + " the most of them): " + kFoldBack);
 }
 
 /// The broad phase's overlapping box pairs, estimated before Embree enumerates them.
@@ -1326,7 +1338,7 @@ void certified_cable_pairs(Context& ctx, std::vector<ClashEntry>& out) {
     if (!local.empty()) {
       std::lock_guard<std::mutex> lock(mu);
       contacts.insert(contacts.end(), local.begin(), local.end());
-      if (contacts.size() > lim.max_pair_contacts) refuse_contacts(ctx, local.front(), "chords");
+      if (contacts.size() > lim.max_pair_contacts) refuse_contacts(ctx, contacts, "chords");
     }
   });
   ctx.counters.pair_contacts = as_i64(contacts.size());
@@ -1455,12 +1467,12 @@ void discrete_cable_pairs(Context& ctx, const std::vector<DiscreteSamples>& ds, 
     if (!self && excused(cables[a], s, p, cables[b], t, q)) return;
     const double ha = ds[a].spacing, hb = ds[b].spacing;
     local.push_back(PairContact::ordered(a, s, s - ha, s + ha, p, b, t, t - hb, t + hb, q, d));
-    if (local.size() > ctx.req.limits.max_pair_contacts) refuse_contacts(ctx, local.back(), "samples");
+    if (local.size() > ctx.req.limits.max_pair_contacts) refuse_contacts(ctx, local, "samples");
   };
   auto merge = [&](std::vector<PairContact>& local) {
     std::lock_guard<std::mutex> lock(mu);
     contacts.insert(contacts.end(), local.begin(), local.end());
-    if (contacts.size() > ctx.req.limits.max_pair_contacts) refuse_contacts(ctx, local.back(), "samples");
+    if (contacts.size() > ctx.req.limits.max_pair_contacts) refuse_contacts(ctx, contacts, "samples");
   };
   auto want = [&](int a, int b) { return a == b ? ctx.req.check_self : ctx.req.check_cable_cable; };
   if (!ctx.req.use_index) {
