@@ -112,9 +112,10 @@ int run_audit_command(const AuditFlags& f) {
   Scene scene;
   const AuditReport rep = audit_scene_file(f.scene, opt, &scene);
   const std::filesystem::path report_path = std::filesystem::path(f.out) / "report.json";
-  write_audit_report(rep, report_path);
   const nlohmann::json report = audit_report_json(rep);
+  // The view first: if it is refused (exit 2), no report.json claims the audit ran.
   write_view_outputs(f.out, scene, scene.harness, report, render);  // view.html, render.png (issue 9)
+  write_audit_report(rep, report_path);
   if (f.json)
     std::cout << report.dump(2) << "\n";
   else if (!f.quiet)

@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 namespace loom {
@@ -204,7 +205,16 @@ Image render_scene(const Scene& scene, const Harness& harness, const nlohmann::j
     so.chord_tolerance = kTubeChordPerRadius * r;
     Part p;
     p.name = harness.cables[c].id;
-    p.mesh = sweep_tube(*cl, r, so).mesh;
+    so.max_triangles = opt.max_tube_triangles - std::min(opt.max_tube_triangles, st.tube_triangles);
+    try {
+      p.mesh = sweep_tube(*cl, r, so).mesh;
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("render: cable '" + harness.cables[c].id + "': " + e.what() + " (the tubes of " +
+                                  std::to_string(tubes.size()) + " cables before it have " +
+                                  std::to_string(st.tube_triangles) + " of the render's " +
+                                  std::to_string(opt.max_tube_triangles) +
+                                  "; a route folding back on itself thousands of times?)");
+    }
     st.tube_triangles += p.mesh.triangles.size();
     harness_box.extend(p.mesh.bounds());
     tubes.push_back(std::move(p));

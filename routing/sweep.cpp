@@ -373,6 +373,13 @@ void mesh_sections(const SweepOptions& opt, double max_turn, SweepResult& out) {
   const std::size_t ring_vertices = nr * un;
   if (ring_vertices + 2 > std::numeric_limits<std::uint32_t>::max())
     throw std::invalid_argument("sweep: " + std::to_string(ring_vertices) + " vertices exceed 32-bit indices");
+  // The mesh's size is known before any of it is allocated: refuse it here if it is over
+  // the caller's budget (e.g. a route folding back on itself thousands of times).
+  const std::size_t planned_triangles = (nr > 0 ? nr - 1 : 0) * 2 * un + (opt.end_caps ? 2 * un : 0);
+  if (planned_triangles > opt.max_triangles)
+    throw std::invalid_argument("sweep: the tube would have " + std::to_string(planned_triangles) + " triangles (" +
+                                std::to_string(nr) + " rings of " + std::to_string(n) + " vertices), more than the " +
+                                std::to_string(opt.max_triangles) + " allowed");
   // Unit circle (cos, sin) at the even rings' angles 2πj/n, then at the odd rings' 2π(j + ½)/n.
   std::vector<Eigen::Vector2d> circle(2 * un);
   for (std::size_t j = 0; j < un; ++j)

@@ -6,6 +6,7 @@
 #include "core/mesh.hpp"
 
 #include <functional>
+#include <limits>
 #include <vector>
 
 namespace loom {
@@ -14,6 +15,10 @@ namespace loom {
 struct SweepOptions {
   double chord_tolerance = 0.01;  ///< max distance between the mesh and the true surface, scene units
   bool end_caps = true;           ///< close both ends (watertight)
+  /// Most triangles the mesh may have; past it the sweep throws std::invalid_argument
+  /// after placing the rings and before allocating the mesh. A caller meshing many tubes
+  /// passes what is left of its own budget.
+  std::size_t max_triangles = std::numeric_limits<std::size_t>::max();
 };
 
 /// One cross-section of a sweep: a circle in the plane normal to `tangent` (world

@@ -293,8 +293,10 @@ ViewStats write_view_html(const std::filesystem::path& file, const Scene& scene,
 
 ViewStats write_view_outputs(const std::filesystem::path& dir, const Scene& scene, const Harness& harness,
                              const nlohmann::json& report, const RenderOptions& render) {
+  // Render first: if the picture is refused (its tube budget), neither file is written.
+  const Image img = render_scene(scene, harness, report, render);
   const ViewStats st = write_view_html(dir / "view.html", scene, harness, report);
-  write_png(dir / "render.png", render_scene(scene, harness, report, render));
+  write_png(dir / "render.png", img);
   return st;
 }
 

@@ -59,7 +59,7 @@ ViewStats write_view_html(const std::filesystem::path& file, const Scene& scene,
 
 /// What `loom route` and `loom audit` write beside report.json: DIR/view.html and
 /// DIR/render.png (routing/render.hpp; size, camera and progress from `render`). Returns the
-/// page's stats.
+/// page's stats. The picture is made first: if render_scene throws, neither file is written.
 ViewStats write_view_outputs(const std::filesystem::path& dir, const Scene& scene, const Harness& harness,
                              const nlohmann::json& report, const RenderOptions& render = {});
 

@@ -16,6 +16,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <stdexcept>
 #include <random>
 
 namespace loom {
@@ -223,6 +224,33 @@ TEST(Render, EmptySceneAndBadSize) {
   for (std::size_t i = 0; i < img.rgb.size(); i += 3) EXPECT_EQ(img.rgb[i], 244);
   opt.width = 0;
   EXPECT_THROW(render_scene(empty, empty.harness, nlohmann::json::object(), opt), InputError);
+}
+
+// The tubes' triangle budget: at the triangles the scene needs the render runs, one below
+// it the render is refused with the cable named (routes folding back on themselves
+// thousands of times ran the machine out of memory here).
+TEST(Render, TubeTriangleBudgetIsHeldAndNamesTheCable) {
+  const Scene scene = small_scene();
+  RenderOptions opt;
+  opt.width = 16;
+  opt.height = 16;
+  RenderStats st;
+  render_scene(scene, scene.harness, nlohmann::json::object(), opt, &st);
+  ASSERT_GT(st.tube_triangles, 0u);
+  opt.max_tube_triangles = st.tube_triangles;
+  RenderStats again;
+  EXPECT_NO_THROW(render_scene(scene, scene.harness, nlohmann::json::object(), opt, &again));
+  EXPECT_EQ(again.tube_triangles, st.tube_triangles);
+  opt.max_tube_triangles = st.tube_triangles - 1;
+  try {
+    render_scene(scene, scene.harness, nlohmann::json::object(), opt);
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("render: cable 'W1'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("more than the " + std::to_string(st.tube_triangles - 1) + " allowed"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(Render, WritesPng) {

@@ -227,6 +227,19 @@ TEST(Sweep, ResolutionFollowsTheChordTolerance) {
   EXPECT_THROW(loom::sweep_tube(Centerline(), 1.0, {}), std::invalid_argument);
 }
 
+TEST(Sweep, TriangleBudgetIsHeldBeforeTheMeshIsMade) {
+  const Centerline c = s_curve();
+  const loom::SweepResult full = loom::sweep_tube(c, 1.0, {0.01, true});
+  loom::SweepOptions opt{0.01, true};
+  opt.max_triangles = full.mesh.triangle_count();  // exactly enough: the same mesh
+  EXPECT_EQ(loom::sweep_tube(c, 1.0, opt).mesh.triangle_count(), full.mesh.triangle_count());
+  opt.max_triangles -= 1;
+  EXPECT_THROW(loom::sweep_tube(c, 1.0, opt), std::invalid_argument);
+  opt.end_caps = false;  // the caps' 2n triangles are not counted without caps
+  opt.max_triangles = full.mesh.triangle_count() - 2 * static_cast<std::size_t>(full.circumferential);
+  EXPECT_EQ(loom::sweep_tube(c, 1.0, opt).mesh.triangle_count(), opt.max_triangles);
+}
+
 // Regression (2026-11-25, session 20): a route with 200,000 key points 10 nm apart made the
 // render's tube sweep place at least four rings per knot span (15 GB, 50 s). A run of
 // intervals that stays within half the axial tolerance of a straight tube is now crossed in
