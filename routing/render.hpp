@@ -7,6 +7,7 @@
 #include "core/harness.hpp"
 #include "core/progress.hpp"
 #include "core/scene.hpp"
+#include "routing/sweep.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -34,11 +35,10 @@ struct RenderOptions {
   double marker_radius_px = 0.0;
   /// Stage "render": image rows ray-cast, one call at a time from TBB workers. May be empty.
   ProgressFn progress;
-  /// Most triangles of all cable tubes together (~150 bytes each with the ray-casting BVH:
-  /// the default is ~6 GB). A harness of 1,000 cables of a few metres needs a few million;
-  /// past it render_scene throws std::invalid_argument naming the cable (routes folding
-  /// back on themselves thousands of times ran the machine out of memory).
-  std::size_t max_tube_triangles = 40'000'000;
+  /// Most triangles of all cable tubes together (~150 bytes each with the ray-casting
+  /// BVH); past it render_scene throws std::invalid_argument naming the cable (routes
+  /// folding back on themselves thousands of times ran the machine out of memory).
+  std::size_t max_tube_triangles = kHarnessTubeTriangleBudget;
 };
 
 /// An 8-bit RGB picture, rows top to bottom.

@@ -8,8 +8,10 @@
 #include "routing/report_json.hpp"
 #include "routing/sweep.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
+#include <stdexcept>
 
 namespace loom {
 
@@ -105,8 +107,7 @@ json route_report_json(const RouteReport& rep) {
 }
 
 void write_route_outputs(const RouteReport& rep, const std::filesystem::path& dir, double chord_tolerance) {
-  write_harness_xml(rep.routed, dir / "routed.xml");
-  write_file_atomic(dir / "report.json", route_report_json(rep).dump(2) + "\n");
+  // The tubes first: if they are refused (the budget), no file is written.
   const HarnessTopology topo(rep.routed);
   Mesh all;
   std::vector<std::array<std::uint8_t, 3>> colors;
@@ -116,10 +117,20 @@ void write_route_outputs(const RouteReport& rep, const std::filesystem::path& di
   for (std::size_t c = 0; c < rep.routed.cables.size(); ++c) {
     auto curve = curves.cable(static_cast<int>(c));
     if (!curve) continue;
-    const SweepResult tube = sweep_tube(*curve, rep.routed.cables[c].radius(), so);
+    so.max_triangles = kHarnessTubeTriangleBudget - std::min(kHarnessTubeTriangleBudget, all.triangles.size());
+    SweepResult tube;
+    try {
+      tube = sweep_tube(*curve, rep.routed.cables[c].radius(), so);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("cables.ply: cable '" + rep.routed.cables[c].id + "': " + e.what() +
+                                  " (the cables before it have " + std::to_string(all.triangles.size()) + " of " +
+                                  std::to_string(kHarnessTubeTriangleBudget) + ")");
+    }
     all.append(tube.mesh);
     colors.insert(colors.end(), tube.mesh.vertices.size(), cable_color(c));
   }
+  write_harness_xml(rep.routed, dir / "routed.xml");
+  write_file_atomic(dir / "report.json", route_report_json(rep).dump(2) + "\n");
   write_mesh(dir / "cables.ply", all, colors);
 }
 

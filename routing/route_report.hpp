@@ -15,6 +15,8 @@ nlohmann::json route_report_json(const RouteReport& report);
 
 /// Writes DIR/routed.xml, DIR/report.json and DIR/cables.ply (one swept tube per routed
 /// cable, coloured per cable), each atomically. `chord_tolerance` sets the tube resolution.
+/// The tubes are swept first, within kHarnessTubeTriangleBudget triangles together; past
+/// it throws std::invalid_argument naming the cable, and writes nothing.
 void write_route_outputs(const RouteReport& report, const std::filesystem::path& dir, double chord_tolerance);
 
 }  // namespace loom

@@ -12,6 +12,11 @@
 namespace loom {
 
 /// Resolution of a swept surface, derived from a chord tolerance.
+/// Most triangles of all cable tubes of one harness output (render.png, cables.ply):
+/// ~1 GB as a mesh, ~6 GB with a ray-casting BVH. A harness of 1,000 cables of a few metres
+/// needs a few million; routes folding back on themselves thousands of times need more.
+constexpr std::size_t kHarnessTubeTriangleBudget = 40'000'000;
+
 struct SweepOptions {
   double chord_tolerance = 0.01;  ///< max distance between the mesh and the true surface, scene units
   bool end_caps = true;           ///< close both ends (watertight)
