@@ -1,25 +1,89 @@
-// Broad phase over boxes: a BoxTree collided with itself, on a TBB arena of the asked size.
+// Broad phase over boxes: a BoxTree collided with itself, on a TBB arena of the asked size,
+// its work estimated from a sample of boxes before Embree enumerates the pairs.
 #include "index/box_pairs.hpp"
 
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
+#include <limits>
+#include <numeric>
+#include <random>
 #include <stdexcept>
 #include <string>
 
 namespace loom {
+namespace {
 
-std::vector<BoxPair> overlapping_box_pairs(const std::vector<AABB>& boxes, int threads) {
+/// Seed of the estimate's draw (the estimate, and so a refusal, is reproducible).
+constexpr std::uint64_t kSampleSeed = 0x6c6f6f6d;  // "loom"
+/// Smallest cap on one drawn box's counted overlaps (the cap is 4 · max_overlaps / boxes,
+/// at least this): a chord block in a large bundle meets a few blocks of every cable in it.
+constexpr std::size_t kMinCountCap = 1000;
+
+/// Fills result.estimated_overlaps and result.busiest (see BoxPairResult). Why a sample:
+/// counting every box's overlaps costs what enumerating them does.
+void estimate_overlaps(const BoxTree& tree, const std::vector<AABB>& boxes, std::size_t budget,
+                       BoxPairResult& result) {
+  const std::size_t n = boxes.size();
+  if (n < 2) return;
+  std::vector<std::size_t> drawn(std::min(n, kBoxPairSample));
+  if (drawn.size() == n) {
+    std::iota(drawn.begin(), drawn.end(), std::size_t{0});
+  } else {
+    std::mt19937_64 rng(kSampleSeed);
+    std::uniform_int_distribution<std::size_t> pick(0, n - 1);
+    for (std::size_t& k : drawn) k = pick(rng);
+  }
+  // No box overlaps more than n boxes, so a cap of n counts exactly (and cannot overflow).
+  const std::size_t per_box = budget / n + 1;
+  const std::size_t cap = std::max(kMinCountCap, per_box > n / 4 ? n : 4 * per_box);
+  std::vector<std::size_t> count(drawn.size());
+  tbb::parallel_for(std::size_t{0}, drawn.size(),
+                    [&](std::size_t k) { count[k] = tree.count_overlapping(boxes[drawn[k]], cap); });
+  double sum = 0.0;
+  std::size_t busiest = 0;
+  for (std::size_t k = 0; k < drawn.size(); ++k) {
+    sum += static_cast<double>(count[k] > 0 ? count[k] - 1 : 0);  // a box overlaps itself
+    if (count[k] > count[busiest]) busiest = k;
+  }
+  result.busiest = static_cast<std::uint32_t>(drawn[busiest]);
+  // Each pair is counted from both its boxes.
+  result.estimated_overlaps = 0.5 * sum * static_cast<double>(n) / static_cast<double>(drawn.size());
+}
+
+}  // namespace
+
+BoxPairResult overlapping_box_pairs(const std::vector<AABB>& boxes, const BoxPairRequest& request) {
   // Stricter than BoxTree: a broad phase is given the boxes of real geometry, so an unset
   // box here is a caller's bug, not a part without triangles. BoxTree rejects the rest.
   for (std::size_t i = 0; i < boxes.size(); ++i)
     if (box_is_unset(boxes[i]))
       throw std::invalid_argument("overlapping_box_pairs: box " + std::to_string(i) + " is unset (no point added)");
-  std::vector<BoxPair> pairs;
-  // Build and traversal both run on the arena, so `threads` bounds the whole call.
-  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
-  // BoxTree validates every box, so even one or two boxes are checked.
-  arena.execute([&] { pairs = BoxTree(boxes).self_pairs(); });
-  return pairs;
+  BoxPairResult result;
+  // Build, estimate and traversal all run on the arena, so `threads` bounds the whole call.
+  tbb::task_arena arena(request.threads > 0 ? request.threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    const BoxTree tree(boxes);  // validates every box, so even one or two boxes are checked
+    const bool bounded = request.max_overlaps != std::numeric_limits<std::size_t>::max();
+    if (bounded) estimate_overlaps(tree, boxes, request.max_overlaps, result);
+    if (bounded && result.estimated_overlaps > static_cast<double>(request.max_overlaps)) {
+      result.status = BoxPairStatus::TooManyOverlaps;
+      return;
+    }
+    try {
+      result.pairs = tree.self_pairs(request.filter);
+    } catch (const std::length_error&) {
+      result.status = BoxPairStatus::TooManyKept;
+    }
+  });
+  return result;
+}
+
+std::vector<BoxPair> overlapping_box_pairs(const std::vector<AABB>& boxes, int threads) {
+  BoxPairRequest request;
+  request.threads = threads;
+  return overlapping_box_pairs(boxes, request).pairs;
 }
 
 }  // namespace loom

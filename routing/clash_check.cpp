@@ -3,6 +3,7 @@
 #include "routing/clash_check.hpp"
 
 #include "core/error.hpp"
+#include "index/box_pairs.hpp"
 #include "index/box_tree.hpp"
 #include "index/triangle_distance.hpp"
 
@@ -14,16 +15,15 @@
 #include <atomic>
 #include <cmath>
 #include <functional>
-#include <tuple>
 #include <limits>
 #include <optional>
 #include <map>
 #include <memory>
 #include <mutex>
-#include <random>
 #include <numeric>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 
 namespace loom {
@@ -56,15 +56,6 @@ constexpr double kShortSpanRadii = 0.25;
 constexpr double kMaxChordsPerCable = 1e7;
 /// Chords per block in the cable–cable narrow phase.
 constexpr std::size_t kBlock = 8;
-/// Blocks drawn (fixed seed) to estimate the broad phase's overlapping pairs; with fewer
-/// blocks all are counted. The estimate's relative standard error is ~1/√(blocks drawn
-/// that overlap many), well under the factor the limits leave to spare.
-constexpr std::size_t kOverlapSampleBlocks = 1024;
-/// Seed of that draw (the estimate, and so a refusal, is reproducible).
-constexpr std::uint64_t kOverlapSampleSeed = 0x6c6f6f6d;  // "loom"
-/// Smallest cap on one drawn block's counted overlaps (the cap is 4 · max_block_overlaps /
-/// blocks, at least this): a block in a large bundle meets a few blocks of every cable in it.
-constexpr std::size_t kMinOverlapCountCap = 1000;
 /// Arc-length slack (relative to the cable length) when deciding that two chord or sample
 /// intervals touch.
 constexpr double kTouchRel = 1e-9;
@@ -1209,44 +1200,6 @@ const char* const kFoldBack = "a route folds back on itself or runs over another
                               what + " are in contact (" + among + " the most of them): " + kFoldBack);
 }
 
-/// The broad phase's overlapping box pairs, estimated before Embree enumerates them.
-struct OverlapEstimate {
-  double pairs = 0.0;     ///< estimated unordered pairs {i, j}, i ≠ j, of overlapping boxes
-  std::size_t worst = 0;  ///< the counted box with the most overlaps (for the message)
-};
-
-/// Estimates the overlapping pairs among `boxes` (indexed by `tree`) from at most
-/// kOverlapSampleBlocks of them drawn with a fixed seed, each counting its overlaps up to a
-/// cap that lets the estimate reach twice `budget`; exact (up to the cap) when all are
-/// counted. Why a sample: counting every box's overlaps costs what enumerating them does.
-OverlapEstimate estimate_overlaps(const BoxTree& tree, const std::vector<AABB>& boxes, std::size_t budget,
-                                  int threads) {
-  OverlapEstimate est;
-  const std::size_t n = boxes.size();
-  if (n < 2) return est;
-  std::vector<std::size_t> drawn(std::min(n, kOverlapSampleBlocks));
-  if (drawn.size() == n) {
-    std::iota(drawn.begin(), drawn.end(), std::size_t{0});
-  } else {
-    std::mt19937_64 rng(kOverlapSampleSeed);
-    std::uniform_int_distribution<std::size_t> pick(0, n - 1);
-    for (std::size_t& k : drawn) k = pick(rng);
-  }
-  const std::size_t cap = std::max(kMinOverlapCountCap, 4 * (budget / n + 1));
-  std::vector<std::size_t> count(drawn.size());
-  parallel_indices(drawn.size(), threads,
-                   [&](std::size_t k) { count[k] = tree.count_overlapping(boxes[drawn[k]], cap); });
-  double sum = 0.0;
-  for (std::size_t k = 0; k < drawn.size(); ++k) {
-    sum += static_cast<double>(count[k] > 0 ? count[k] - 1 : 0);  // a box overlaps itself
-    if (count[k] > count[est.worst]) est.worst = k;
-  }
-  est.worst = drawn[est.worst];
-  // Each pair is counted from both its boxes.
-  est.pairs = 0.5 * sum * static_cast<double>(n) / static_cast<double>(drawn.size());
-  return est;
-}
-
 /// Block pairs handed to one narrow-phase task (amortises task and lock overhead).
 constexpr std::size_t kPairsPerTask = 256;
 
@@ -1282,8 +1235,9 @@ void certified_cable_pairs(Context& ctx, std::vector<ClashEntry>& out) {
   // cables' blocks both inside one harness segment (bundled there on purpose: every
   // contact is excused), not a cable's blocks closer in s than π r. Why here: a large
   // bundle puts every block beside the blocks of every other cable in it.
-  BoxTree::PairFilter filter;
-  filter.keep = [&](std::uint32_t i, std::uint32_t j) {
+  const ClashLimits& lim = ctx.req.limits;
+  BoxPairRequest bp;
+  bp.filter.keep = [&](std::uint32_t i, std::uint32_t j) {
     const BlockRef& x = blocks[i];
     const BlockRef& y = blocks[j];
     if (x.cable == y.cable) {
@@ -1294,33 +1248,23 @@ void certified_cable_pairs(Context& ctx, std::vector<ClashEntry>& out) {
     }
     return ctx.req.check_cable_cable && !(block_segment[i] >= 0 && block_segment[i] == block_segment[j]);
   };
-  // Bound the broad phase's own time first: Embree enumerates every overlapping pair,
-  // kept or not, and cannot be stopped.
-  const ClashLimits& lim = ctx.req.limits;
-  filter.max_pairs = lim.max_block_pairs;
-  std::vector<BoxPair> pairs;
-  {
-    std::unique_ptr<BoxTree> tree;
-    tbb::task_arena arena(ctx.req.threads > 0 ? ctx.req.threads : tbb::task_arena::automatic);
-    arena.execute([&] { tree = std::make_unique<BoxTree>(boxes); });
-    const OverlapEstimate est = estimate_overlaps(*tree, boxes, lim.max_block_overlaps, ctx.req.threads);
-    ctx.counters.block_overlaps_estimate = static_cast<std::int64_t>(std::llround(std::min(est.pairs, 9e18)));
-    if (est.pairs > static_cast<double>(lim.max_block_overlaps))
-      throw std::invalid_argument("check_clashes: about " + full_precision(std::round(est.pairs)) +
-                                  " pairs of chord blocks come within reach of each other (limit " +
-                                  full_precision(static_cast<double>(lim.max_block_overlaps)) + "; cable '" +
-                                  ctx.cables[blocks[est.worst].cable].id + "' among them): " + kFoldBack);
-    try {
-      arena.execute([&] { pairs = tree->self_pairs(filter); });
-    } catch (const std::length_error&) {
-      throw std::invalid_argument("check_clashes: more than " +
-                                  full_precision(static_cast<double>(lim.max_block_pairs)) +
-                                  " pairs of chord blocks of different cables, or of one cable πr apart, come "
-                                  "within reach of each other: " +
-                                  kFoldBack);
-    }
-    ctx.counters.block_pairs = as_i64(pairs.size());
-  }
+  bp.filter.max_pairs = lim.max_block_pairs;
+  bp.max_overlaps = lim.max_block_overlaps;
+  bp.threads = ctx.req.threads;
+  BoxPairResult found = overlapping_box_pairs(boxes, bp);
+  ctx.counters.block_overlaps_estimate =
+      static_cast<std::int64_t>(std::llround(std::min(found.estimated_overlaps, 9e18)));
+  if (found.status == BoxPairStatus::TooManyOverlaps)
+    throw std::invalid_argument("check_clashes: about " + full_precision(std::round(found.estimated_overlaps)) +
+                                " pairs of chord blocks come within reach of each other (limit " +
+                                full_precision(static_cast<double>(lim.max_block_overlaps)) + "; cable '" +
+                                ctx.cables[blocks[found.busiest].cable].id + "' among them): " + kFoldBack);
+  if (found.status == BoxPairStatus::TooManyKept)
+    throw std::invalid_argument("check_clashes: more than " + full_precision(static_cast<double>(lim.max_block_pairs)) +
+                                " pairs of chord blocks of different cables, or of one cable πr apart, come within "
+                                "reach of each other: " + kFoldBack);
+  std::vector<BoxPair>& pairs = found.pairs;
+  ctx.counters.block_pairs = as_i64(pairs.size());
   if (ctx.req.check_self)
     for (std::uint32_t i = 0; i < blocks.size(); ++i) pairs.emplace_back(i, i);
   std::mutex mu;

@@ -14,7 +14,6 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
-#include <stdexcept>
 #include <string>
 
 namespace loom {
@@ -197,6 +196,7 @@ Image render_scene(const Scene& scene, const Harness& harness, const nlohmann::j
   AABB harness_box;
   const HarnessTopology topo(harness);
   SegmentCurves curves(topo);
+  TubeBudget budget("render", opt.max_tube_triangles);
   for (std::size_t c = 0; c < harness.cables.size(); ++c) {
     const auto cl = curves.cable(static_cast<int>(c));
     const double r = harness.cables[c].radius();
@@ -205,21 +205,12 @@ Image render_scene(const Scene& scene, const Harness& harness, const nlohmann::j
     so.chord_tolerance = kTubeChordPerRadius * r;
     Part p;
     p.name = harness.cables[c].id;
-    so.max_triangles = opt.max_tube_triangles - std::min(opt.max_tube_triangles, st.tube_triangles);
-    try {
-      p.mesh = sweep_tube(*cl, r, so).mesh;
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument("render: cable '" + harness.cables[c].id + "': " + e.what() + " (the tubes of " +
-                                  std::to_string(tubes.size()) + " cables before it have " +
-                                  std::to_string(st.tube_triangles) + " of the render's " +
-                                  std::to_string(opt.max_tube_triangles) +
-                                  "; a route folding back on itself thousands of times?)");
-    }
-    st.tube_triangles += p.mesh.triangles.size();
+    p.mesh = budget.sweep(*cl, r, so, harness.cables[c].id).mesh;
     harness_box.extend(p.mesh.bounds());
     tubes.push_back(std::move(p));
     tube_cable.push_back(c);
   }
+  st.tube_triangles = budget.used();
   AABB frame_box = harness_box;
   if (frame_box.empty()) frame_box = scene.bounds();
   if (frame_box.empty()) frame_box.extend(Vec3::Zero());

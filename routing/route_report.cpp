@@ -8,10 +8,8 @@
 #include "routing/report_json.hpp"
 #include "routing/sweep.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <map>
-#include <stdexcept>
 
 namespace loom {
 
@@ -114,18 +112,11 @@ void write_route_outputs(const RouteReport& rep, const std::filesystem::path& di
   SweepOptions so;
   so.chord_tolerance = chord_tolerance;
   SegmentCurves curves(topo);
+  TubeBudget budget("cables.ply");
   for (std::size_t c = 0; c < rep.routed.cables.size(); ++c) {
     auto curve = curves.cable(static_cast<int>(c));
     if (!curve) continue;
-    so.max_triangles = kHarnessTubeTriangleBudget - std::min(kHarnessTubeTriangleBudget, all.triangles.size());
-    SweepResult tube;
-    try {
-      tube = sweep_tube(*curve, rep.routed.cables[c].radius(), so);
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument("cables.ply: cable '" + rep.routed.cables[c].id + "': " + e.what() +
-                                  " (the cables before it have " + std::to_string(all.triangles.size()) + " of " +
-                                  std::to_string(kHarnessTubeTriangleBudget) + ")");
-    }
+    const SweepResult tube = budget.sweep(*curve, rep.routed.cables[c].radius(), so, rep.routed.cables[c].id);
     all.append(tube.mesh);
     colors.insert(colors.end(), tube.mesh.vertices.size(), cable_color(c));
   }

@@ -14,6 +14,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace loom {
 
@@ -507,6 +508,23 @@ SweepResult sweep_canal(const Centerline& c, const std::function<double(double)>
   SweepResult out;
   sweep_canal(c, radius_of_s, opt, out);
   return out;
+}
+
+TubeBudget::TubeBudget(std::string owner, std::size_t total) : owner_(std::move(owner)), total_(total) {}
+
+SweepResult TubeBudget::sweep(const Centerline& c, double radius, SweepOptions opt, const std::string& cable) {
+  opt.max_triangles = std::min(opt.max_triangles, total_ - std::min(total_, used_));
+  SweepResult tube;
+  try {
+    tube = sweep_tube(c, radius, opt);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(owner_ + ": cable '" + cable + "': " + e.what() + " (the tubes of " +
+                                std::to_string(cables_) + " cables before it have " + std::to_string(used_) + " of " +
+                                std::to_string(total_) + "; a route folding back on itself thousands of times?)");
+  }
+  used_ += tube.mesh.triangles.size();
+  ++cables_;
+  return tube;
 }
 
 std::vector<SweepSection> tube_sections(const Centerline& c, double radius, const SweepOptions& opt) {

@@ -7,6 +7,7 @@
 
 #include <functional>
 #include <limits>
+#include <string>
 #include <vector>
 
 namespace loom {
@@ -64,6 +65,26 @@ void sweep_tube(const Centerline& c, double radius, const SweepOptions& opt, Swe
 /// sweep_canal into `out`, reusing its storage as sweep_tube(c, radius, opt, out) does.
 void sweep_canal(const Centerline& c, const std::function<double(double)>& radius_of_s, const SweepOptions& opt,
                  SweepResult& out);
+
+/// Sweeps the tubes of many cables within one triangle budget: each sweep may use what the
+/// earlier ones left (SweepOptions::max_triangles), so the budget is judged before each
+/// mesh is allocated. Not thread-safe (one per output).
+class TubeBudget {
+ public:
+  /// `owner` prefixes refusals (e.g. "render", "cables.ply").
+  explicit TubeBudget(std::string owner, std::size_t total = kHarnessTubeTriangleBudget);
+  /// sweep_tube(c, radius, opt) within what is left. Past it throws std::invalid_argument
+  /// naming the owner, `cable`, the triangles the cables before it took and the budget.
+  SweepResult sweep(const Centerline& c, double radius, SweepOptions opt, const std::string& cable);
+  /// Triangles of the tubes swept so far.
+  std::size_t used() const { return used_; }
+
+ private:
+  std::string owner_;
+  std::size_t total_ = 0;
+  std::size_t used_ = 0;
+  std::size_t cables_ = 0;
+};
 
 /// The cross-sections sweep_tube places (their spacing keeps the sagitta along the tube
 /// within half the chord tolerance), with rotation-minimising frames.

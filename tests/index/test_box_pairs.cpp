@@ -1,6 +1,7 @@
 // Broad phase against brute force: random boxes with fixed seeds (sparse, dense, thin,
 // far from the origin), degenerate inputs (empty, one box, all equal, points, touching
-// faces), thread counts, bad input, and a rapidcheck invariant.
+// faces), thread counts, bad input, and a rapidcheck invariant; the bounded form's filter,
+// estimate and statuses.
 #include "index/box_pairs.hpp"
 #include "index/random_boxes.hpp"
 
@@ -103,6 +104,51 @@ TEST(BoxPairs, BadBoxIsNamed) {
   std::vector<AABB> empty_box(3, box(Vec3::Zero(), Vec3::Ones()));
   empty_box[1] = AABB();  // default box is empty (inverted, infinite)
   EXPECT_THROW(overlapping_box_pairs(empty_box, 1), std::invalid_argument);
+}
+
+TEST(BoxPairs, BoundedFormKeepsTheFilteredPairsAndEstimatesExactlyWhenAllAreCounted) {
+  const auto boxes = random_boxes(12, 800, 1.0, 0.04);  // ≤ kBoxPairSample: every box counted
+  const auto all = brute_pairs(boxes);
+  ASSERT_GT(all.size(), 100u);
+  BoxPairRequest req;
+  req.filter.keep = [](std::uint32_t i, std::uint32_t j) { return (i ^ j) & 1u; };
+  req.max_overlaps = all.size();  // exactly the work: allowed
+  req.threads = 2;
+  const BoxPairResult r = overlapping_box_pairs(boxes, req);
+  ASSERT_EQ(r.status, BoxPairStatus::Done);
+  EXPECT_DOUBLE_EQ(r.estimated_overlaps, static_cast<double>(all.size()));
+  std::vector<BoxPair> kept;
+  for (const BoxPair& p : all)
+    if ((p.first ^ p.second) & 1u) kept.push_back(p);
+  EXPECT_EQ(r.pairs, kept);
+  req.max_overlaps = all.size() - 1;
+  const BoxPairResult over = overlapping_box_pairs(boxes, req);
+  EXPECT_EQ(over.status, BoxPairStatus::TooManyOverlaps);
+  EXPECT_TRUE(over.pairs.empty());
+  req.max_overlaps = all.size();
+  req.filter.max_pairs = kept.size() - 1;
+  EXPECT_EQ(overlapping_box_pairs(boxes, req).status, BoxPairStatus::TooManyKept);
+  // The unbounded form makes no estimate.
+  EXPECT_EQ(overlapping_box_pairs(boxes, BoxPairRequest{}).estimated_overlaps, 0.0);
+}
+
+TEST(BoxPairs, SampledEstimateIsCloseAndNamesABusyBox) {
+  // More boxes than the sample: a uniform field, and one with a dense cluster.
+  for (bool cluster : {false, true}) {
+    auto boxes = random_boxes(13, 6000, 1.0, 0.03);
+    if (cluster)
+      for (std::size_t i = 0; i < 1500; ++i) boxes[i] = box(Vec3::Constant(0.5), Vec3::Constant(0.52));
+    const double truth = static_cast<double>(brute_pairs(boxes).size());
+    BoxPairRequest req;
+    req.max_overlaps = static_cast<std::size_t>(10 * truth);
+    const BoxPairResult r = overlapping_box_pairs(boxes, req);
+    ASSERT_EQ(r.status, BoxPairStatus::Done);
+    EXPECT_NEAR(r.estimated_overlaps / truth, 1.0, 0.25) << "cluster " << cluster << ": " << r.estimated_overlaps
+                                                         << " vs " << truth;
+    if (cluster) {
+      EXPECT_LT(r.busiest, 1500u);  // one of the 1,500 equal boxes overlaps the most
+    }
+  }
 }
 
 RC_GTEST_PROP(BoxPairs, EqualsBruteForce, ()) {
