@@ -1104,8 +1104,10 @@ TEST(AuditCli, BadInputExitsTwoAndWritesNothing) {
 TEST(AuditCli, ARouteFoldingBackOnItselfExitsTwoAndWritesNothing) {
   const fs::path dir = fs::temp_directory_path() / ("loom-test-fold-" + std::to_string(::getpid()));
   fs::create_directories(dir);
-  {
-    std::ofstream x(dir / "fold.xml");
+  // The same file with `folds` folds: 2 folds audit (the file itself is good input), 6,000
+  // are refused.
+  auto write = [&](const std::string& name, int folds) {
+    std::ofstream x(dir / name);
     x << R"(<?xml version="1.0" encoding="UTF-8"?>
 <harness name="fold" units="mm">
   <attributes>
@@ -1119,13 +1121,18 @@ TEST(AuditCli, ARouteFoldingBackOnItselfExitsTwoAndWritesNothing) {
     <port id="J2" x="30" y="30" z="40" dx="-1" dy="0" dz="0"/>
     <segment from="J1" to="J2">
       <path interp="polyline">)";
-    for (int i = 0; i <= 6000; ++i) x << "<pt x=\"" << 1e-3 * i << "\" y=\"" << ((i % 2) ? 80 : 30) << "\" z=\"40\"/>";
+    for (int i = 0; i <= folds; ++i) x << "<pt x=\"" << 1e-3 * i << "\" y=\"" << ((i % 2) ? 80 : 30) << "\" z=\"40\"/>";
     x << R"(</path>
     </segment>
   </structure>
 </harness>
 )";
-  }
+  };
+  write("fold.xml", 6000);
+  write("fold2.xml", 2);
+  const CliRun few = loom_audit(kAuditData + "clean.toml --routes " + (dir / "fold2.xml").string(), "fold2");
+  EXPECT_NE(few.status, 2);
+  EXPECT_FALSE(few.report.empty());
   for (const char* method : {"certified", "discrete"}) {
     const CliRun r = loom_audit(kAuditData + "clean.toml --routes " + (dir / "fold.xml").string() + " --method " + method,
                                 std::string("fold-") + method);
