@@ -100,6 +100,8 @@ int run_simplify(const SimplifyCommandOptions& o) {
                      {"status", alpha_sim_status_name(r.status)},
                      {"reason", r.reason},
                      {"copy_of", r.copy_of},
+                     {"prisms_absorbed", r.prisms_absorbed},
+                     {"booleans", r.booleans},
                      {"projections", projections}});
     if (!o.quiet) {
       // Below the containment tolerance a distance is rounding (a part kept as it was).

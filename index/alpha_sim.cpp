@@ -4,6 +4,7 @@
 
 #include "core/error.hpp"
 #include "index/embree_index.hpp"
+#include "index/extrusion.hpp"
 
 #include <BRepAlgoAPI_Common.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
@@ -521,34 +522,32 @@ std::size_t count_contained_mesh(const EmbreeIndex& q, const std::vector<Vec3>& 
 }
 
 // --- OpenCASCADE prisms ∩ -----------------------------------------------------------------
-gp_Pnt to_gp(const AlphaSimPrism& pr, const Vec2& q, double depth) {
-  const Vec3 p = pr.u * q.x() + pr.v * q.y() + pr.n * depth;
+gp_Pnt to_gp(const Extrusion& e, const Vec2& q, double depth) {
+  const Vec3 p = e.u * q.x() + e.v * q.y() + e.n * depth;
   return gp_Pnt(p.x(), p.y(), p.z());
 }
 
-TopoDS_Wire ring_wire(const AlphaSimPrism& pr, const std::vector<Vec2>& ring, double depth) {
+TopoDS_Wire ring_wire(const Extrusion& e, const std::vector<Vec2>& ring, double depth) {
   BRepBuilderAPI_MakePolygon poly;
-  for (const auto& q : ring) poly.Add(to_gp(pr, q, depth));
+  for (const auto& q : ring) poly.Add(to_gp(e, q, depth));
   poly.Close();
   if (!poly.IsDone()) throw std::runtime_error("polygon wire failed");
   return poly.Wire();
 }
 
-/// Extrudes the polygons of one plane over [depth_min - margin, depth_max + margin].
-TopoDS_Shape prism_shape(const AlphaSimPrism& pr, const std::vector<PolygonWithHoles2>& polys, double margin) {
+/// The extrusion as an OpenCASCADE solid (a compound of one prism per polygon).
+TopoDS_Shape prism_shape(const Extrusion& e) {
   BRep_Builder builder;
   TopoDS_Compound comp;
   builder.MakeCompound(comp);
-  const double d0 = pr.depth_min - margin;
-  const gp_Vec dir(pr.n.x() * (pr.depth_max - pr.depth_min + 2 * margin),
-                   pr.n.y() * (pr.depth_max - pr.depth_min + 2 * margin),
-                   pr.n.z() * (pr.depth_max - pr.depth_min + 2 * margin));
-  const Vec3 o = pr.n * d0;
-  const gp_Pln plane(gp_Pnt(o.x(), o.y(), o.z()), gp_Dir(pr.n.x(), pr.n.y(), pr.n.z()));
+  const double d0 = e.depth_min, len = e.depth_max - e.depth_min;
+  const gp_Vec dir(e.n.x() * len, e.n.y() * len, e.n.z() * len);
+  const Vec3 o = e.n * d0;
+  const gp_Pln plane(gp_Pnt(o.x(), o.y(), o.z()), gp_Dir(e.n.x(), e.n.y(), e.n.z()));
   int count = 0;
-  for (const auto& poly : polys) {
-    BRepBuilderAPI_MakeFace mf(plane, ring_wire(pr, poly.outer, d0), true);
-    for (const auto& h : poly.holes) mf.Add(ring_wire(pr, h, d0));
+  for (const auto& poly : e.polygons) {
+    BRepBuilderAPI_MakeFace mf(plane, ring_wire(e, poly.outer, d0), true);
+    for (const auto& h : poly.holes) mf.Add(ring_wire(e, h, d0));
     if (!mf.IsDone()) throw std::runtime_error("planar face failed");
     BRepPrimAPI_MakePrism prism(mf.Face(), dir);
     prism.Build();
@@ -974,30 +973,62 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   if (!opt.build_mesh) return finish();
   const auto t_mesh = Clock::now();
 
-  // 5–6. extrude and intersect (OpenCASCADE), mesh the result.
-  TopoDS_Shape result;
-  try {
-    const double margin = std::max(10.0 * tol, 1e-3 * opt.dim_pre);
-    std::vector<TopoDS_Shape> shapes3(specs.size());
-    for (std::size_t k = 0; k < specs.size(); ++k) shapes3[k] = prism_shape(prisms[k], polys[k], margin);
-    result = shapes3[0];
-    for (std::size_t k = 1; k < specs.size(); ++k) result = common(result, shapes3[k], tol);
-    out.mesh = mesh_shape(result, opt.dim_pre, &r.faces_after);
-  } catch (const Standard_Failure& e) {
-    keep_original(out, part, AlphaSimStatus::Failed,
-                  std::string("OpenCASCADE failed: ") + (e.GetMessageString() ? e.GetMessageString() : "?") +
-                      ": original kept");
-    return finish();
-  } catch (const std::exception& e) {
-    keep_original(out, part, AlphaSimStatus::Failed, std::string("OpenCASCADE failed: ") + e.what() + ": original kept");
-    return finish();
-  }
-  r.mesh_ms = ms_since(t_mesh);
-  weld_identical_vertices(out.mesh);
-  const MeshTopology otopo = analyse_topology(out.mesh);
+  // 5–6. extrude and intersect, mesh the result. Each prism runs a margin past the part
+  // so that no cap of one coincides with a face of another.
+  const double margin = std::max(10.0 * tol, 1e-3 * opt.dim_pre);
+  std::vector<Extrusion> extrusions(specs.size());
+  for (std::size_t k = 0; k < specs.size(); ++k)
+    extrusions[k] = {prisms[k].u, prisms[k].v, prisms[k].n, prisms[k].depth_min - margin,
+                     prisms[k].depth_max + margin, polys[k]};
+  // Prisms whose region is an axis-aligned rectangle are slabs the others can carry (the
+  // spar seen from above and from the side): fewer OpenCASCADE Booleans, and none when one
+  // prism is left. Slack tol: the result may stand off the exact intersection by that much
+  // along an axis (it only grows, so containment holds), where projections of the same
+  // part's extent differ by rounding.
+  const ExtrusionReduction reduced =
+      opt.absorb_box_prisms ? reduce_extrusions(extrusions, tol) : ExtrusionReduction{extrusions, 0};
+  r.prisms_absorbed = static_cast<int>(reduced.absorbed);
   // Watertight: no boundary and no misoriented edge. Edges shared by four triangles are
   // allowed: two pieces of the intersection may touch along an edge.
-  const bool watertight = otopo.boundary_edges == 0 && otopo.misoriented_edges == 0;
+  auto watertight_mesh = [](Mesh& m, MeshTopology& t) {
+    weld_identical_vertices(m);
+    t = analyse_topology(m);
+    return t.boundary_edges == 0 && t.misoriented_edges == 0;
+  };
+  MeshTopology otopo;
+  bool watertight = false;
+  if (reduced.kept.size() == 1 && opt.step_dir.empty()) {
+    // One prism: it is the result; mesh it directly (no OpenCASCADE, no STEP asked for).
+    try {
+      out.mesh = extrusion_mesh(reduced.kept[0]);
+      r.faces_after = extrusion_faces(reduced.kept[0]);
+      watertight = watertight_mesh(out.mesh, otopo);
+    } catch (const std::runtime_error&) {
+      watertight = false;  // rings that cross: OpenCASCADE below decides
+    }
+  }
+  TopoDS_Shape result;
+  if (!watertight) {
+    try {
+      std::vector<TopoDS_Shape> solids(reduced.kept.size());
+      for (std::size_t k = 0; k < reduced.kept.size(); ++k) solids[k] = prism_shape(reduced.kept[k]);
+      result = solids[0];
+      for (std::size_t k = 1; k < solids.size(); ++k) result = common(result, solids[k], tol);
+      r.booleans = static_cast<int>(solids.size()) - 1;
+      out.mesh = mesh_shape(result, opt.dim_pre, &r.faces_after);
+    } catch (const Standard_Failure& e) {
+      keep_original(out, part, AlphaSimStatus::Failed,
+                    std::string("OpenCASCADE failed: ") + (e.GetMessageString() ? e.GetMessageString() : "?") +
+                        ": original kept");
+      return finish();
+    } catch (const std::exception& e) {
+      keep_original(out, part, AlphaSimStatus::Failed,
+                    std::string("OpenCASCADE failed: ") + e.what() + ": original kept");
+      return finish();
+    }
+    watertight = watertight_mesh(out.mesh, otopo);
+  }
+  r.mesh_ms = ms_since(t_mesh);
   if (watertight && out.mesh.signed_volume() < 0.0)
     for (auto& f : out.mesh.triangles) std::swap(f[1], f[2]);
   r.closed_after = watertight;

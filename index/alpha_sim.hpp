@@ -64,7 +64,11 @@ struct AlphaSimOptions {
   double polygon_growth_factor = 0.25;
   /// Convex arcs (a cylinder seen end-on) are also coarsened, outwards (grow_simplify).
   bool merge_convex_corners = true;
-  bool build_mesh = true;       ///< OpenCASCADE prisms ∩ → triangle mesh (else implicit only)
+  bool build_mesh = true;       ///< prisms ∩ → triangle mesh (else implicit only)
+  /// Prisms whose region is an axis-aligned rectangle are absorbed into the others
+  /// (reduce_extrusions) before the OpenCASCADE Booleans; false runs every Boolean (an
+  /// ablation: the solid is the same, within the containment tolerance).
+  bool absorb_box_prisms = true;
   bool measure = true;          ///< containment of the mesh + Hausdorff distance
   /// If set, writes <step_dir>/<stem>.step (OpenCASCADE); the stem is simplify_part's
   /// `step_stem`, in simplify_parts the part's output_file_stems entry.
@@ -141,7 +145,11 @@ struct AlphaSimResult {
   double lost_space_resolution = 0.0; ///< grid spacing of that probe
   double time_ms = 0.0;
   double shapes_ms = 0.0;   ///< sampling + α-shapes + repair + implicit verification
-  double mesh_ms = 0.0;     ///< OpenCASCADE prisms, Booleans, meshing
+  double mesh_ms = 0.0;     ///< extrusion, intersection (OpenCASCADE Booleans where needed), meshing
+  /// Prisms whose region was an axis-aligned rectangle and whose slabs the other prisms
+  /// carry (reduce_extrusions): each one is a Boolean fewer.
+  int prisms_absorbed = 0;
+  int booleans = 0;  ///< OpenCASCADE Boolean operations run (0: one prism was left, meshed directly)
   double measure_ms = 0.0;  ///< mesh containment, Hausdorff, lost-space probe
   std::vector<ProjectionReport> projections;
   /// simplify_parts: the earlier part this one is a moved copy of (its result was moved,
