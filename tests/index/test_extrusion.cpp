@@ -198,7 +198,8 @@ std::vector<Vec2> random_star(double cx, double cy, double r, int n, std::mt1993
   std::vector<Vec2> ring;
   for (int k = 0; k < n; ++k) {
     const double a = 2 * M_PI * (k + 0.8 * u(rng)) / n;
-    ring.emplace_back(cx + r * u(rng) * std::cos(a), cy + r * u(rng) * std::sin(a));
+    const double radius = r * u(rng);
+    ring.emplace_back(cx + radius * std::cos(a), cy + radius * std::sin(a));
   }
   return ring;
 }
