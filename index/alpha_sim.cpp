@@ -1006,6 +1006,18 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     } catch (const std::runtime_error&) {
       watertight = false;  // rings that cross: OpenCASCADE below decides
     }
+  } else if (reduced.kept.size() == 2 && opt.step_dir.empty() && axis_aligned(reduced.kept[0]) &&
+             axis_aligned(reduced.kept[1])) {
+    // Two prisms across each other (the rib's outline and its web): sliced along their
+    // common axis, no OpenCASCADE.
+    try {
+      ExtrusionPairMesh pair = extrusion_pair_mesh(reduced.kept[0], reduced.kept[1]);
+      out.mesh = std::move(pair.mesh);
+      r.faces_after = pair.face_planes;
+      watertight = watertight_mesh(out.mesh, otopo);
+    } catch (const std::runtime_error&) {
+      watertight = false;
+    }
   }
   TopoDS_Shape result;
   if (!watertight) {

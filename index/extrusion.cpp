@@ -11,8 +11,10 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <utility>
 
 namespace loom {
@@ -116,6 +118,37 @@ Absorbed absorb_slab(std::vector<Extrusion>& kept, const Slab& s, double slack) 
   return Absorbed::No;
 }
 
+/// Sets each face's info to its nesting depth: the number of constraints crossed from the
+/// unbounded face (odd: inside the constrained rings).
+void mark_nesting(Cdt& cdt) {
+  for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f) f->info() = -1;
+  std::vector<Cdt::Face_handle> frontier{cdt.infinite_face()}, next;
+  cdt.infinite_face()->info() = 0;
+  for (int level = 0; !frontier.empty(); ++level) {
+    // Flood the current level; faces across a constraint start the next one.
+    while (!frontier.empty()) {
+      const Cdt::Face_handle f = frontier.back();
+      frontier.pop_back();
+      for (int i = 0; i < 3; ++i) {
+        const Cdt::Face_handle g = f->neighbor(i);
+        if (g->info() != -1) continue;
+        if (cdt.is_constrained(Cdt::Edge(f, i))) {
+          next.push_back(g);
+        } else {
+          g->info() = level;
+          frontier.push_back(g);
+        }
+      }
+    }
+    for (const auto& g : next)
+      if (g->info() == -1) {
+        g->info() = level + 1;
+        frontier.push_back(g);
+      }
+    next.clear();
+  }
+}
+
 }  // namespace
 
 bool axis_aligned(const Extrusion& e) {
@@ -208,33 +241,7 @@ Mesh extrusion_mesh(const Extrusion& e) {
     } catch (const Cdt::Intersection_of_constraints_exception&) {
       throw std::runtime_error("extrusion: the rings of a polygon cross");
     }
-    // Nesting depth across constraints from the unbounded face: odd is inside.
-    for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f) f->info() = -1;
-    std::vector<Cdt::Face_handle> frontier{cdt.infinite_face()}, next;
-    cdt.infinite_face()->info() = 0;
-    for (int level = 0; !frontier.empty(); ++level) {
-      // Flood the current level; faces across a constraint start the next one.
-      while (!frontier.empty()) {
-        const Cdt::Face_handle f = frontier.back();
-        frontier.pop_back();
-        for (int i = 0; i < 3; ++i) {
-          const Cdt::Face_handle g = f->neighbor(i);
-          if (g->info() != -1) continue;
-          if (cdt.is_constrained(Cdt::Edge(f, i))) {
-            next.push_back(g);
-          } else {
-            g->info() = level;
-            frontier.push_back(g);
-          }
-        }
-      }
-      for (const auto& g : next)
-        if (g->info() == -1) {
-          g->info() = level + 1;
-          frontier.push_back(g);
-        }
-      next.clear();
-    }
+    mark_nesting(cdt);
     for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
       if (f->info() % 2 != 1) continue;
       const int a = f->vertex(0)->info(), b = f->vertex(1)->info(), c = f->vertex(2)->info();
@@ -250,6 +257,254 @@ Mesh extrusion_mesh(const Extrusion& e) {
     m.vertices.push_back(p + e.n * e.depth_max);
   }
   return m;
+}
+
+namespace {
+
+/// A region edge in world coordinates (p: the in-plane axis other than c; g: along c),
+/// g0 < g1 (edges at one height bound no slab and are left out).
+struct SliceEdge {
+  double p0, g0, p1, g1;
+  /// Heights where the edge crosses a depth bound of the other extrusion, and that bound.
+  std::array<double, 2> cross_g = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+  std::array<double, 2> cross_p = {0.0, 0.0};
+  /// p at height g: exactly an end's p at that end's height and exactly the bound at a
+  /// crossing height, so that the pieces meeting there (an edge on one side, the bound on
+  /// the other) share their vertices.
+  double at(double g) const {
+    if (g == g0) return p0;
+    if (g == g1) return p1;
+    for (int i = 0; i < 2; ++i)
+      if (g == cross_g[i]) return cross_p[i];
+    return p0 + (g - g0) * (p1 - p0) / (g1 - g0);
+  }
+};
+
+/// One end of a slice interval: a region edge, or a depth bound of the other extrusion.
+struct SliceBound {
+  const SliceEdge* edge = nullptr;
+  double constant = 0.0;
+  double at(double g) const { return edge ? edge->at(g) : constant; }
+};
+struct SliceInterval {
+  SliceBound lo, hi;
+};
+
+/// An extrusion's region as edges in (p, g) = (world axis ip, world axis ig).
+std::vector<SliceEdge> slice_edges(const Extrusion& e, int ip, int ig) {
+  std::vector<SliceEdge> out;
+  auto ring = [&](const std::vector<Vec2>& r) {
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      const Vec3 x0 = e.u * r[i].x() + e.v * r[i].y();
+      const Vec3 x1 = e.u * r[(i + 1) % r.size()].x() + e.v * r[(i + 1) % r.size()].y();
+      if (x0[ig] < x1[ig]) out.push_back({x0[ip], x0[ig], x1[ip], x1[ig]});
+      else if (x1[ig] < x0[ig]) out.push_back({x1[ip], x1[ig], x0[ip], x0[ig]});
+    }
+  };
+  for (const auto& poly : e.polygons) {
+    ring(poly.outer);
+    for (const auto& h : poly.holes) ring(h);
+  }
+  return out;
+}
+
+/// The region's slice inside the slab [h0, h1], clipped to the depth range [d.lo, d.hi]:
+/// even-odd pairs of the edges spanning it. Valid across the slab because slabs end at
+/// every vertex and depth crossing. Spanning is decided from the edges' ends and the order
+/// from the mean of their values at h0 and h1 (the value at the true middle): a slab one
+/// rounding step thick has no double strictly inside, and two edges meeting at one end
+/// are told apart by the other.
+std::vector<SliceInterval> slice_at(const std::vector<SliceEdge>& edges, double h0, double h1, const Slab& d) {
+  std::vector<std::pair<double, const SliceEdge*>> crossing;
+  for (const SliceEdge& e : edges)
+    if (e.g0 <= h0 && h1 <= e.g1) crossing.emplace_back(0.5 * (e.at(h0) + e.at(h1)), &e);
+  std::sort(crossing.begin(), crossing.end(),
+            [](const auto& x, const auto& y) { return x.first < y.first; });
+  std::vector<SliceInterval> out;
+  for (std::size_t i = 0; i + 1 < crossing.size(); i += 2) {
+    const double lv = crossing[i].first, hv = crossing[i + 1].first;
+    if (hv <= d.lo || lv >= d.hi) continue;
+    SliceInterval iv;
+    iv.lo = lv < d.lo ? SliceBound{nullptr, d.lo} : SliceBound{crossing[i].second, 0.0};
+    iv.hi = hv > d.hi ? SliceBound{nullptr, d.hi} : SliceBound{crossing[i + 1].second, 0.0};
+    out.push_back(iv);
+  }
+  return out;
+}
+
+/// Records in each edge, and adds to `heights`, where it crosses the depth bounds d.lo
+/// (slot 0) and d.hi (slot 1) strictly between its ends.
+void add_crossings(std::vector<SliceEdge>& edges, const Slab& d, std::vector<double>& heights) {
+  for (SliceEdge& e : edges)
+    for (int i = 0; i < 2; ++i) {
+      const double bound = i == 0 ? d.lo : d.hi;
+      if ((e.p0 - bound) * (e.p1 - bound) >= 0.0) continue;
+      e.cross_g[i] = e.g0 + (bound - e.p0) * (e.g1 - e.g0) / (e.p1 - e.p0);
+      e.cross_p[i] = bound;
+      heights.push_back(e.cross_g[i]);
+    }
+}
+
+bool covers(const std::vector<SliceInterval>& ivs, double g, double x) {
+  for (const auto& iv : ivs)
+    if (iv.lo.at(g) < x && x < iv.hi.at(g)) return true;
+  return false;
+}
+
+/// lo, the grid values strictly between, hi (one point if lo == hi).
+std::vector<double> chain(const std::vector<double>& grid, double lo, double hi) {
+  std::vector<double> c{lo};
+  for (double v : grid)
+    if (lo < v && v < hi) c.push_back(v);
+  if (hi > lo) c.push_back(hi);
+  return c;
+}
+
+}  // namespace
+
+ExtrusionPairMesh extrusion_pair_mesh(const Extrusion& a, const Extrusion& b) {
+  const int ia = world_axis(a.n).first, ib = world_axis(b.n).first;
+  if (!axis_aligned(a) || !axis_aligned(b) || ia == ib)
+    throw std::runtime_error("extrusion pair: the frames are not axis-aligned with different normals");
+  const int ic = 3 - ia - ib;
+  // a's region lies in (axis ib, axis ic), its depth along ia; b's in (ia, ic), depth along ib.
+  const Slab da = slab_of(a.n, a.depth_min, a.depth_max), db = slab_of(b.n, b.depth_min, b.depth_max);
+  std::vector<SliceEdge> ea = slice_edges(a, ib, ic), eb = slice_edges(b, ia, ic);
+  std::vector<double> heights;
+  for (const auto* es : {&ea, &eb})
+    for (const SliceEdge& e : *es) {
+      heights.push_back(e.g0);
+      heights.push_back(e.g1);
+    }
+  add_crossings(ea, db, heights);
+  add_crossings(eb, da, heights);
+  std::sort(heights.begin(), heights.end());
+  heights.erase(std::unique(heights.begin(), heights.end()), heights.end());
+  const std::size_t slabs = heights.size() < 2 ? 0 : heights.size() - 1;
+  // Slab k spans [heights[k], heights[k + 1]]: U = slices of b (along ia), V = of a (along ib).
+  std::vector<std::vector<SliceInterval>> us(slabs), vs(slabs);
+  for (std::size_t k = 0; k < slabs; ++k) {
+    us[k] = slice_at(eb, heights[k], heights[k + 1], da);
+    vs[k] = slice_at(ea, heights[k], heights[k + 1], db);
+  }
+  // The grid at each height: every bound of the slabs below and above, evaluated there.
+  std::vector<std::vector<double>> grid_u(heights.size()), grid_v(heights.size());
+  for (std::size_t h = 0; h < heights.size(); ++h) {
+    for (std::size_t k : {h - 1, h}) {
+      if (k >= slabs) continue;  // h - 1 wraps below 0
+      for (const auto& iv : us[k]) grid_u[h].insert(grid_u[h].end(), {iv.lo.at(heights[h]), iv.hi.at(heights[h])});
+      for (const auto& iv : vs[k]) grid_v[h].insert(grid_v[h].end(), {iv.lo.at(heights[h]), iv.hi.at(heights[h])});
+    }
+    for (auto* g : {&grid_u[h], &grid_v[h]}) {
+      std::sort(g->begin(), g->end());
+      g->erase(std::unique(g->begin(), g->end()), g->end());
+    }
+  }
+
+  ExtrusionPairMesh out;
+  Mesh& m = out.mesh;
+  auto point = [&](double pa, double pb, double g) {
+    Vec3 x;
+    x[ia] = pa;
+    x[ib] = pb;
+    x[ic] = g;
+    return x;
+  };
+  // Faces by plane: a bound (edge or depth constant) and which side of the pieces it is
+  // (0–3), or a slice height facing up (4) or down (5).
+  using FaceKey = std::tuple<const void*, double, int>;
+  std::set<FaceKey> planes;
+  // Appends triangle pqr on face `key` facing `outward` (its normal's component along it
+  // is positive).
+  auto tri = [&](const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& outward, const FaceKey& key) {
+    const double s = (q - p).cross(r - p).dot(outward);
+    if (s == 0.0) return;
+    const auto base = static_cast<std::uint32_t>(m.vertices.size());
+    m.vertices.insert(m.vertices.end(), {p, q, r});
+    if (s > 0.0) m.triangles.push_back({base, base + 1, base + 2});
+    else m.triangles.push_back({base, base + 2, base + 1});
+    planes.insert(key);
+  };
+  Vec3 axis_a = Vec3::Zero(), axis_b = Vec3::Zero(), axis_c = Vec3::Zero();
+  axis_a[ia] = 1.0;
+  axis_b[ib] = 1.0;
+  axis_c[ic] = 1.0;
+  // A side face between two chains at heights g0 < g1, each a run of values along the
+  // face; `at(x, g)` places value x of the chain at height g. Zipped into triangles.
+  auto side = [&](const std::vector<double>& c0, const std::vector<double>& c1, double g0, double g1, auto at,
+                  const Vec3& outward, const SliceBound& bound, int which) {
+    const FaceKey key{bound.edge, bound.constant, which};
+    const double l0 = c0.back() - c0.front(), l1 = c1.back() - c1.front();
+    std::size_t i = 0, j = 0;
+    while (i + 1 < c0.size() || j + 1 < c1.size()) {
+      // Advance along the chain whose next point comes first (by fraction of its length).
+      const bool step0 = j + 1 >= c1.size() ||
+                         (i + 1 < c0.size() && (l0 > 0 ? (c0[i + 1] - c0.front()) / l0 : 1.0) <=
+                                                   (l1 > 0 ? (c1[j + 1] - c1.front()) / l1 : 1.0));
+      if (step0) {
+        tri(at(c0[i], g0), at(c0[i + 1], g0), at(c1[j], g1), outward, key);
+        ++i;
+      } else {
+        tri(at(c0[i], g0), at(c1[j + 1], g1), at(c1[j], g1), outward, key);
+        ++j;
+      }
+    }
+  };
+  // A hexahedron whose four bounds are the same in the next slab continues there: it is
+  // emitted once over its whole run, so a height where only other pieces change does not
+  // split its faces (no face of that height touches them).
+  auto same = [](const SliceInterval& x, const SliceInterval& y) {
+    return x.lo.edge == y.lo.edge && x.lo.constant == y.lo.constant && x.hi.edge == y.hi.edge &&
+           x.hi.constant == y.hi.constant;
+  };
+  auto continues = [&](std::size_t k, const SliceInterval& u, const SliceInterval& v) {
+    const bool has_u = std::any_of(us[k].begin(), us[k].end(), [&](const auto& x) { return same(x, u); });
+    return has_u && std::any_of(vs[k].begin(), vs[k].end(), [&](const auto& y) { return same(y, v); });
+  };
+  for (std::size_t k = 0; k < slabs; ++k) {
+    for (const auto& u : us[k])
+      for (const auto& v : vs[k]) {
+        if (k > 0 && continues(k - 1, u, v)) continue;
+        std::size_t last = k;
+        while (last + 1 < slabs && continues(last + 1, u, v)) ++last;
+        const double g0 = heights[k], g1 = heights[last + 1];
+        const auto &grid_v0 = grid_v[k], &grid_v1 = grid_v[last + 1], &grid_u0 = grid_u[k], &grid_u1 = grid_u[last + 1];
+        const double u00 = u.lo.at(g0), u01 = u.hi.at(g0), u10 = u.lo.at(g1), u11 = u.hi.at(g1);
+        const double v00 = v.lo.at(g0), v01 = v.hi.at(g0), v10 = v.lo.at(g1), v11 = v.hi.at(g1);
+        // Faces on the u bounds run along v, and the other way round.
+        const auto cv0 = chain(grid_v0, v00, v01), cv1 = chain(grid_v1, v10, v11);
+        const auto cu0 = chain(grid_u0, u00, u01), cu1 = chain(grid_u1, u10, u11);
+        side(cv0, cv1, g0, g1, [&](double y, double g) { return point(g == g0 ? u00 : u10, y, g); }, -axis_a, u.lo, 0);
+        side(cv0, cv1, g0, g1, [&](double y, double g) { return point(g == g0 ? u01 : u11, y, g); }, axis_a, u.hi, 1);
+        side(cu0, cu1, g0, g1, [&](double x, double g) { return point(x, g == g0 ? v00 : v10, g); }, -axis_b, v.lo, 2);
+        side(cu0, cu1, g0, g1, [&](double x, double g) { return point(x, g == g0 ? v01 : v11, g); }, axis_b, v.hi, 3);
+      }
+  }
+  // At each height: grid cells under material below only face up, above only face down.
+  static const std::vector<SliceInterval> none;
+  for (std::size_t h = 0; h < heights.size(); ++h) {
+    const double g = heights[h];
+    const auto &ub = h > 0 ? us[h - 1] : none, &vb = h > 0 ? vs[h - 1] : none;
+    const auto &ua = h < slabs ? us[h] : none, &va = h < slabs ? vs[h] : none;
+    const auto& gu = grid_u[h];
+    const auto& gv = grid_v[h];
+    for (std::size_t p = 0; p + 1 < gu.size(); ++p)
+      for (std::size_t q = 0; q + 1 < gv.size(); ++q) {
+        const double xm = 0.5 * (gu[p] + gu[p + 1]), ym = 0.5 * (gv[q] + gv[q + 1]);
+        const bool below = covers(ub, g, xm) && covers(vb, g, ym), above = covers(ua, g, xm) && covers(va, g, ym);
+        if (below == above) continue;
+        const Vec3 outward = below ? axis_c : -axis_c;
+        const FaceKey key{nullptr, g, below ? 4 : 5};
+        const Vec3 c00 = point(gu[p], gv[q], g), c10 = point(gu[p + 1], gv[q], g), c11 = point(gu[p + 1], gv[q + 1], g),
+                   c01 = point(gu[p], gv[q + 1], g);
+        tri(c00, c10, c11, outward, key);
+        tri(c00, c11, c01, outward, key);
+      }
+  }
+  if (m.triangles.empty()) throw std::runtime_error("extrusion pair: the intersection is empty");
+  weld_identical_vertices(m);
+  out.face_planes = static_cast<int>(planes.size());
+  return out;
 }
 
 int extrusion_faces(const Extrusion& e) {

@@ -927,39 +927,44 @@ TEST(AlphaSim, LongBoxIsTwelveTriangles) {
 }
 
 TEST(AlphaSim, AbsorbedBoxPrismsGiveTheSolidOfEveryBoolean) {
-  // A U-channel (rectangles from the side and the end: no Boolean left), the L-bracket
+  // A U-channel (rectangles from the side and the end: one prism left), the L-bracket
   // (a rectangle from two sides), a box (one box) and a cylinder across the axes (one
-  // rectangle absorbed): the same solid as intersecting all three prisms with OpenCASCADE.
+  // rectangle absorbed, two prisms left: sliced): the same solid as intersecting all three
+  // prisms with OpenCASCADE, with no Boolean run.
   struct Case {
     Part part;
     double dim_pre;
-    int booleans;  // left after absorbing
+    int kept;  // prisms left after absorbing
   };
   std::vector<Case> cases;
   cases.push_back({make_part("U", extruded_grid(20, 6, 1.0, 30.0,
                                                 [](int i, int j) { return j == 0 || i < 2 || i > 17; })),
-                   1.0, 0});
+                   1.0, 1});
   cases.push_back({make_part("L", extruded_grid(12, 12, 1.0, 2.0, [](int i, int j) { return i < 3 || j < 3; })),
-                   1.0, 0});
-  cases.push_back({make_part("box", box_mesh({0, 0, 0}, {40, 6, 20})), 2.0, 0});
+                   1.0, 1});
+  cases.push_back({make_part("box", box_mesh({0, 0, 0}, {40, 6, 20})), 2.0, 1});
   Mesh cyl = cylinder_mesh(5.0, 20.0, 48);
   for (auto& v : cyl.vertices) v = Vec3(v.z(), v.x(), v.y());  // along x
-  cases.push_back({make_part("cyl-x", cyl), 1.0, 1});
+  cases.push_back({make_part("cyl-x", cyl), 1.0, 2});
   for (const Case& c : cases) {
     AlphaSimOptions every = options(c.dim_pre);
     every.absorb_box_prisms = false;
     const auto a = simplify_part(c.part, options(c.dim_pre)), b = simplify_part(c.part, every);
     ASSERT_EQ(a.result.status, AlphaSimStatus::Ok) << c.part.name << ": " << a.result.reason;
     ASSERT_EQ(b.result.status, AlphaSimStatus::Ok) << c.part.name << ": " << b.result.reason;
-    EXPECT_EQ(a.result.booleans, c.booleans) << c.part.name;
-    EXPECT_EQ(a.result.prisms_absorbed, 2 - c.booleans) << c.part.name;
+    EXPECT_EQ(a.result.booleans, 0) << c.part.name;
+    EXPECT_EQ(a.result.prisms_absorbed, 3 - c.kept) << c.part.name;
     EXPECT_EQ(b.result.booleans, 2) << c.part.name;
     EXPECT_TRUE(a.result.closed_after) << c.part.name;
     EXPECT_DOUBLE_EQ(a.result.containment, 1.0) << c.part.name;
     // Absorbing may stand off by the containment tolerance along an axis, no more.
     EXPECT_NEAR(a.result.volume_after, b.result.volume_after, 1e-6 * b.result.volume_after) << c.part.name;
     EXPECT_NEAR(a.result.hausdorff, b.result.hausdorff, a.result.tolerance + 1e-12) << c.part.name;
-    EXPECT_EQ(a.result.faces_after, b.result.faces_after) << c.part.name;
+    if (c.kept == 1) {
+      EXPECT_EQ(a.result.faces_after, b.result.faces_after) << c.part.name;
+    }
+    // Slabs split faces where OpenCASCADE has one: more triangles, never many more here.
+    EXPECT_LE(a.result.triangles_after, 2 * b.result.triangles_after) << c.part.name;
     // Both meshes are the same surface: every vertex of one lies on the other.
     const EmbreeIndex on_b({make_part("b", b.mesh)});
     for (const Vec3& v : a.mesh.vertices)

@@ -15,6 +15,7 @@
 #include "core/part.hpp"
 #include "index/box_pairs.hpp"
 #include "index/embree_index.hpp"
+#include "index/extrusion.hpp"
 #include "routing/sweep.hpp"
 
 namespace {
@@ -119,4 +120,50 @@ TEST(Regression, EmbreeApproximateSegmentQueryKeepsTheCallersRadiusUntilAHit) {
   EXPECT_LE(h.distance, 1.1);
 }
 
+// Found while writing extrusion_pair_mesh (not landed): the grown outline of a 48-sided
+// cylinder seen end on has two vertices whose x differ by one rounding step
+// (3.8834821936197748 and ...752), so the slab between those heights had no double
+// strictly inside. Its midpoint equalled one end, the edge ending there was not counted as
+// crossing it, the slab came out empty, and the solid got an internal crack of width
+// 4e-16 (two full cross-sections facing away from each other), measured as a Hausdorff
+// distance of 1.11 against 0.25. Spanning is now decided from the edges' ends.
+TEST(Regression, ExtrusionPairSlabOneRoundingStepThickKeepsItsMaterial) {
+  using loom::Extrusion;
+  using loom::PolygonWithHoles2;
+  using loom::Vec2;
+  Extrusion xy;  // u = x, v = y, n = z
+  xy.depth_min = 0;
+  xy.depth_max = 20;
+  const double r[][2] = {{-4.6998064879820269, -1.9467373520048534}, {-3.7835190904341873, -3.3180565361232524},
+                         {-2.2845623299736051, -4.6326075317266646}, {-1.6653345369377348e-15, -5.0870446340321855},
+                         {1.9467373520048532, -4.6998064879820278},  {3.8834821936197748, -3.4057132446366323},
+                         {5.0660457239771155, -1.0076964768729766},  {4.9137077307296124, 1.3166093198595945},
+                         {3.8834821936197752, 3.4057132446366318},   {1.9467373520048532, 4.6998064879820278},
+                         {-1.6653345369377348e-15, 5.0870446340321855}, {-2.2845623299736051, 4.6326075317266646},
+                         {-3.7835190904341873, 3.3180565361232524},  {-4.6998064879820278, 1.9467373520048532},
+                         {-5.0870446340321855, -1.8873791418627661e-15}};
+  PolygonWithHoles2 outline;
+  for (const auto& q : r) outline.outer.emplace_back(q[0], q[1]);
+  xy.polygons = {outline};
+  Extrusion xz;
+  xz.u = Vec3::UnitX();
+  xz.v = Vec3::UnitZ();
+  xz.n = -Vec3::UnitY();
+  xz.depth_min = -5;
+  xz.depth_max = 5;
+  xz.polygons = {PolygonWithHoles2{{Vec2(-5, 0), Vec2(5, 0), Vec2(5, 20), Vec2(-5, 20)}, {}}};
+  const loom::ExtrusionPairMesh pm = loom::extrusion_pair_mesh(xy, xz);
+  // No face across the solid: every triangle lies on the outline's walls, the planes
+  // |x| = 5, |y| = 5 or the ends z = 0, 20.
+  for (const auto& t : pm.mesh.triangles) {
+    const Vec3 c = (pm.mesh.vertices[t[0]] + pm.mesh.vertices[t[1]] + pm.mesh.vertices[t[2]]) / 3.0;
+    const bool end = std::abs(c.z()) < 1e-9 || std::abs(c.z() - 20.0) < 1e-9;
+    const bool side = std::abs(std::abs(c.x()) - 5.0) < 1e-9 || std::abs(std::abs(c.y()) - 5.0) < 1e-9 ||
+                      std::hypot(c.x(), c.y()) > 4.9;
+    EXPECT_TRUE(end || side) << "triangle inside the solid at " << c.transpose();
+  }
+  EXPECT_GT(pm.mesh.signed_volume(), 0.0);
+}
+
 }  // namespace
+
