@@ -997,26 +997,16 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   };
   MeshTopology otopo;
   bool watertight = false;
-  if (reduced.kept.size() == 1 && opt.step_dir.empty()) {
-    // One prism: it is the result; mesh it directly (no OpenCASCADE, no STEP asked for).
+  if (reduced.kept.size() <= 2 && opt.step_dir.empty()) {
+    // One prism is the result; two across each other (the rib's outline and its web) are
+    // sliced along their common axis. No OpenCASCADE (and no STEP asked for).
     try {
-      out.mesh = extrusion_mesh(reduced.kept[0]);
-      r.faces_after = extrusion_faces(reduced.kept[0]);
+      ExtrusionsMesh direct = mesh_extrusions(reduced.kept);
+      out.mesh = std::move(direct.mesh);
+      r.faces_after = direct.faces;
       watertight = watertight_mesh(out.mesh, otopo);
     } catch (const std::runtime_error&) {
-      watertight = false;  // rings that cross: OpenCASCADE below decides
-    }
-  } else if (reduced.kept.size() == 2 && opt.step_dir.empty() && axis_aligned(reduced.kept[0]) &&
-             axis_aligned(reduced.kept[1])) {
-    // Two prisms across each other (the rib's outline and its web): sliced along their
-    // common axis, no OpenCASCADE.
-    try {
-      ExtrusionPairMesh pair = extrusion_pair_mesh(reduced.kept[0], reduced.kept[1]);
-      out.mesh = std::move(pair.mesh);
-      r.faces_after = pair.face_planes;
-      watertight = watertight_mesh(out.mesh, otopo);
-    } catch (const std::runtime_error&) {
-      watertight = false;
+      watertight = false;  // e.g. rings that cross, frames not along the axes: OpenCASCADE decides
     }
   }
   TopoDS_Shape result;

@@ -362,7 +362,7 @@ std::vector<double> chain(const std::vector<double>& grid, double lo, double hi)
 
 }  // namespace
 
-ExtrusionPairMesh extrusion_pair_mesh(const Extrusion& a, const Extrusion& b) {
+ExtrusionsMesh extrusion_pair_mesh(const Extrusion& a, const Extrusion& b) {
   const int ia = world_axis(a.n).first, ib = world_axis(b.n).first;
   if (!axis_aligned(a) || !axis_aligned(b) || ia == ib)
     throw std::runtime_error("extrusion pair: the frames are not axis-aligned with different normals");
@@ -401,7 +401,7 @@ ExtrusionPairMesh extrusion_pair_mesh(const Extrusion& a, const Extrusion& b) {
     }
   }
 
-  ExtrusionPairMesh out;
+  ExtrusionsMesh out;
   Mesh& m = out.mesh;
   auto point = [&](double pa, double pb, double g) {
     Vec3 x;
@@ -503,7 +503,7 @@ ExtrusionPairMesh extrusion_pair_mesh(const Extrusion& a, const Extrusion& b) {
   }
   if (m.triangles.empty()) throw std::runtime_error("extrusion pair: the intersection is empty");
   weld_identical_vertices(m);
-  out.face_planes = static_cast<int>(planes.size());
+  out.faces = static_cast<int>(planes.size());
   return out;
 }
 
@@ -514,6 +514,12 @@ int extrusion_faces(const Extrusion& e) {
     for (const auto& h : p.holes) faces += static_cast<int>(h.size());
   }
   return faces;
+}
+
+ExtrusionsMesh mesh_extrusions(const std::vector<Extrusion>& kept) {
+  if (kept.size() == 1) return {extrusion_mesh(kept[0]), extrusion_faces(kept[0])};
+  if (kept.size() == 2) return extrusion_pair_mesh(kept[0], kept[1]);
+  throw std::runtime_error("extrusions: " + std::to_string(kept.size()) + " to intersect need a general Boolean");
 }
 
 }  // namespace loom

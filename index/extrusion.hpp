@@ -4,7 +4,8 @@
 /// frame whose axes are world axes, is the intersection of three axis slabs; each slab is
 /// either implied by another prism's extent or applied by clipping another prism's depth
 /// range (or rectangle). Absorbing such prisms leaves fewer general Booleans to run, and
-/// none at all when a single prism remains: that prism is then meshed directly.
+/// none at all when one prism remains (meshed directly) or two whose normals are different
+/// axes (sliced along the third).
 /// All coordinates are world frame, scene units.
 
 #include "core/mesh.hpp"
@@ -56,22 +57,29 @@ Mesh extrusion_mesh(const Extrusion& e);
 /// B-rep faces of the extrusion as a solid: one wall per ring edge, two caps per polygon.
 int extrusion_faces(const Extrusion& e);
 
-/// Closed, outward-oriented mesh of the intersection of two axis-aligned extrusions whose
-/// normals are different world axes (so both regions contain the third axis, c), and the
-/// number of its distinct face planes. Sliced along c at every vertex of either region and
-/// where an edge crosses the other extrusion's depth bounds, each slab is a union of
-/// hexahedra (a slice of one region times a slice of the other, bounds moving linearly);
-/// at each slice plane the faces are the cells of the bounds' grid that lie below or above
-/// only, and every edge in that plane is split at every grid point it passes, so vertices
-/// are shared (computed once per edge and height) and the mesh is conforming. Faces stay
-/// split where their pieces are: re-triangulating each face plane as a whole gave fewer
-/// triangles but long ones across whole faces, coarser Embree leaves and ~20% slower
-/// clearance queries on the wing. Throws std::runtime_error when the frames are not of
-/// that kind or the intersection is empty.
-struct ExtrusionPairMesh {
+/// A closed, outward-oriented mesh of an intersection of extrusions, and its faces: B-rep
+/// faces for one extrusion (extrusion_faces), distinct face planes for two.
+struct ExtrusionsMesh {
   Mesh mesh;
-  int face_planes = 0;
+  int faces = 0;
 };
-ExtrusionPairMesh extrusion_pair_mesh(const Extrusion& a, const Extrusion& b);
+
+/// The intersection of two axis-aligned extrusions whose normals are different world axes
+/// (so both regions contain the third axis, c). Sliced along c at every vertex of either
+/// region and where an edge crosses the other extrusion's depth bounds, each slab is a
+/// union of hexahedra (a slice of one region times a slice of the other, bounds moving
+/// linearly); at each slice plane the faces are the cells of the bounds' grid that lie
+/// below or above only, and every edge in that plane is split at every grid point it
+/// passes, so vertices are shared (computed once per edge and height) and the mesh is
+/// conforming. Faces stay split where their pieces are: re-triangulating each face plane as
+/// a whole gave fewer triangles but long ones across whole faces, coarser Embree leaves and
+/// ~20% slower clearance queries on the wing. Throws std::runtime_error when the frames are
+/// not of that kind or the intersection is empty.
+ExtrusionsMesh extrusion_pair_mesh(const Extrusion& a, const Extrusion& b);
+
+/// The intersection of `kept` meshed without a general Boolean: one extrusion
+/// (extrusion_mesh) or two (extrusion_pair_mesh). Throws std::runtime_error for any other
+/// count, and what those throw.
+ExtrusionsMesh mesh_extrusions(const std::vector<Extrusion>& kept);
 
 }  // namespace loom

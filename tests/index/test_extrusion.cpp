@@ -317,7 +317,7 @@ TEST(ExtrusionPair, CrossedSquareFramesHaveTheirClosedFormVolume) {
   yz.polygons = {PolygonWithHoles2{{Vec2(0, 0), Vec2(8, 0), Vec2(4, 10)}, {}}};
   yz.depth_min = -1;
   yz.depth_max = 11;
-  const ExtrusionPairMesh pm = extrusion_pair_mesh(xz, yz);
+  const ExtrusionsMesh pm = extrusion_pair_mesh(xz, yz);
   expect_closed(pm.mesh, "frames");
   // ∫ w_x(z) w_y(z) dz, w_y = 8 (1 - z/10); w_x = 10 outside z ∈ (2, 8), 4 inside.
   auto w_y_integral = [](double a, double b) { return 8.0 * ((b - a) - (b * b - a * a) / 20.0); };
@@ -326,7 +326,7 @@ TEST(ExtrusionPair, CrossedSquareFramesHaveTheirClosedFormVolume) {
   // Nine planes: the frame's four walls across z (x = 0, 2, 8, 10), the triangle's two
   // slanted walls, and the slice planes z = 0 (facing down), 2 (up, under the hole) and 8
   // (down, over it); the apex at z = 10 is an edge.
-  EXPECT_EQ(pm.face_planes, 9);
+  EXPECT_EQ(pm.faces, 9);
 
   // Depth ranges that cut the other region: y ∈ [1, 5] clips the triangle's slices, and
   // x ∈ [3, 20] the frame's.
@@ -334,7 +334,7 @@ TEST(ExtrusionPair, CrossedSquareFramesHaveTheirClosedFormVolume) {
   xz.depth_max = -1;
   yz.depth_min = 3;
   yz.depth_max = 20;
-  const ExtrusionPairMesh cut = extrusion_pair_mesh(xz, yz);
+  const ExtrusionsMesh cut = extrusion_pair_mesh(xz, yz);
   expect_closed(cut.mesh, "cut");
   const double v = pair_volume(xz, yz, 200000);
   EXPECT_NEAR(cut.mesh.signed_volume(), v, 1e-6 * v);
@@ -351,6 +351,9 @@ TEST(ExtrusionPair, RefusesParallelFramesAndEmptyIntersections) {
   c.depth_min = -1;
   c.depth_max = 2;
   EXPECT_THROW(extrusion_pair_mesh(a, c), std::runtime_error);
+  // Three need a general Boolean; one is meshed as it is.
+  EXPECT_THROW(mesh_extrusions({a, c, c}), std::runtime_error);
+  EXPECT_EQ(mesh_extrusions({a}).faces, extrusion_faces(a));
 }
 
 RC_GTEST_PROP(ExtrusionPairProperty, RandomRegionsGiveAClosedSolidOfTheSlicedVolume, ()) {
@@ -379,7 +382,7 @@ RC_GTEST_PROP(ExtrusionPairProperty, RandomRegionsGiveAClosedSolidOfTheSlicedVol
   region(xz);
   region(yz);
   const double v = pair_volume(xz, yz, 100000);
-  ExtrusionPairMesh pm;
+  ExtrusionsMesh pm;
   try {
     pm = extrusion_pair_mesh(xz, yz);
   } catch (const std::runtime_error&) {

@@ -152,7 +152,7 @@ TEST(Regression, ExtrusionPairSlabOneRoundingStepThickKeepsItsMaterial) {
   xz.depth_min = -5;
   xz.depth_max = 5;
   xz.polygons = {PolygonWithHoles2{{Vec2(-5, 0), Vec2(5, 0), Vec2(5, 20), Vec2(-5, 20)}, {}}};
-  const loom::ExtrusionPairMesh pm = loom::extrusion_pair_mesh(xy, xz);
+  const loom::ExtrusionsMesh pm = loom::extrusion_pair_mesh(xy, xz);
   // No face across the solid: every triangle lies on the outline's walls, the planes
   // |x| = 5, |y| = 5 or the ends z = 0, 20.
   for (const auto& t : pm.mesh.triangles) {
