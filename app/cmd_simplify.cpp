@@ -102,6 +102,7 @@ int run_simplify(const SimplifyCommandOptions& o) {
                      {"copy_of", r.copy_of},
                      {"prisms_absorbed", r.prisms_absorbed},
                      {"booleans", r.booleans},
+                     {"booleans_by", r.booleans_by},
                      {"projections", projections}});
     if (!o.quiet) {
       // Below the containment tolerance a distance is rounding (a part kept as it was).

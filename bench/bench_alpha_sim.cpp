@@ -145,6 +145,34 @@ std::vector<Part> scene_files(const Scene& settings_only, double linear, double 
   return parts;
 }
 
+/// One set of parts simplified together at one dim_pre.
+struct Set {
+  std::string name;
+  std::vector<Part> parts;
+  double dim_pre;
+};
+
+/// The wing-section scene at its own dim_pre (unless `quick`) and the real meshes at 2% of
+/// their diagonal.
+std::vector<Set> load_sets(bool quick) {
+  std::vector<Set> sets;
+  if (!quick) try {
+    const Scene wing = load_scene(fs::path(LOOM_SOURCE_DIR) / "examples" / "wing-section" / "scene.toml");
+    sets.push_back({"wing-section", wing.parts, wing.simplify.dim_pre.value});
+    std::printf("wing-section: %zu parts, %zu triangles, dim_pre %g (%s)\n", wing.parts.size(), wing.triangle_count(),
+                wing.simplify.dim_pre.value, wing.simplify.dim_pre.source.c_str());
+  } catch (const std::exception& e) {
+    std::printf("wing-section scene not loaded: %s\n", e.what());
+  }
+  for (const char* rel : {"occt/motor.stl", "trimesh/featuretype.STL", "fcl/env.obj", "occt/shape.stl",
+                          "trimesh/bunny.ply", "trimesh/tube.obj"}) {
+    Part p = load_part(rel);
+    const double dim = 0.02 * p.mesh.bounds().diagonal();
+    sets.push_back({rel, {p}, dim});
+  }
+  return sets;
+}
+
 /// One index call planning made, with its arguments, for replay on another index.
 struct LoggedQuery {
   enum Kind { kAnyWithin, kInside, kClosest, kSegmentWithin, kKinds };
@@ -309,6 +337,57 @@ void run_gnuplot(const fs::path& script) {
   if (std::system(cmd.c_str()) != 0) std::printf("gnuplot failed\n");
 }
 
+/// Part 3: throughput on all the sets together, 1 vs 2 threads (alpha_sim_throughput.csv).
+void throughput(const fs::path& out_dir, const std::vector<Set>& sets) {
+  std::vector<Part> all;
+  std::size_t all_tris = 0;
+  for (std::size_t s = 0; s < sets.size(); ++s)
+    for (const auto& p : sets[s].parts) {
+      all.push_back(p);
+      all_tris += p.mesh.triangle_count();
+    }
+  std::ofstream tp_csv(out_dir / "alpha_sim_throughput.csv");
+  tp_csv << "threads,triangles,seconds,triangles_per_second,measure,cpu_seconds,triangles_per_cpu_second,"
+            "absorb_box_prisms,occt_booleans\n";
+  // Without the measures: as loom runs, then with the general Booleans on OpenCASCADE (the
+  // twenty-second session's path), then with every OpenCASCADE Boolean run (no prism
+  // absorbed: the solids before it) — the baselines in the same process; last, as loom
+  // runs with the mesh verification. LOOM_TP_ONE=1 runs the first only (for profiling).
+  struct Config {
+    bool measure, absorb, occt;
+    const char* what;
+  };
+  const Config configs[] = {{false, true, false, "without mesh verification"},
+                            {false, true, true, "without mesh verification, OpenCASCADE Booleans"},
+                            {false, false, true, "without mesh verification, every OpenCASCADE Boolean run"},
+                            {true, true, false, "with verification"}};
+  const std::size_t n_configs = std::getenv("LOOM_TP_ONE") ? 1 : std::size(configs);
+  for (std::size_t c = 0; c < n_configs; ++c)
+    for (int threads : {1, 2}) {
+      const Config& cf = configs[c];
+      tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+      const auto t0 = Clock::now();
+      const double cpu0 = cpu_seconds();
+      // The sets run concurrently, as the parts of one scene would (each set has its own
+      // dim_pre, so they cannot be one simplify_parts call).
+      tbb::parallel_for(std::size_t(0), sets.size(), [&](std::size_t s) {
+        AlphaSimOptions o;
+        o.dim_pre = sets[s].dim_pre;
+        o.measure = cf.measure;
+        o.absorb_box_prisms = cf.absorb;
+        o.occt_booleans = cf.occt;
+        std::vector<AlphaSimResult> res;
+        simplify_parts(sets[s].parts, o, &res);
+      });
+      const double sec = seconds_since(t0), cpu = cpu_seconds() - cpu0;
+      tp_csv << threads << "," << all_tris << "," << sec << "," << all_tris / sec << "," << int(cf.measure) << ","
+             << cpu << "," << all_tris / cpu << "," << int(cf.absorb) << "," << int(cf.occt) << "\n";
+      std::printf("throughput (%s): %d thread(s): %zu triangles in %.2f s = %.3g triangles/s (CPU %.2f s = %.3g "
+                  "triangles per CPU second)\n",
+                  cf.what, threads, all_tris, sec, all_tris / sec, cpu, all_tris / cpu);
+    }
+}
+
 /// 5. The wing's CAD files at four tessellations, 0.4 mm / 20° to 0.01 mm / 2.5° (the
 /// scene's own is 0.065 mm / 20°; a CAD export for clash analysis may be finer): α-SIM's
 /// cost follows the projected area in L_max² cells and the input size, its benefit the
@@ -373,10 +452,12 @@ void tessellation_sweep(const fs::path& out_dir, const Scene& wing_settings, int
 }  // namespace
 
 int main(int argc, char** argv) {
-  // `bench_alpha_sim --tessellation [DIR]` runs only part 5, `--planner [DIR]` only part 6.
+  // `bench_alpha_sim --tessellation [DIR]` runs only part 5, `--planner [DIR]` only part 6,
+  // `--throughput [DIR]` only part 3.
   const bool tessellation_only = argc > 1 && std::string(argv[1]) == "--tessellation";
   const bool planner_only = argc > 1 && std::string(argv[1]) == "--planner";
-  const int arg0 = tessellation_only || planner_only ? 2 : 1;
+  const bool throughput_only = argc > 1 && std::string(argv[1]) == "--throughput";
+  const int arg0 = tessellation_only || planner_only || throughput_only ? 2 : 1;
   const fs::path out_dir = argc > arg0 ? fs::path(argv[arg0]) : fs::path(LOOM_SOURCE_DIR) / "bench" / "results";
   fs::create_directories(out_dir);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
@@ -395,6 +476,12 @@ int main(int argc, char** argv) {
     planner_queries(out_dir);
     return 0;
   }
+  // LOOM_BENCH_QUICK=1 skips the wing-section scene (14 STEP parts: seconds to load and simplify).
+  const bool quick = std::getenv("LOOM_BENCH_QUICK") != nullptr;
+  if (throughput_only) {
+    throughput(out_dir, load_sets(quick));
+    return 0;
+  }
 
   // ---- 1 + 2: per part, at the scene's dim_pre (wing) or 2% of the part diagonal (real meshes).
   std::ofstream parts_csv(out_dir / "alpha_sim_parts.csv");
@@ -402,28 +489,7 @@ int main(int argc, char** argv) {
                "query_rate_original,query_rate_simplified,query_speedup,near_rate_original,near_rate_simplified,"
                "near_speedup,clearance_box_original,clearance_box_simplified,clearance_box_speedup,"
                "clearance_near_original,clearance_near_simplified,clearance_near_speedup,copy_of,shapes_ms,mesh_ms,measure_ms\n";
-  struct Set {
-    std::string name;
-    std::vector<Part> parts;
-    double dim_pre;
-  };
-  std::vector<Set> sets;
-  // LOOM_BENCH_QUICK=1 skips the wing-section scene (14 STEP parts: seconds to load and simplify).
-  const bool quick = std::getenv("LOOM_BENCH_QUICK") != nullptr;
-  if (!quick) try {
-    const Scene wing = load_scene(fs::path(LOOM_SOURCE_DIR) / "examples" / "wing-section" / "scene.toml");
-    sets.push_back({"wing-section", wing.parts, wing.simplify.dim_pre.value});
-    std::printf("wing-section: %zu parts, %zu triangles, dim_pre %g (%s)\n", wing.parts.size(), wing.triangle_count(),
-                wing.simplify.dim_pre.value, wing.simplify.dim_pre.source.c_str());
-  } catch (const std::exception& e) {
-    std::printf("wing-section scene not loaded: %s\n", e.what());
-  }
-  for (const char* rel : {"occt/motor.stl", "trimesh/featuretype.STL", "fcl/env.obj", "occt/shape.stl",
-                          "trimesh/bunny.ply", "trimesh/tube.obj"}) {
-    Part p = load_part(rel);
-    const double dim = 0.02 * p.mesh.bounds().diagonal();
-    sets.push_back({rel, {p}, dim});
-  }
+  const std::vector<Set> sets = load_sets(quick);
   std::size_t total_in = 0;
   for (const auto& set : sets) {
     AlphaSimOptions opt;
@@ -476,44 +542,7 @@ int main(int argc, char** argv) {
                 set.name.c_str(), cb.original, cb.simplified, cb.speedup(), cn.original, cn.simplified, cn.speedup());
   }
 
-  // ---- 3: throughput on all real-mesh parts together, 1 vs 2 threads.
-  std::vector<Part> all;
-  std::size_t all_tris = 0;
-  for (std::size_t s = 0; s < sets.size(); ++s)
-    for (const auto& p : sets[s].parts) {
-      all.push_back(p);
-      all_tris += p.mesh.triangle_count();
-    }
-  std::ofstream tp_csv(out_dir / "alpha_sim_throughput.csv");
-  tp_csv << "threads,triangles,seconds,triangles_per_second,measure,cpu_seconds,triangles_per_cpu_second,"
-            "absorb_box_prisms\n";
-  // Without the measures, also with every OpenCASCADE Boolean run (absorb_box_prisms =
-  // false: the solids before the twenty-second session), the baseline in the same process.
-  for (int run = 0; run < 3; ++run)
-    for (int threads : {1, 2}) {
-      const int measure = run == 2 ? 1 : 0;
-      const bool absorb = run != 1;
-      tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
-      const auto t0 = Clock::now();
-      const double cpu0 = cpu_seconds();
-      // The sets run concurrently, as the parts of one scene would (each set has its own
-      // dim_pre, so they cannot be one simplify_parts call).
-      tbb::parallel_for(std::size_t(0), sets.size(), [&](std::size_t s) {
-        AlphaSimOptions o;
-        o.dim_pre = sets[s].dim_pre;
-        o.measure = measure != 0;
-        o.absorb_box_prisms = absorb;
-        std::vector<AlphaSimResult> res;
-        simplify_parts(sets[s].parts, o, &res);
-      });
-      const double sec = seconds_since(t0), cpu = cpu_seconds() - cpu0;
-      tp_csv << threads << "," << all_tris << "," << sec << "," << all_tris / sec << "," << measure << "," << cpu << ","
-             << all_tris / cpu << "," << absorb << "\n";
-      std::printf("throughput (%s%s): %d thread(s): %zu triangles in %.2f s = %.3g triangles/s (CPU %.2f s = %.3g "
-                  "triangles per CPU second)\n",
-                  measure ? "with verification" : "without mesh verification",
-                  absorb ? "" : ", every Boolean run", threads, all_tris, sec, all_tris / sec, cpu, all_tris / cpu);
-    }
+  throughput(out_dir, sets);
 
   // ---- 4: dim_pre sweep on the motor.
   Part motor = load_part("occt/motor.stl");

@@ -997,16 +997,21 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   };
   MeshTopology otopo;
   bool watertight = false;
-  if (reduced.kept.size() <= 2 && opt.step_dir.empty()) {
+  if (opt.step_dir.empty() && !(opt.occt_booleans && reduced.kept.size() > 2)) {
     // One prism is the result; two across each other (the rib's outline and its web) are
-    // sliced along their common axis. No OpenCASCADE (and no STEP asked for).
+    // sliced along their common axis; a third is intersected by exact corefinement (CGAL).
+    // No OpenCASCADE (and no STEP asked for).
     try {
-      ExtrusionsMesh direct = mesh_extrusions(reduced.kept);
+      // Vertices the corefinement leaves on straight edges are removed within tol/4, as
+      // the outlines' collinear points were (merge_tol): containment stays within tol.
+      ExtrusionsMesh direct = mesh_extrusions(reduced.kept, tol / 4.0);
       out.mesh = std::move(direct.mesh);
       r.faces_after = direct.faces;
+      r.booleans = direct.booleans;
+      r.booleans_by = direct.booleans > 0 ? "cgal" : "none";
       watertight = watertight_mesh(out.mesh, otopo);
     } catch (const std::runtime_error&) {
-      watertight = false;  // e.g. rings that cross, frames not along the axes: OpenCASCADE decides
+      watertight = false;  // e.g. rings that cross, a non-manifold result: OpenCASCADE decides
     }
   }
   TopoDS_Shape result;
@@ -1017,6 +1022,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       result = solids[0];
       for (std::size_t k = 1; k < solids.size(); ++k) result = common(result, solids[k], tol);
       r.booleans = static_cast<int>(solids.size()) - 1;
+      r.booleans_by = r.booleans > 0 ? "opencascade" : "none";
       out.mesh = mesh_shape(result, opt.dim_pre, &r.faces_after);
     } catch (const Standard_Failure& e) {
       keep_original(out, part, AlphaSimStatus::Failed,

@@ -66,9 +66,14 @@ struct AlphaSimOptions {
   bool merge_convex_corners = true;
   bool build_mesh = true;       ///< prisms ∩ → triangle mesh (else implicit only)
   /// Prisms whose region is an axis-aligned rectangle are absorbed into the others
-  /// (reduce_extrusions) before the OpenCASCADE Booleans; false runs every Boolean (an
+  /// (reduce_extrusions) before any general Boolean; false runs every Boolean (an
   /// ablation: the solid is the same, within the containment tolerance).
   bool absorb_box_prisms = true;
+  /// The general Booleans (three prisms with general outlines) run on OpenCASCADE solids
+  /// instead of CGAL's exact corefinement of the prism meshes (mesh_extrusions): the path
+  /// before the twenty-third session, kept as the ablation and bench baseline. STEP output
+  /// always uses OpenCASCADE (it needs the B-rep).
+  bool occt_booleans = false;
   bool measure = true;          ///< containment of the mesh + Hausdorff distance
   /// If set, writes <step_dir>/<stem>.step (OpenCASCADE); the stem is simplify_part's
   /// `step_stem`, in simplify_parts the part's output_file_stems entry.
@@ -149,7 +154,10 @@ struct AlphaSimResult {
   /// Prisms whose region was an axis-aligned rectangle and whose slabs the other prisms
   /// carry (reduce_extrusions): each one is a Boolean fewer.
   int prisms_absorbed = 0;
-  int booleans = 0;  ///< OpenCASCADE Boolean operations run (0: one prism was left, meshed directly)
+  /// General Boolean operations run (0: one prism was left, or two sliced by loom).
+  int booleans = 0;
+  /// What ran them: "none", "cgal" (exact mesh corefinement) or "opencascade" (B-rep).
+  std::string booleans_by = "none";
   double measure_ms = 0.0;  ///< mesh containment, Hausdorff, lost-space probe
   std::vector<ProjectionReport> projections;
   /// simplify_parts: the earlier part this one is a moved copy of (its result was moved,

@@ -1,10 +1,6 @@
 #include "index/extrusion.hpp"
 
-#include <CGAL/Constrained_Delaunay_triangulation_2.h>
-#include <CGAL/Constrained_triangulation_face_base_2.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_face_base_with_info_2.h>
-#include <CGAL/Triangulation_vertex_base_with_info_2.h>
+#include "index/ring_triangulation.hpp"
 
 #include <algorithm>
 #include <array>
@@ -19,15 +15,6 @@
 
 namespace loom {
 namespace {
-
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb = CGAL::Triangulation_vertex_base_with_info_2<int, K>;
-using Fbb = CGAL::Triangulation_face_base_with_info_2<int, K>;
-using Fb = CGAL::Constrained_triangulation_face_base_2<K, Fbb>;
-using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
-// Crossing constraints throw instead of inserting constructed points: a cap must use the
-// rings' own vertices, or the walls and caps would not share them.
-using Cdt = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::No_constraint_intersection_requiring_constructions_tag>;
 
 /// World axis of a frame vector that is exactly ± a unit axis: {axis, sign}; axis -1 if not.
 std::pair<int, double> world_axis(const Vec3& w) {
@@ -120,34 +107,6 @@ Absorbed absorb_slab(std::vector<Extrusion>& kept, const Slab& s, double slack) 
 
 /// Sets each face's info to its nesting depth: the number of constraints crossed from the
 /// unbounded face (odd: inside the constrained rings).
-void mark_nesting(Cdt& cdt) {
-  for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f) f->info() = -1;
-  std::vector<Cdt::Face_handle> frontier{cdt.infinite_face()}, next;
-  cdt.infinite_face()->info() = 0;
-  for (int level = 0; !frontier.empty(); ++level) {
-    // Flood the current level; faces across a constraint start the next one.
-    while (!frontier.empty()) {
-      const Cdt::Face_handle f = frontier.back();
-      frontier.pop_back();
-      for (int i = 0; i < 3; ++i) {
-        const Cdt::Face_handle g = f->neighbor(i);
-        if (g->info() != -1) continue;
-        if (cdt.is_constrained(Cdt::Edge(f, i))) {
-          next.push_back(g);
-        } else {
-          g->info() = level;
-          frontier.push_back(g);
-        }
-      }
-    }
-    for (const auto& g : next)
-      if (g->info() == -1) {
-        g->info() = level + 1;
-        frontier.push_back(g);
-      }
-    next.clear();
-  }
-}
 
 }  // namespace
 
@@ -198,7 +157,10 @@ ExtrusionReduction reduce_extrusions(const std::vector<Extrusion>& in, double sl
   return out;
 }
 
-Mesh extrusion_mesh(const Extrusion& e) {
+namespace {
+
+/// extrusion_mesh with face labels: one per wall (ring edge), one per cap of each polygon.
+FacedMesh labelled_extrusion_mesh(const Extrusion& e) {
   if (!(e.depth_min < e.depth_max))
     throw std::runtime_error("extrusion: empty depth range [" + std::to_string(e.depth_min) + ", " +
                              std::to_string(e.depth_max) + "]");
@@ -211,43 +173,46 @@ Mesh extrusion_mesh(const Extrusion& e) {
     if (added) points.push_back(q);
     return it->second;
   };
-  Mesh m;
+  FacedMesh out;
+  Mesh& m = out.mesh;
+  int label = 0;
   auto tri = [&](int a, int b, int c) {
     m.triangles.push_back({static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b), static_cast<std::uint32_t>(c)});
+    out.face.push_back(label);
   };
   for (const auto& poly : e.polygons) {
     if (poly.outer.size() < 3) throw std::runtime_error("extrusion: a polygon has fewer than 3 vertices");
-    Cdt cdt;
+    std::vector<std::vector<int>> rings;
     auto add_ring = [&](const std::vector<Vec2>& ring) {
-      std::vector<Cdt::Vertex_handle> vh;
-      for (const Vec2& q : ring) {
-        auto h = cdt.insert(K::Point_2(q.x(), q.y()));
-        h->info() = vertex(q);
-        vh.push_back(h);
-      }
-      for (std::size_t i = 0; i < vh.size(); ++i) {
-        const int a = vh[i]->info(), b = vh[(i + 1) % vh.size()]->info();
+      std::vector<int> ids;
+      for (const Vec2& q : ring) ids.push_back(vertex(q));
+      for (std::size_t i = 0; i < ids.size(); ++i) {
+        const int a = ids[i], b = ids[(i + 1) % ids.size()];
         if (a == b) continue;
-        cdt.insert_constraint(vh[i], vh[(i + 1) % vh.size()]);
         // Wall quad (a, b) swept from depth_min to depth_max: outward for CCW outer rings
         // and CW holes alike (the region lies to the left of every ring edge).
         tri(2 * a, 2 * b, 2 * b + 1);
         tri(2 * a, 2 * b + 1, 2 * a + 1);
+        ++label;
       }
+      rings.push_back(std::move(ids));
     };
+    add_ring(poly.outer);
+    for (const auto& h : poly.holes) add_ring(h);
+    std::vector<std::array<int, 3>> cap;
     try {
-      add_ring(poly.outer);
-      for (const auto& h : poly.holes) add_ring(h);
-    } catch (const Cdt::Intersection_of_constraints_exception&) {
+      cap = triangulate_rings(points, rings);
+    } catch (const std::runtime_error&) {
       throw std::runtime_error("extrusion: the rings of a polygon cross");
     }
-    mark_nesting(cdt);
-    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
-      if (f->info() % 2 != 1) continue;
-      const int a = f->vertex(0)->info(), b = f->vertex(1)->info(), c = f->vertex(2)->info();
+    const int top = label, bottom = label + 1;
+    for (const auto& [a, b, c] : cap) {
+      label = top;
       tri(2 * a + 1, 2 * b + 1, 2 * c + 1);  // CCW in (u, v): normal +n on the top cap
+      label = bottom;
       tri(2 * a, 2 * c, 2 * b);              // reversed on the bottom cap
     }
+    label = bottom + 1;
   }
   if (points.empty()) throw std::runtime_error("extrusion: the region is empty");
   m.vertices.reserve(2 * points.size());
@@ -256,8 +221,13 @@ Mesh extrusion_mesh(const Extrusion& e) {
     m.vertices.push_back(p + e.n * e.depth_min);
     m.vertices.push_back(p + e.n * e.depth_max);
   }
-  return m;
+  out.faces = extrusion_faces(e);
+  return out;
 }
+
+}  // namespace
+
+Mesh extrusion_mesh(const Extrusion& e) { return labelled_extrusion_mesh(e).mesh; }
 
 namespace {
 
@@ -413,7 +383,7 @@ ExtrusionsMesh extrusion_pair_mesh(const Extrusion& a, const Extrusion& b) {
   // Faces by plane: a bound (edge or depth constant) and which side of the pieces it is
   // (0–3), or a slice height facing up (4) or down (5).
   using FaceKey = std::tuple<const void*, double, int>;
-  std::set<FaceKey> planes;
+  std::map<FaceKey, int> planes;
   // Appends triangle pqr on face `key` facing `outward` (its normal's component along it
   // is positive).
   auto tri = [&](const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& outward, const FaceKey& key) {
@@ -423,7 +393,7 @@ ExtrusionsMesh extrusion_pair_mesh(const Extrusion& a, const Extrusion& b) {
     m.vertices.insert(m.vertices.end(), {p, q, r});
     if (s > 0.0) m.triangles.push_back({base, base + 1, base + 2});
     else m.triangles.push_back({base, base + 2, base + 1});
-    planes.insert(key);
+    out.face.push_back(planes.emplace(key, static_cast<int>(planes.size())).first->second);
   };
   Vec3 axis_a = Vec3::Zero(), axis_b = Vec3::Zero(), axis_c = Vec3::Zero();
   axis_a[ia] = 1.0;
@@ -503,6 +473,10 @@ ExtrusionsMesh extrusion_pair_mesh(const Extrusion& a, const Extrusion& b) {
   }
   if (m.triangles.empty()) throw std::runtime_error("extrusion pair: the intersection is empty");
   weld_identical_vertices(m);
+  // Every triangle has a nonzero area (tri() drops the others), so welding equal vertices
+  // removes none and the labels stay aligned; checked, since a lost one would shift them.
+  if (m.triangles.size() != out.face.size())
+    throw std::runtime_error("extrusion pair: welding removed a triangle (labels would not match)");
   out.faces = static_cast<int>(planes.size());
   return out;
 }
@@ -516,10 +490,20 @@ int extrusion_faces(const Extrusion& e) {
   return faces;
 }
 
-ExtrusionsMesh mesh_extrusions(const std::vector<Extrusion>& kept) {
-  if (kept.size() == 1) return {extrusion_mesh(kept[0]), extrusion_faces(kept[0])};
-  if (kept.size() == 2) return extrusion_pair_mesh(kept[0], kept[1]);
-  throw std::runtime_error("extrusions: " + std::to_string(kept.size()) + " to intersect need a general Boolean");
+ExtrusionsMesh mesh_extrusions(const std::vector<Extrusion>& kept, double tol) {
+  if (kept.empty()) throw std::runtime_error("extrusions: nothing to intersect");
+  // The pair slicer takes two axis extrusions whose normals are different axes; it is far
+  // cheaper than a general Boolean, so the first two go through it whenever it can.
+  const bool pair = kept.size() >= 2 && axis_aligned(kept[0]) && axis_aligned(kept[1]) && kept[0].n.dot(kept[1].n) == 0.0;
+  ExtrusionsMesh acc;
+  if (pair) acc = extrusion_pair_mesh(kept[0], kept[1]);
+  else static_cast<FacedMesh&>(acc) = labelled_extrusion_mesh(kept[0]);
+  for (std::size_t i = pair ? 2 : 1; i < kept.size(); ++i) {
+    static_cast<FacedMesh&>(acc) = mesh_intersection(acc, labelled_extrusion_mesh(kept[i]));
+    ++acc.booleans;
+  }
+  if (acc.booleans > 0) merge_face_vertices(acc, tol);
+  return acc;
 }
 
 }  // namespace loom

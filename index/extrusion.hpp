@@ -10,6 +10,8 @@
 
 #include "core/mesh.hpp"
 #include "index/alpha_shape_2d.hpp"
+#include "index/face_vertices.hpp"
+#include "index/mesh_boolean.hpp"
 
 #include <cstddef>
 #include <vector>
@@ -59,9 +61,8 @@ int extrusion_faces(const Extrusion& e);
 
 /// A closed, outward-oriented mesh of an intersection of extrusions, and its faces: B-rep
 /// faces for one extrusion (extrusion_faces), distinct face planes for two.
-struct ExtrusionsMesh {
-  Mesh mesh;
-  int faces = 0;
+struct ExtrusionsMesh : FacedMesh {
+  int booleans = 0;  ///< general Booleans run (CGAL corefinements, mesh_intersection)
 };
 
 /// The intersection of two axis-aligned extrusions whose normals are different world axes
@@ -77,9 +78,13 @@ struct ExtrusionsMesh {
 /// not of that kind or the intersection is empty.
 ExtrusionsMesh extrusion_pair_mesh(const Extrusion& a, const Extrusion& b);
 
-/// The intersection of `kept` meshed without a general Boolean: one extrusion
-/// (extrusion_mesh) or two (extrusion_pair_mesh). Throws std::runtime_error for any other
-/// count, and what those throw.
-ExtrusionsMesh mesh_extrusions(const std::vector<Extrusion>& kept);
+/// The intersection of `kept` (≥ 1): one extrusion is meshed directly (extrusion_mesh),
+/// two axis extrusions across each other are sliced (extrusion_pair_mesh); any other is
+/// intersected with the rest by exact corefinement of the meshes (mesh_intersection), one
+/// general Boolean each, after which the vertices the corefinement left inside faces and
+/// along straight edges are removed (merge_face_vertices; the solid moves by at most
+/// `tol`, scene units). Faces: as those give them. Throws std::runtime_error for an empty
+/// list, and what those throw.
+ExtrusionsMesh mesh_extrusions(const std::vector<Extrusion>& kept, double tol);
 
 }  // namespace loom

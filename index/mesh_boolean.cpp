@@ -1,0 +1,147 @@
+#include "index/mesh_boolean.hpp"
+
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/corefinement.h>
+#include <CGAL/Surface_mesh.h>
+
+#include <algorithm>
+#include <map>
+#include <memory>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <utility>
+
+namespace loom {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_exact_constructions_kernel;
+using SurfaceMesh = CGAL::Surface_mesh<Kernel::Point_3>;
+using FaceIndex = SurfaceMesh::Face_index;
+using LabelMap = SurfaceMesh::Property_map<FaceIndex, int>;
+namespace PMP = CGAL::Polygon_mesh_processing;
+
+/// Union-find root with path halving.
+std::size_t root(std::vector<std::size_t>& parent, std::size_t i) {
+  while (parent[i] != i) i = parent[i] = parent[parent[i]];
+  return i;
+}
+
+SurfaceMesh to_surface_mesh(const FacedMesh& m, int label_offset, const char* which) {
+  if (m.face.size() != m.mesh.triangles.size())
+    throw std::runtime_error(std::string("mesh intersection: ") + which + " has " + std::to_string(m.face.size()) +
+                             " face labels for " + std::to_string(m.mesh.triangles.size()) + " triangles");
+  SurfaceMesh sm;
+  LabelMap label = sm.add_property_map<FaceIndex, int>("f:label", -1).first;
+  std::vector<SurfaceMesh::Vertex_index> vs;
+  vs.reserve(m.mesh.vertices.size());
+  for (const Vec3& p : m.mesh.vertices) vs.push_back(sm.add_vertex(Kernel::Point_3(p.x(), p.y(), p.z())));
+  for (std::size_t t = 0; t < m.mesh.triangles.size(); ++t) {
+    const auto& tri = m.mesh.triangles[t];
+    const FaceIndex f = sm.add_face(vs[tri[0]], vs[tri[1]], vs[tri[2]]);
+    if (f == SurfaceMesh::null_face())
+      throw std::runtime_error(std::string("mesh intersection: ") + which + " is not an oriented 2-manifold (triangle " +
+                               std::to_string(t) + ")");
+    label[f] = m.face[t] + label_offset;
+  }
+  if (!CGAL::is_closed(sm)) throw std::runtime_error(std::string("mesh intersection: ") + which + " is not closed");
+  return sm;
+}
+
+/// Carries each input triangle's label to its pieces and to their copies in the result.
+/// CGAL copies the visitor: the state it shares lives in the meshes' property maps.
+struct LabelVisitor : PMP::Corefinement::Default_visitor<SurfaceMesh> {
+  std::shared_ptr<int> splitting = std::make_shared<int>(-1);  // label of the face being split
+
+  static LabelMap labels(const SurfaceMesh& tm) {
+    return tm.property_map<FaceIndex, int>("f:label").first;
+  }
+  void before_subface_creations(FaceIndex f_old, SurfaceMesh& tm) { *splitting = labels(tm)[f_old]; }
+  void after_subface_created(FaceIndex f_new, SurfaceMesh& tm) { labels(tm)[f_new] = *splitting; }
+  void after_face_copy(FaceIndex f_old, const SurfaceMesh& src, FaceIndex f_new, SurfaceMesh& tgt) {
+    labels(tgt)[f_new] = labels(src)[f_old];
+  }
+};
+
+}  // namespace
+
+int labelled_faces(const Mesh& m, const std::vector<int>& face) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> first_of_edge;
+  std::vector<std::size_t> parent(m.triangles.size());
+  std::iota(parent.begin(), parent.end(), std::size_t(0));
+  for (std::size_t t = 0; t < m.triangles.size(); ++t)
+    for (int e = 0; e < 3; ++e) {
+      const std::uint32_t a = m.triangles[t][static_cast<std::size_t>(e)], b = m.triangles[t][static_cast<std::size_t>((e + 1) % 3)];
+      const auto [it, added] = first_of_edge.emplace(std::minmax(a, b), t);
+      if (added || face[it->second] != face[t]) continue;
+      const std::size_t ra = root(parent, it->second), rb = root(parent, t);
+      if (ra != rb) parent[ra] = rb;
+    }
+  int n = 0;
+  for (std::size_t t = 0; t < parent.size(); ++t) n += root(parent, t) == t ? 1 : 0;
+  return n;
+}
+
+FacedMesh mesh_intersection(const FacedMesh& a, const FacedMesh& b) {
+  const int shift = a.face.empty() ? 0 : *std::max_element(a.face.begin(), a.face.end()) + 1;
+  SurfaceMesh sa = to_surface_mesh(a, 0, "the first mesh"), sb = to_surface_mesh(b, shift, "the second mesh"), out;
+  out.add_property_map<FaceIndex, int>("f:label", -1);
+  LabelVisitor visitor;
+  // Both inputs come from loom's own meshers, closed by construction; CGAL's own volume
+  // check (a self-intersection test of each) is left to what follows: the caller's
+  // watertightness test of the result and its containment verification.
+  if (!PMP::corefine_and_compute_intersection(sa, sb, out, CGAL::parameters::visitor(visitor)))
+    throw std::runtime_error("mesh intersection: CGAL could not build the intersection as a manifold mesh");
+  if (out.number_of_faces() == 0) throw std::runtime_error("mesh intersection: the intersection is empty");
+  if (!CGAL::is_triangle_mesh(out)) throw std::runtime_error("mesh intersection: the result is not a triangle mesh");
+
+  // The same solid comes out in an order that varies from run to run: CGAL's box
+  // intersection breaks ties between equal box bounds by the boxes' addresses, so the
+  // intersection points are numbered in heap order. Vertices are sorted by their
+  // coordinates and triangles by their vertices, so equal inputs give equal outputs.
+  // (out was built fresh, so its indices are dense: no removed elements.)
+  std::vector<Vec3> points;
+  points.reserve(out.number_of_vertices());
+  for (const auto v : out.vertices()) {
+    const auto& p = out.point(v);
+    points.emplace_back(CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z()));
+  }
+  std::vector<std::uint32_t> order(points.size());
+  std::iota(order.begin(), order.end(), 0u);
+  const auto less = [&](std::uint32_t i, std::uint32_t j) {
+    const Vec3 &pi = points[i], &pj = points[j];
+    return std::tie(pi.x(), pi.y(), pi.z()) < std::tie(pj.x(), pj.y(), pj.z());
+  };
+  std::stable_sort(order.begin(), order.end(), less);
+  std::vector<std::uint32_t> rank(points.size());
+  FacedMesh r;
+  r.mesh.vertices.reserve(points.size());
+  for (std::uint32_t i = 0; i < order.size(); ++i) {
+    rank[order[i]] = i;
+    r.mesh.vertices.push_back(points[order[i]]);
+  }
+  const LabelMap label = LabelVisitor::labels(out);
+  std::vector<std::pair<std::array<std::uint32_t, 3>, int>> tris;
+  tris.reserve(out.number_of_faces());
+  for (const auto f : out.faces()) {
+    std::array<std::uint32_t, 3> t{};
+    std::size_t k = 0;
+    for (const auto v : CGAL::vertices_around_face(out.halfedge(f), out)) t[k++] = rank[static_cast<std::size_t>(v)];
+    // Rotated to start at the smallest index (orientation kept).
+    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+    if (label[f] < 0) throw std::runtime_error("mesh intersection: a result triangle lost its face label");
+    tris.emplace_back(t, label[f]);
+  }
+  std::sort(tris.begin(), tris.end());
+  r.mesh.triangles.reserve(tris.size());
+  r.face.reserve(tris.size());
+  for (const auto& [t, l] : tris) {
+    r.mesh.triangles.push_back(t);
+    r.face.push_back(l);
+  }
+  r.faces = labelled_faces(r.mesh, r.face);
+  return r;
+}
+
+}  // namespace loom
