@@ -2,9 +2,13 @@
 
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
+#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <memory>
 #include <numeric>
@@ -29,23 +33,49 @@ std::size_t root(std::vector<std::size_t>& parent, std::size_t i) {
 }
 
 SurfaceMesh to_surface_mesh(const FacedMesh& m, int label_offset, const char* which) {
+  const std::string name = std::string("mesh intersection: ") + which;
   if (m.face.size() != m.mesh.triangles.size())
-    throw std::runtime_error(std::string("mesh intersection: ") + which + " has " + std::to_string(m.face.size()) +
-                             " face labels for " + std::to_string(m.mesh.triangles.size()) + " triangles");
-  SurfaceMesh sm;
-  LabelMap label = sm.add_property_map<FaceIndex, int>("f:label", -1).first;
-  std::vector<SurfaceMesh::Vertex_index> vs;
-  vs.reserve(m.mesh.vertices.size());
-  for (const Vec3& p : m.mesh.vertices) vs.push_back(sm.add_vertex(Kernel::Point_3(p.x(), p.y(), p.z())));
-  for (std::size_t t = 0; t < m.mesh.triangles.size(); ++t) {
+    throw std::runtime_error(name + " has " + std::to_string(m.face.size()) + " face labels for " +
+                             std::to_string(m.mesh.triangles.size()) + " triangles");
+  // Through a polygon soup, which CGAL orients and checks: where pieces of the solid touch
+  // along an edge or at a vertex (rings that touch, two sliced pieces meeting) it would
+  // duplicate the vertex there. CGAL 5.5's Boolean operations take no such input (it is
+  // self-intersecting for them: they crashed on it), so it is refused and the caller uses
+  // OpenCASCADE.
+  std::vector<Kernel::Point_3> points;
+  points.reserve(m.mesh.vertices.size());
+  for (const Vec3& p : m.mesh.vertices) points.emplace_back(p.x(), p.y(), p.z());
+  std::vector<std::array<std::size_t, 3>> polygons;
+  polygons.reserve(m.mesh.triangles.size());
+  for (const auto& t : m.mesh.triangles) polygons.push_back({t[0], t[1], t[2]});
+  if (!PMP::orient_polygon_soup(points, polygons))
+    throw std::runtime_error(name + " has pieces that touch along an edge or at a vertex (not a 2-manifold)");
+  // The soup was oriented already (outward): no triangle may have been turned.
+  for (std::size_t t = 0; t < polygons.size(); ++t) {
     const auto& tri = m.mesh.triangles[t];
-    const FaceIndex f = sm.add_face(vs[tri[0]], vs[tri[1]], vs[tri[2]]);
-    if (f == SurfaceMesh::null_face())
-      throw std::runtime_error(std::string("mesh intersection: ") + which + " is not an oriented 2-manifold (triangle " +
-                               std::to_string(t) + ")");
-    label[f] = m.face[t] + label_offset;
+    const auto& poly = polygons[t];
+    bool same = false;
+    for (int r = 0; r < 3 && !same; ++r) {
+      same = true;
+      for (int k = 0; k < 3; ++k) {
+        const Vec3& v = m.mesh.vertices[tri[static_cast<std::size_t>(k)]];
+        const auto& q = points[poly[static_cast<std::size_t>((k + r) % 3)]];
+        same = same && q == Kernel::Point_3(v.x(), v.y(), v.z());
+      }
+    }
+    if (!same) throw std::runtime_error(name + " is not consistently oriented (triangle " + std::to_string(t) + ")");
   }
-  if (!CGAL::is_closed(sm)) throw std::runtime_error(std::string("mesh intersection: ") + which + " is not closed");
+  SurfaceMesh sm;
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, sm);
+  if (sm.number_of_faces() != polygons.size())
+    throw std::runtime_error(name + " could not be made a half-edge mesh");
+  if (!CGAL::is_closed(sm)) throw std::runtime_error(name + " is not closed");
+  // CGAL's precondition (crossing faces are undefined behaviour there, as the touching
+  // pieces above were): checked, since the meshers' rounding is not proven never to fold.
+  if (PMP::does_self_intersect(sm)) throw std::runtime_error(name + " intersects itself");
+  // Faces were added in polygon order to an empty mesh: face t is triangle t.
+  LabelMap label = sm.add_property_map<FaceIndex, int>("f:label", -1).first;
+  for (std::size_t t = 0; t < polygons.size(); ++t) label[FaceIndex(static_cast<SurfaceMesh::size_type>(t))] = m.face[t] + label_offset;
   return sm;
 }
 
@@ -88,9 +118,6 @@ FacedMesh mesh_intersection(const FacedMesh& a, const FacedMesh& b) {
   SurfaceMesh sa = to_surface_mesh(a, 0, "the first mesh"), sb = to_surface_mesh(b, shift, "the second mesh"), out;
   out.add_property_map<FaceIndex, int>("f:label", -1);
   LabelVisitor visitor;
-  // Both inputs come from loom's own meshers, closed by construction; CGAL's own volume
-  // check (a self-intersection test of each) is left to what follows: the caller's
-  // watertightness test of the result and its containment verification.
   if (!PMP::corefine_and_compute_intersection(sa, sb, out, CGAL::parameters::visitor(visitor)))
     throw std::runtime_error("mesh intersection: CGAL could not build the intersection as a manifold mesh");
   if (out.number_of_faces() == 0) throw std::runtime_error("mesh intersection: the intersection is empty");

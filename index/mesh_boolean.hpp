@@ -25,12 +25,13 @@ struct FacedMesh {
 int labelled_faces(const Mesh& m, const std::vector<int>& face);
 
 /// The intersection of the solids bounded by a.mesh and b.mesh (each closed,
-/// outward-oriented, not self-intersecting; touching along edges is allowed). Computed
+/// outward-oriented, not self-intersecting, a 2-manifold: pieces that touch along an edge
+/// or at a vertex are refused). Computed
 /// exactly; the result's vertices are then rounded to double (≤ half an ulp each). Each
 /// result triangle keeps the label of the input triangle it is a piece of (b's labels
 /// shifted past a's). Corefinement keeps the points where the inputs' triangles were split,
 /// so faces are triangulated on more vertices than their corners. Throws
-/// std::runtime_error if an input is not a closed oriented 2-manifold, if CGAL cannot make
+/// std::runtime_error if an input is not a closed, consistently oriented 2-manifold, if CGAL cannot make
 /// the result a manifold, or if the result is empty.
 FacedMesh mesh_intersection(const FacedMesh& a, const FacedMesh& b);
 

@@ -1150,7 +1150,9 @@ TEST(AlphaSim, TranslatedAndAxisTurnedCopiesAreSimplifiedOnce) {
 
 // ----------------------------------------------------------------------- property
 
-RC_GTEST_PROP(AlphaSimProperty, RandomBoxUnionsAreContained, ()) {
+/// Inside a property: one to three boxes, each turned about (1, 2, 3) (so that all three
+/// projections are general outlines), their shells overlapping or apart.
+Part random_turned_boxes() {
   const int n = *rc::gen::inRange(1, 4);
   Mesh m;
   for (int k = 0; k < n; ++k) {
@@ -1161,16 +1163,58 @@ RC_GTEST_PROP(AlphaSimProperty, RandomBoxUnionsAreContained, ()) {
     b.transform(Eigen::Affine3d(Eigen::AngleAxisd(angle, Vec3(1, 2, 3).normalized())));
     m.append(b);
   }
-  Part p = make_part("boxes", m);
+  return make_part("boxes", m);
+}
+
+/// Inside a property: options at a random dim_pre for random_turned_boxes.
+AlphaSimOptions random_box_options() {
   auto o = options(*rc::gen::inRange(5, 40) / 10.0);
   o.detect_lost_space = false;  // overlapping shells have no consistent inside
   o.containment_max_samples = 20000;
-  const auto sp = simplify_part(p, o);
+  return o;
+}
+
+RC_GTEST_PROP(AlphaSimProperty, RandomBoxUnionsAreContained, ()) {
+  const Part p = random_turned_boxes();
+  const auto sp = simplify_part(p, random_box_options());
   // The output contains the original: verified, or the original itself is kept.
   RC_ASSERT(sp.result.fallback == AlphaSimFallback::Original || sp.result.containment == 1.0);
   RC_ASSERT(sp.result.containment_implicit == 1.0);
   if (sp.solid)
     for (const auto& v : p.mesh.vertices) RC_ASSERT(sp.solid->contains(v, sp.result.tolerance));
+}
+
+/// Random points (fixed seed) in the implicit solid of sp that the mesh neither holds nor
+/// comes within tol of. The extruded outlines only grow the α-shapes (and merging collinear
+/// points shrinks them by less than tol), so the mesh must hold the implicit solid.
+std::size_t implicit_points_outside_the_mesh(const AlphaSimPart& sp, double tol, int samples) {
+  const EmbreeIndex mesh({make_part("mesh", sp.mesh)});
+  const AABB box = sp.mesh.bounds();
+  std::mt19937_64 rng(23);
+  std::size_t outside = 0;
+  for (int k = 0; k < samples; ++k) {
+    Vec3 q;
+    for (int c = 0; c < 3; ++c) q[c] = std::uniform_real_distribution<double>(box.min[c], box.max[c])(rng);
+    if (sp.solid->contains(q) && !mesh.inside(q) && !(mesh.closest(q, tol).found())) ++outside;
+  }
+  return outside;
+}
+
+RC_GTEST_PROP(AlphaSimProperty, TheMeshHoldsTheImplicitSolid, ()) {
+  // The mesh (two prisms sliced, the third by exact corefinement, corefinement points
+  // merged) against the implicit solid, the independent definition of the same prisms,
+  // whose outlines the mesh's only grow.
+  const Part p = random_turned_boxes();
+  AlphaSimOptions o = random_box_options();
+  o.measure = false;
+  const auto sp = simplify_part(p, o);
+  RC_PRE(sp.result.fallback != AlphaSimFallback::Original);
+  RC_ASSERT(sp.result.closed_after);
+  // Where pieces touch (a 2-manifold cannot hold them), OpenCASCADE runs the Booleans, and
+  // its result has lost pieces of the intersection that hold no surface of the part (known
+  // limit, DESIGN-NOTES): only CGAL's result is held to this.
+  RC_TAG(sp.result.booleans_by);
+  if (sp.result.booleans_by == "cgal") RC_ASSERT(implicit_points_outside_the_mesh(sp, sp.result.tolerance, 20000) == 0u);
 }
 
 RC_GTEST_PROP(AlphaSimProperty, GrowSimplifyOnlyGrowsRandomStarRings, ()) {

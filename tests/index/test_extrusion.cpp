@@ -3,6 +3,9 @@
 // in an intersection of extrusions iff it is in each: depth range and even-odd rings).
 #include "index/extrusion.hpp"
 
+#include "core/part.hpp"
+#include "index/embree_index.hpp"
+
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
 
@@ -356,31 +359,37 @@ TEST(ExtrusionPair, RefusesParallelFramesAndEmptyIntersections) {
   EXPECT_EQ(mesh_extrusions({a}, 1e-9).faces, extrusion_faces(a));
 }
 
+namespace {
+
+/// Inside a property: one or two random star regions (side by side along the in-plane axis
+/// other than z, some with a square hole) and a random depth range for e.
+void random_region(Extrusion& e, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> coord(0.0, 10.0);
+  const int pieces = *rc::gen::inRange(1, 3);
+  for (int i = 0; i < pieces; ++i) {
+    // A star around c: every vertex at least 1.8 from it, consecutive ones less than
+    // 2π·1.56/n apart in angle, so from 6 vertices on every edge is more than
+    // 1.8·cos(0.26π) ≈ 1.22 from c and a square hole of half-side 0.5 around c lies
+    // inside (CW).
+    const Vec2 c(7.0 + 14.0 * i, 5.0 + coord(rng) / 5);
+    const int n = *rc::gen::inRange(3, 14);
+    PolygonWithHoles2 p{random_star(c.x(), c.y(), 6.0, n, rng), {}};
+    if (n >= 6 && *rc::gen::inRange(0, 2) == 1)
+      p.holes.push_back({c + Vec2(-0.5, -0.5), c + Vec2(-0.5, 0.5), c + Vec2(0.5, 0.5), c + Vec2(0.5, -0.5)});
+    e.polygons.push_back(p);
+  }
+  const double lo = coord(rng) * 2.0 - 2.0, hi = lo + 2.0 + coord(rng) * 2.0;
+  e.depth_min = e.n.sum() < 0 ? -hi : lo;
+  e.depth_max = e.n.sum() < 0 ? -lo : hi;
+}
+
+}  // namespace
+
 RC_GTEST_PROP(ExtrusionPairProperty, RandomRegionsGiveAClosedSolidOfTheSlicedVolume, ()) {
   std::mt19937_64 rng(*rc::gen::arbitrary<std::uint32_t>());
-  std::uniform_real_distribution<double> coord(0.0, 10.0);
   Extrusion xz = frame_xz(), yz = frame_yz();
-  auto region = [&](Extrusion& e) {
-    const int pieces = *rc::gen::inRange(1, 3);
-    for (int i = 0; i < pieces; ++i) {
-      // Separate pieces side by side along the in-plane axis other than z.
-      // A star around c: every vertex at least 1.8 from it, consecutive ones less than
-      // 2π·1.56/n apart in angle, so from 6 vertices on every edge is more than
-      // 1.8·cos(0.26π) ≈ 1.22 from c and a square hole of half-side 0.5 around c lies
-      // inside (CW).
-      const Vec2 c(7.0 + 14.0 * i, 5.0 + coord(rng) / 5);
-      const int n = *rc::gen::inRange(3, 14);
-      PolygonWithHoles2 p{random_star(c.x(), c.y(), 6.0, n, rng), {}};
-      if (n >= 6 && *rc::gen::inRange(0, 2) == 1)
-        p.holes.push_back({c + Vec2(-0.5, -0.5), c + Vec2(-0.5, 0.5), c + Vec2(0.5, 0.5), c + Vec2(0.5, -0.5)});
-      e.polygons.push_back(p);
-    }
-    const double lo = coord(rng) * 2.0 - 2.0, hi = lo + 2.0 + coord(rng) * 2.0;
-    e.depth_min = e.n.sum() < 0 ? -hi : lo;
-    e.depth_max = e.n.sum() < 0 ? -lo : hi;
-  };
-  region(xz);
-  region(yz);
+  random_region(xz, rng);
+  random_region(yz, rng);
   const double v = pair_volume(xz, yz, 100000);
   ExtrusionsMesh pm;
   try {
@@ -395,4 +404,48 @@ RC_GTEST_PROP(ExtrusionPairProperty, RandomRegionsGiveAClosedSolidOfTheSlicedVol
   RC_ASSERT(t.boundary_edges == 0u);
   RC_ASSERT(t.misoriented_edges == 0u);
   RC_ASSERT(std::abs(m.signed_volume() - v) <= 1e-4 * std::max(v, 1.0));
+}
+
+RC_GTEST_PROP(ExtrusionsProperty, ThreeRandomRegionsGiveTheirIntersection, ()) {
+  // Three general outlines: two sliced, the third by exact corefinement, the points it
+  // leaves merged within tol. Against point membership in every extrusion (even-odd rings,
+  // depth range) at random points more than 10·tol from any face plane.
+  std::mt19937_64 rng(*rc::gen::arbitrary<std::uint32_t>());
+  std::vector<Extrusion> es = {frame_xy(), frame_xz(), frame_yz()};
+  std::uniform_real_distribution<double> end(0.0, 4.0);
+  for (auto& e : es) {
+    random_region(e, rng);
+    // Depth over most of the others' outlines (random ends), so that all three meet.
+    const double lo = -3.0 + end(rng), hi = 27.0 + end(rng);
+    e.depth_min = e.n.sum() < 0 ? -hi : lo;
+    e.depth_max = e.n.sum() < 0 ? -lo : hi;
+  }
+  const double tol = 1e-7;
+  ExtrusionsMesh r;
+  try {
+    r = mesh_extrusions(es, tol);
+  } catch (const std::runtime_error&) {
+    // Refused only when nothing is left: no sample point lies in all three.
+    std::uniform_real_distribution<double> x(-2.0, 30.0), z(-4.0, 24.0);
+    for (int k = 0; k < 20000; ++k) RC_ASSERT(!inside_all(es, Vec3(x(rng), x(rng), z(rng))));
+    return;
+  }
+  RC_ASSERT(r.booleans == 1);
+  Mesh m = r.mesh;
+  weld_identical_vertices(m);
+  const MeshTopology t = analyse_topology(m);
+  RC_ASSERT(t.boundary_edges == 0u);
+  RC_ASSERT(t.misoriented_edges == 0u);
+  RC_ASSERT(m.signed_volume() > 0.0);
+  Part part;
+  part.name = "r";
+  part.mesh = r.mesh;
+  part.closed = true;
+  const EmbreeIndex index({part});
+  std::uniform_real_distribution<double> x(-2.0, 30.0), z(-4.0, 24.0);
+  for (int k = 0; k < 5000; ++k) {
+    const Vec3 p(x(rng), x(rng), z(rng));
+    if (boundary_distance(es, p) < 10.0 * tol) continue;
+    RC_ASSERT(index.inside(p) == inside_all(es, p));
+  }
 }

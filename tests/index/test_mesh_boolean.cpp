@@ -95,8 +95,23 @@ TEST(MeshBoolean, SphereCutByABoxKeepsTheSphereInside) {
   for (const Vec3& v : upper.mesh.vertices) EXPECT_GE(v.z(), -1e-15) << v.transpose();
 }
 
-TEST(MeshBoolean, RefusesEmptyAndOpenInputs) {
+TEST(MeshBoolean, RefusesEmptyOpenAndTouchingInputs) {
   EXPECT_THROW(mesh_intersection(labelled_box({0, 0, 0}, {1, 1, 1}), labelled_box({2, 2, 2}, {3, 3, 3})), std::runtime_error);
+  // Two boxes touching along an edge (x = y = 1): not a 2-manifold, which CGAL's Booleans
+  // do not take (the caller uses OpenCASCADE there).
+  FacedMesh touching = labelled_box({0, 0, 0}, {1, 1, 1});
+  {
+    const FacedMesh other = labelled_box({1, 1, 0}, {2, 2, 1});
+    const auto base = static_cast<std::uint32_t>(touching.mesh.vertices.size());
+    touching.mesh.vertices.insert(touching.mesh.vertices.end(), other.mesh.vertices.begin(), other.mesh.vertices.end());
+    for (auto t : other.mesh.triangles) touching.mesh.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+    for (int l : other.face) touching.face.push_back(l + 6);
+  }
+  // As two shells (the edge's vertices twice: they touch, a self-intersection for CGAL)
+  // and welded (one edge of four triangles).
+  EXPECT_THROW(mesh_intersection(touching, labelled_box({0, 0, 0}, {2, 2, 2})), std::runtime_error);
+  ASSERT_EQ(weld_identical_vertices(touching.mesh), 2u);
+  EXPECT_THROW(mesh_intersection(touching, labelled_box({0, 0, 0}, {2, 2, 2})), std::runtime_error);
   FacedMesh unlabelled = labelled_box({0, 0, 0}, {1, 1, 1});
   unlabelled.face.pop_back();
   EXPECT_THROW(mesh_intersection(unlabelled, labelled_box({0, 0, 0}, {2, 2, 2})), std::runtime_error);
