@@ -490,8 +490,10 @@ int extrusion_faces(const Extrusion& e) {
   return faces;
 }
 
-ExtrusionsMesh mesh_extrusions(const std::vector<Extrusion>& kept, double tol) {
-  if (kept.empty()) throw std::runtime_error("extrusions: nothing to intersect");
+namespace {
+
+/// mesh_extrusions for one order of `kept`.
+ExtrusionsMesh mesh_extrusions_in_order(const std::vector<Extrusion>& kept, double tol) {
   // The pair slicer takes two axis extrusions whose normals are different axes; it is far
   // cheaper than a general Boolean, so the first two go through it whenever it can.
   const bool pair = kept.size() >= 2 && axis_aligned(kept[0]) && axis_aligned(kept[1]) && kept[0].n.dot(kept[1].n) == 0.0;
@@ -504,6 +506,27 @@ ExtrusionsMesh mesh_extrusions(const std::vector<Extrusion>& kept, double tol) {
   }
   if (acc.booleans > 0) merge_face_vertices(acc, tol);
   return acc;
+}
+
+}  // namespace
+
+ExtrusionsMesh mesh_extrusions(const std::vector<Extrusion>& kept, double tol) {
+  if (kept.empty()) throw std::runtime_error("extrusions: nothing to intersect");
+  if (kept.size() != 3) return mesh_extrusions_in_order(kept, tol);
+  // Three: which two are sliced matters where pieces touch. The sliced pair's pieces may
+  // meet along an edge, or the third outline's rings at a vertex, and CGAL's Boolean takes
+  // neither (mesh_intersection refuses); another pair often has no such contact. The
+  // orders are tried in a fixed sequence, so the result is deterministic.
+  const int orders[3][3] = {{0, 1, 2}, {0, 2, 1}, {1, 2, 0}};
+  std::string why;
+  for (const auto& o : orders) {
+    try {
+      return mesh_extrusions_in_order({kept[o[0]], kept[o[1]], kept[o[2]]}, tol);
+    } catch (const std::runtime_error& e) {
+      why += std::string(why.empty() ? "" : "; ") + e.what();
+    }
+  }
+  throw std::runtime_error("extrusions: no order of the three could be intersected: " + why);
 }
 
 }  // namespace loom

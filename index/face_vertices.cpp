@@ -9,6 +9,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -100,60 +101,88 @@ FaceVertexMerge merge_face_vertices(FacedMesh& m, double tol) {
     }
 
   // Candidates: inside one face, or on exactly one crease line between two faces.
-  std::vector<char> removable(nv, 0), interior(nv, 0);
+  std::vector<char> candidate(nv, 0), interior(nv, 0);
   for (std::uint32_t v = 0; v < nv; ++v) {
     if (label0[v] == -1 || many_labels[v]) continue;
     if (label1[v] == -1) {
-      removable[v] = interior[v] = crease[v].empty() ? 1 : 0;
+      candidate[v] = interior[v] = crease[v].empty() ? 1 : 0;
     } else {
-      removable[v] = crease[v].size() == 2 ? 1 : 0;
+      candidate[v] = crease[v].size() == 2 ? 1 : 0;
     }
   }
-  // Crease candidates in chains between kept vertices: Douglas–Peucker along each.
-  // walk(v, nb): the vertices from v's neighbour nb along the crease line up to the first
-  // kept one (included), or back to v (a closed chain: v is the last entry).
-  auto walk = [&](std::uint32_t v, std::uint32_t nb) {
-    std::vector<std::uint32_t> path{nb};
-    std::uint32_t prev = v, cur = nb;
-    while (cur != v && removable[cur] && !interior[cur]) {
-      const std::uint32_t next = crease[cur][0] == prev ? crease[cur][1] : crease[cur][0];
-      prev = cur;
-      cur = next;
-      path.push_back(cur);
-    }
-    return path;
+  std::vector<std::vector<std::uint32_t>> members(nt);
+  for (std::uint32_t t = 0; t < nt; ++t) members[root(parent, t)].push_back(t);
+  std::vector<char> removable(nv, 0), redo(nt, 0);
+  // True if the boundary of the face made of `face`'s triangles uses a vertex twice or has
+  // two vertices at one point.
+  auto self_touching = [&](const std::vector<std::uint32_t>& face) {
+    const std::size_t r = root(parent, face.front());
+    std::set<std::uint32_t> starts;
+    std::set<std::tuple<double, double, double>> at;
+    for (std::uint32_t f : face)
+      for (int e = 0; e < 3; ++e) {
+        const std::uint32_t a = T[f][e], b = T[f][(e + 1) % 3];
+        if (root(parent, across(a, b)) == r) continue;
+        if (!starts.insert(a).second || !at.emplace(V[a].x(), V[a].y(), V[a].z()).second) return true;
+      }
+    return false;
   };
-  std::vector<char> seen(nv, 0);
-  for (std::uint32_t v = 0; v < nv; ++v) {
-    if (!removable[v] || interior[v] || seen[v]) continue;
-    std::vector<std::uint32_t> chain;
-    const std::vector<std::uint32_t> one = walk(v, crease[v][0]);
-    if (one.back() == v) {
-      removable[v] = 0;  // a closed chain: v is kept, as both its ends
-      chain.push_back(v);
-      chain.insert(chain.end(), one.begin(), one.end());
-    } else {
-      const std::vector<std::uint32_t> other = walk(v, crease[v][1]);
-      chain.assign(other.rbegin(), other.rend());
-      chain.push_back(v);
-      chain.insert(chain.end(), one.begin(), one.end());
+  // A face whose boundary touches itself (a vertex used twice, or two vertices at one
+  // point: corefinement's copies of a vertex where pieces meet) cannot be re-triangulated
+  // from boundary loops: such faces keep their triangles and all their vertices, and the
+  // removals are decided again without those vertices.
+  std::vector<char> forced(nv, 0);
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (std::uint32_t v = 0; v < nv; ++v) removable[v] = candidate[v] && !forced[v];
+    // Crease candidates in chains between kept vertices: Douglas–Peucker along each.
+    // walk(v, nb): the vertices from v's neighbour nb along the crease line up to the first
+    // kept one (included), or back to v (a closed chain: v is the last entry).
+    auto walk = [&](std::uint32_t v, std::uint32_t nb) {
+      std::vector<std::uint32_t> path{nb};
+      std::uint32_t prev = v, cur = nb;
+      while (cur != v && removable[cur] && !interior[cur]) {
+        const std::uint32_t next = crease[cur][0] == prev ? crease[cur][1] : crease[cur][0];
+        prev = cur;
+        cur = next;
+        path.push_back(cur);
+      }
+      return path;
+    };
+    std::vector<char> seen(nv, 0);
+    for (std::uint32_t v = 0; v < nv; ++v) {
+      if (!removable[v] || interior[v] || seen[v]) continue;
+      std::vector<std::uint32_t> chain;
+      const std::vector<std::uint32_t> one = walk(v, crease[v][0]);
+      if (one.back() == v) {
+        removable[v] = 0;  // a closed chain: v is kept, as both its ends
+        chain.push_back(v);
+        chain.insert(chain.end(), one.begin(), one.end());
+      } else {
+        const std::vector<std::uint32_t> other = walk(v, crease[v][1]);
+        chain.assign(other.rbegin(), other.rend());
+        chain.push_back(v);
+        chain.insert(chain.end(), one.begin(), one.end());
+      }
+      for (std::uint32_t k : chain) seen[k] = 1;
+      keep_far_vertices(V, chain, 0, chain.size() - 1, tol, removable);
     }
-    for (std::uint32_t k : chain) seen[k] = 1;
-    keep_far_vertices(V, chain, 0, chain.size() - 1, tol, removable);
+    std::fill(redo.begin(), redo.end(), 0);
+    for (std::uint32_t t = 0; t < nt; ++t)
+      for (int e = 0; e < 3; ++e)
+        if (removable[T[t][e]]) redo[root(parent, t)] = 1;
+    for (std::size_t r = 0; r < nt; ++r) {
+      if (!redo[r] || !self_touching(members[r])) continue;
+      for (std::uint32_t f : members[r])
+        for (std::uint32_t k : T[f]) forced[k] = 1;
+      changed = true;
+    }
   }
 
   FaceVertexMerge result;
   for (std::uint32_t v = 0; v < nv; ++v)
     if (removable[v]) ++(interior[v] ? result.interior : result.crease);
   if (result.interior + result.crease == 0) return result;
-
-  // Faces that lose a vertex.
-  std::vector<char> redo(nt, 0);
-  for (std::uint32_t t = 0; t < nt; ++t)
-    for (int e = 0; e < 3; ++e)
-      if (removable[T[t][e]]) redo[root(parent, t)] = 1;
-  std::vector<std::vector<std::uint32_t>> members(nt);
-  for (std::uint32_t t = 0; t < nt; ++t) members[root(parent, t)].push_back(t);
 
   std::vector<std::array<std::uint32_t, 3>> tris;
   std::vector<int> labels;

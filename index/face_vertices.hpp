@@ -24,7 +24,9 @@ struct FaceVertexMerge {
 /// units, ≥ 0) of the segment between the nearest kept vertices along that edge line
 /// (Douglas–Peucker along each such chain, so removals never add up beyond `tol`). Each
 /// face (connected triangles of one label) that loses a vertex is re-triangulated in its
-/// plane on its remaining boundary vertices (triangulate_rings). The solid moves by at most
+/// plane on its remaining boundary vertices (triangulate_rings); a face whose boundary
+/// touches itself (a vertex twice, or two vertices at one point, as where corefinement's
+/// pieces meet) keeps its triangles and vertices instead. The solid moves by at most
 /// `tol`; labels and `faces` are kept; unused vertices are dropped, the rest keep their order.
 /// Throws std::runtime_error (and leaves m unchanged) if a face's boundary is not a set of
 /// simple loops in its plane (it touches itself, or its loops cross once projected) or its

@@ -63,7 +63,7 @@ void expect_closed(const Mesh& m) { EXPECT_TRUE(testmesh::closed_and_oriented(m)
 
 TEST(FaceVertices, SubdividedBoxIsItsEightCorners) {
   FacedMesh f = labelled_box({0, 0, 0}, {4, 2, 1});
-  split_triangle(f, 0, Vec3(1.0, 0.5, 0.0));  // inside the bottom face
+  split_triangle(f, 0, Vec3(1.0, 1.0, 0.0));  // inside the bottom face
   split_edge(f, static_cast<std::uint32_t>(vertex_index(f, {0, 0, 0})),
              static_cast<std::uint32_t>(vertex_index(f, {4, 0, 0})), Vec3(1.5, 0, 0));  // on an edge
   split_edge(f, static_cast<std::uint32_t>(vertex_index(f, {0, 0, 0})), static_cast<std::uint32_t>(vertex_index(f, {1.5, 0, 0})),
@@ -95,7 +95,7 @@ TEST(FaceVertices, AKinkBeyondTheToleranceStays) {
 
 TEST(FaceVertices, RefusesAnOpenMeshAndLeavesItUnchanged) {
   FacedMesh f = labelled_box({0, 0, 0}, {1, 1, 1});
-  split_triangle(f, 0, Vec3(0.5, 0.25, 0.0));
+  split_triangle(f, 0, Vec3(0.25, 0.5, 0.0));
   f.mesh.triangles.pop_back();
   f.face.pop_back();
   const FacedMesh before = f;
