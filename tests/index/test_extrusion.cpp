@@ -406,31 +406,57 @@ RC_GTEST_PROP(ExtrusionPairProperty, RandomRegionsGiveAClosedSolidOfTheSlicedVol
   RC_ASSERT(std::abs(m.signed_volume() - v) <= 1e-4 * std::max(v, 1.0));
 }
 
-RC_GTEST_PROP(ExtrusionsProperty, ThreeRandomRegionsGiveTheirIntersection, ()) {
-  // Three general outlines: two sliced, the third by exact corefinement, the points it
-  // leaves merged within tol. Against point membership in every extrusion (even-odd rings,
-  // depth range) at random points more than 10·tol from any face plane.
-  std::mt19937_64 rng(*rc::gen::arbitrary<std::uint32_t>());
+namespace {
+
+/// Inside a property: the three axis frames, each with random regions and a depth over most
+/// of the others' outlines (random ends), so that all three meet; with `user_plane`, a
+/// fourth frame of random normal (a user projection plane) whose region covers their middle.
+std::vector<Extrusion> random_meeting_extrusions(std::mt19937_64& rng, bool user_plane) {
   std::vector<Extrusion> es = {frame_xy(), frame_xz(), frame_yz()};
   std::uniform_real_distribution<double> end(0.0, 4.0);
   for (auto& e : es) {
     random_region(e, rng);
-    // Depth over most of the others' outlines (random ends), so that all three meet.
     const double lo = -3.0 + end(rng), hi = 27.0 + end(rng);
     e.depth_min = e.n.sum() < 0 ? -hi : lo;
     e.depth_max = e.n.sum() < 0 ? -lo : hi;
   }
+  if (user_plane) {
+    std::normal_distribution<double> g(0.0, 1.0);
+    Extrusion e;
+    e.n = Vec3(g(rng), g(rng), g(rng)).normalized();
+    e.u = e.n.unitOrthogonal();
+    e.v = e.n.cross(e.u);
+    const Vec3 middle(10.0, 10.0, 6.0);
+    const double cu = middle.dot(e.u), cv = middle.dot(e.v), cn = middle.dot(e.n);
+    e.polygons = {PolygonWithHoles2{random_star(cu, cv, 14.0, *rc::gen::inRange(3, 14), rng), {}}};
+    e.depth_min = cn - 12.0 - end(rng);
+    e.depth_max = cn + 12.0 + end(rng);
+    es.push_back(e);
+  }
+  return es;
+}
+
+}  // namespace
+
+RC_GTEST_PROP(ExtrusionsProperty, ThreeRandomRegionsGiveTheirIntersection, ()) {
+  // Three general outlines: two sliced, the third by exact corefinement, the points it
+  // leaves merged within tol; with a fourth, user-plane outline half of the time (one more
+  // corefinement, faces at any angle). Against point membership in every extrusion
+  // (even-odd rings, depth range) at random points more than 10·tol from any face plane.
+  std::mt19937_64 rng(*rc::gen::arbitrary<std::uint32_t>());
+  const bool user_plane = *rc::gen::arbitrary<bool>();
+  const std::vector<Extrusion> es = random_meeting_extrusions(rng, user_plane);
   const double tol = 1e-7;
   ExtrusionsMesh r;
   try {
     r = mesh_extrusions(es, tol);
   } catch (const std::runtime_error&) {
-    // Refused only when nothing is left: no sample point lies in all three.
+    // Refused only when nothing is left: no sample point lies in all of them.
     std::uniform_real_distribution<double> x(-2.0, 30.0), z(-4.0, 24.0);
     for (int k = 0; k < 20000; ++k) RC_ASSERT(!inside_all(es, Vec3(x(rng), x(rng), z(rng))));
     return;
   }
-  RC_ASSERT(r.booleans == 1);
+  RC_ASSERT(r.booleans == (user_plane ? 2 : 1));
   Mesh m = r.mesh;
   weld_identical_vertices(m);
   const MeshTopology t = analyse_topology(m);
