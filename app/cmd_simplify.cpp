@@ -103,6 +103,7 @@ int run_simplify(const SimplifyCommandOptions& o) {
                      {"prisms_absorbed", r.prisms_absorbed},
                      {"booleans", r.booleans},
                      {"booleans_by", r.booleans_by},
+                     {"booleans_note", r.booleans_note},
                      {"projections", projections}});
     if (!o.quiet) {
       // Below the containment tolerance a distance is rounding (a part kept as it was).

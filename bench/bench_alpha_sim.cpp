@@ -339,13 +339,9 @@ void run_gnuplot(const fs::path& script) {
 
 /// Part 3: throughput on all the sets together, 1 vs 2 threads (alpha_sim_throughput.csv).
 void throughput(const fs::path& out_dir, const std::vector<Set>& sets) {
-  std::vector<Part> all;
   std::size_t all_tris = 0;
-  for (std::size_t s = 0; s < sets.size(); ++s)
-    for (const auto& p : sets[s].parts) {
-      all.push_back(p);
-      all_tris += p.mesh.triangle_count();
-    }
+  for (const Set& set : sets)
+    for (const auto& p : set.parts) all_tris += p.mesh.triangle_count();
   std::ofstream tp_csv(out_dir / "alpha_sim_throughput.csv");
   tp_csv << "threads,triangles,seconds,triangles_per_second,measure,cpu_seconds,triangles_per_cpu_second,"
             "absorb_box_prisms,occt_booleans\n";

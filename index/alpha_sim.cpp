@@ -997,7 +997,10 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   };
   MeshTopology otopo;
   bool watertight = false;
-  if (opt.step_dir.empty() && !(opt.occt_booleans && reduced.kept.size() > 2)) {
+  const bool occt_asked = opt.occt_booleans && reduced.kept.size() > 2;
+  if (!opt.step_dir.empty()) r.booleans_note = "--step";
+  else if (occt_asked) r.booleans_note = "occt_booleans";
+  if (opt.step_dir.empty() && !occt_asked) {
     // One prism is the result; two across each other (the rib's outline and its web) are
     // sliced along their common axis; a third is intersected by exact corefinement (CGAL).
     // No OpenCASCADE (and no STEP asked for).
@@ -1010,8 +1013,11 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       r.booleans = direct.booleans;
       r.booleans_by = direct.booleans > 0 ? "cgal" : "none";
       watertight = watertight_mesh(out.mesh, otopo);
-    } catch (const std::runtime_error&) {
-      watertight = false;  // e.g. rings that cross, a non-manifold result: OpenCASCADE decides
+      if (!watertight) r.booleans_note = "loom's mesh is not closed";
+    } catch (const std::runtime_error& e) {
+      // e.g. rings that cross, pieces that touch: OpenCASCADE decides, and the report says why.
+      watertight = false;
+      r.booleans_note = e.what();
     }
   }
   TopoDS_Shape result;
@@ -1023,6 +1029,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       for (std::size_t k = 1; k < solids.size(); ++k) result = common(result, solids[k], tol);
       r.booleans = static_cast<int>(solids.size()) - 1;
       r.booleans_by = r.booleans > 0 ? "opencascade" : "none";
+      if (r.booleans == 0) r.booleans_note.clear();  // OpenCASCADE meshed one prism: no Boolean to explain
       out.mesh = mesh_shape(result, opt.dim_pre, &r.faces_after);
     } catch (const Standard_Failure& e) {
       keep_original(out, part, AlphaSimStatus::Failed,

@@ -158,6 +158,9 @@ struct AlphaSimResult {
   int booleans = 0;
   /// What ran them: "none", "cgal" (exact mesh corefinement) or "opencascade" (B-rep).
   std::string booleans_by = "none";
+  /// Why OpenCASCADE ran them where loom's own path was tried first and refused (its
+  /// message), or "--step" / "occt_booleans" when asked; empty otherwise.
+  std::string booleans_note;
   double measure_ms = 0.0;  ///< mesh containment, Hausdorff, lost-space probe
   std::vector<ProjectionReport> projections;
   /// simplify_parts: the earlier part this one is a moved copy of (its result was moved,

@@ -19,11 +19,6 @@ namespace {
 
 std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) { return (std::uint64_t(a) << 32) | b; }
 
-std::size_t root(std::vector<std::size_t>& parent, std::size_t i) {
-  while (parent[i] != i) i = parent[i] = parent[parent[i]];
-  return i;
-}
-
 double segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
   const Vec3 ab = b - a;
   const double len2 = ab.squaredNorm();
@@ -75,8 +70,7 @@ FaceVertexMerge merge_face_vertices(FacedMesh& m, double tol) {
   };
 
   // Faces: triangles joined across edges with one label.
-  std::vector<std::size_t> parent(nt);
-  std::iota(parent.begin(), parent.end(), std::size_t(0));
+  const std::vector<std::size_t> face_id = labelled_face_ids(m.mesh, m.face);
   // Per vertex: its labels (two tracked, more flagged) and its neighbours across crease
   // edges (edges between two labels).
   std::vector<int> label0(nv, -1), label1(nv, -1);
@@ -89,15 +83,9 @@ FaceVertexMerge merge_face_vertices(FacedMesh& m, double tol) {
       if (label0[a] == -1 || label0[a] == l) label0[a] = l;
       else if (label1[a] == -1 || label1[a] == l) label1[a] = l;
       else many_labels[a] = 1;
-      if (a > b) continue;  // each undirected edge once
-      const std::uint32_t u = across(a, b);
-      if (m.face[u] == l) {
-        const std::size_t ra = root(parent, t), rb = root(parent, u);
-        if (ra != rb) parent[ra] = rb;
-      } else {
-        crease[a].push_back(b);
-        crease[b].push_back(a);
-      }
+      if (a > b || m.face[across(a, b)] == l) continue;  // each undirected crease edge once
+      crease[a].push_back(b);
+      crease[b].push_back(a);
     }
 
   // Candidates: inside one face, or on exactly one crease line between two faces.
@@ -111,18 +99,18 @@ FaceVertexMerge merge_face_vertices(FacedMesh& m, double tol) {
     }
   }
   std::vector<std::vector<std::uint32_t>> members(nt);
-  for (std::uint32_t t = 0; t < nt; ++t) members[root(parent, t)].push_back(t);
+  for (std::uint32_t t = 0; t < nt; ++t) members[face_id[t]].push_back(t);
   std::vector<char> removable(nv, 0), redo(nt, 0);
   // True if the boundary of the face made of `face`'s triangles uses a vertex twice or has
   // two vertices at one point.
   auto self_touching = [&](const std::vector<std::uint32_t>& face) {
-    const std::size_t r = root(parent, face.front());
+    const std::size_t r = face_id[face.front()];
     std::set<std::uint32_t> starts;
     std::set<std::tuple<double, double, double>> at;
     for (std::uint32_t f : face)
       for (int e = 0; e < 3; ++e) {
         const std::uint32_t a = T[f][e], b = T[f][(e + 1) % 3];
-        if (root(parent, across(a, b)) == r) continue;
+        if (face_id[across(a, b)] == r) continue;
         if (!starts.insert(a).second || !at.emplace(V[a].x(), V[a].y(), V[a].z()).second) return true;
       }
     return false;
@@ -170,7 +158,7 @@ FaceVertexMerge merge_face_vertices(FacedMesh& m, double tol) {
     std::fill(redo.begin(), redo.end(), 0);
     for (std::uint32_t t = 0; t < nt; ++t)
       for (int e = 0; e < 3; ++e)
-        if (removable[T[t][e]]) redo[root(parent, t)] = 1;
+        if (removable[T[t][e]]) redo[face_id[t]] = 1;
     for (std::size_t r = 0; r < nt; ++r) {
       if (!redo[r] || !self_touching(members[r])) continue;
       for (std::uint32_t f : members[r])
@@ -189,7 +177,7 @@ FaceVertexMerge merge_face_vertices(FacedMesh& m, double tol) {
   tris.reserve(nt);
   labels.reserve(nt);
   for (std::uint32_t t = 0; t < nt; ++t) {
-    const std::size_t r = root(parent, t);
+    const std::size_t r = face_id[t];
     if (!redo[r]) {
       tris.push_back(T[t]);
       labels.push_back(m.face[t]);
@@ -218,7 +206,7 @@ FaceVertexMerge merge_face_vertices(FacedMesh& m, double tol) {
     for (std::uint32_t f : face)
       for (int e = 0; e < 3; ++e) {
         const std::uint32_t a = T[f][e], b = T[f][(e + 1) % 3];
-        if (root(parent, across(a, b)) == r) continue;
+        if (face_id[across(a, b)] == r) continue;
         if (!next_of.emplace(a, b).second) throw failure("a face touches itself at a vertex");
       }
     Vec3 u = n.unitOrthogonal();

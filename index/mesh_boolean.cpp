@@ -50,19 +50,14 @@ SurfaceMesh to_surface_mesh(const FacedMesh& m, int label_offset, const char* wh
   for (const auto& t : m.mesh.triangles) polygons.push_back({t[0], t[1], t[2]});
   if (!PMP::orient_polygon_soup(points, polygons))
     throw std::runtime_error(name + " has pieces that touch along an edge or at a vertex (not a 2-manifold)");
-  // The soup was oriented already (outward): no triangle may have been turned.
+  // No point was added, so the indices are the mesh's: the soup was oriented already
+  // (outward), and no triangle may have been turned.
   for (std::size_t t = 0; t < polygons.size(); ++t) {
     const auto& tri = m.mesh.triangles[t];
     const auto& poly = polygons[t];
     bool same = false;
-    for (int r = 0; r < 3 && !same; ++r) {
-      same = true;
-      for (int k = 0; k < 3; ++k) {
-        const Vec3& v = m.mesh.vertices[tri[static_cast<std::size_t>(k)]];
-        const auto& q = points[poly[static_cast<std::size_t>((k + r) % 3)]];
-        same = same && q == Kernel::Point_3(v.x(), v.y(), v.z());
-      }
-    }
+    for (std::size_t r = 0; r < 3; ++r)
+      same = same || (poly[r] == tri[0] && poly[(r + 1) % 3] == tri[1] && poly[(r + 2) % 3] == tri[2]);
     if (!same) throw std::runtime_error(name + " is not consistently oriented (triangle " + std::to_string(t) + ")");
   }
   SurfaceMesh sm;
@@ -96,7 +91,7 @@ struct LabelVisitor : PMP::Corefinement::Default_visitor<SurfaceMesh> {
 
 }  // namespace
 
-int labelled_faces(const Mesh& m, const std::vector<int>& face) {
+std::vector<std::size_t> labelled_face_ids(const Mesh& m, const std::vector<int>& face) {
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> first_of_edge;
   std::vector<std::size_t> parent(m.triangles.size());
   std::iota(parent.begin(), parent.end(), std::size_t(0));
@@ -108,8 +103,20 @@ int labelled_faces(const Mesh& m, const std::vector<int>& face) {
       const std::size_t ra = root(parent, it->second), rb = root(parent, t);
       if (ra != rb) parent[ra] = rb;
     }
+  // Name each face by its first triangle, whatever root the union ended with.
+  std::vector<std::size_t> first(m.triangles.size(), m.triangles.size()), id(m.triangles.size());
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    std::size_t& f = first[root(parent, t)];
+    if (f == m.triangles.size()) f = t;
+    id[t] = f;
+  }
+  return id;
+}
+
+int labelled_faces(const Mesh& m, const std::vector<int>& face) {
+  const std::vector<std::size_t> id = labelled_face_ids(m, face);
   int n = 0;
-  for (std::size_t t = 0; t < parent.size(); ++t) n += root(parent, t) == t ? 1 : 0;
+  for (std::size_t t = 0; t < id.size(); ++t) n += id[t] == t ? 1 : 0;
   return n;
 }
 

@@ -7,6 +7,7 @@
 
 #include "core/mesh.hpp"
 
+#include <cstddef>
 #include <vector>
 
 namespace loom {
@@ -20,8 +21,12 @@ struct FacedMesh {
   int faces = 0;
 };
 
-/// Number of connected sets of triangles of `m` with one label (adjacent across an edge
-/// with equal vertex ids). `face` has one label per triangle.
+/// Per triangle of `m`, its face: the smallest triangle index of its connected set of
+/// triangles with one label (adjacent across an edge with equal vertex ids). `face` has
+/// one label per triangle.
+std::vector<std::size_t> labelled_face_ids(const Mesh& m, const std::vector<int>& face);
+
+/// Number of those faces (labelled_face_ids).
 int labelled_faces(const Mesh& m, const std::vector<int>& face);
 
 /// The intersection of the solids bounded by a.mesh and b.mesh (each closed,

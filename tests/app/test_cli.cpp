@@ -293,7 +293,7 @@ TEST(CliSimplify, WritesEachPartAndTheReport) {
   const std::string rep = slurp(out / "simplify.json");
   for (const char* key : {"\"dim_pre\": 2.0", "\"dim_pre_source\": \"--dim-pre\"", "\"triangles_before\": 12",
                           "\"triangles_after\": 12", "\"containment\": 1.0", "\"status\": \"ok\"", "\"hausdorff\"",
-                          "\"tolerance\"", "\"booleans\": 0", "\"booleans_by\": \"none\""})
+                          "\"tolerance\"", "\"booleans\": 0", "\"booleans_by\": \"none\"", "\"booleans_note\": \"\""})
     EXPECT_NE(rep.find(key), std::string::npos) << key << "\n" << rep;
   for (const auto& e : std::filesystem::directory_iterator(out))
     EXPECT_TRUE(e.path().extension() == ".json" || e.path().extension() == ".stl") << e.path();  // no temp files

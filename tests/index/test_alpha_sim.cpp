@@ -996,6 +996,8 @@ TEST(AlphaSim, CgalBooleansGiveTheSolidOfOpenCascade) {
     ASSERT_NE(b.result.fallback, AlphaSimFallback::Original) << p.name << ": " << b.result.reason;
     EXPECT_EQ(a.result.booleans_by, "cgal") << p.name;
     EXPECT_EQ(b.result.booleans_by, "opencascade") << p.name;
+    EXPECT_EQ(a.result.booleans_note, "") << p.name;
+    EXPECT_EQ(b.result.booleans_note, "occt_booleans") << p.name;
     // Two of the three prisms are sliced by loom, the third is one corefinement.
     EXPECT_EQ(a.result.booleans, 1) << p.name;
     EXPECT_EQ(b.result.booleans, 2) << p.name;
@@ -1218,6 +1220,7 @@ RC_GTEST_PROP(AlphaSimProperty, TheMeshHoldsTheImplicitSolid, ()) {
   // its result has lost pieces of the intersection that hold no surface of the part (known
   // limit, DESIGN-NOTES): only CGAL's result is held to this.
   RC_TAG(sp.result.booleans_by);
+  RC_ASSERT((sp.result.booleans_by == "opencascade") == !sp.result.booleans_note.empty());  // the fallback says why
   if (sp.result.booleans_by == "cgal") RC_ASSERT(implicit_points_outside_the_mesh(sp, sp.result.tolerance, 20000) == 0u);
 }
 
