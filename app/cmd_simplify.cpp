@@ -79,6 +79,8 @@ int run_simplify(const SimplifyCommandOptions& o) {
                              {"kept_triangles", p.kept_triangles},
                              {"area", finite_or_zero(p.area)},
                              {"hull_area", finite_or_zero(p.hull_area)},
+                             {"edge_on_triangles", p.edge_on_triangles},
+                             {"edge_on_segments", p.edge_on_segments},
                              {"polygon_vertices", p.polygon_vertices},
                              {"holes", p.holes}});
     parts.push_back({{"name", r.name},

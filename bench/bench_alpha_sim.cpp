@@ -344,19 +344,22 @@ void throughput(const fs::path& out_dir, const std::vector<Set>& sets) {
     for (const auto& p : set.parts) all_tris += p.mesh.triangle_count();
   std::ofstream tp_csv(out_dir / "alpha_sim_throughput.csv");
   tp_csv << "threads,triangles,seconds,triangles_per_second,measure,cpu_seconds,triangles_per_cpu_second,"
-            "absorb_box_prisms,occt_booleans\n";
-  // Without the measures: as loom runs, then with the general Booleans on OpenCASCADE (the
-  // twenty-second session's path), then with every OpenCASCADE Boolean run (no prism
-  // absorbed: the solids before it) — the baselines in the same process; last, as loom
-  // runs with the mesh verification. LOOM_TP_ONE=1 runs the first only (for profiling).
+            "absorb_box_prisms,occt_booleans,edge_on_segments\n";
+  // Without the measures: as loom runs, then with the samples of triangles seen edge-on
+  // tested like the others (the twenty-third session's path), then also with the general
+  // Booleans on OpenCASCADE (the twenty-second's), then with every OpenCASCADE Boolean run
+  // (no prism absorbed: the solids before it) — the baselines in the same process; last,
+  // as loom runs with the mesh verification. LOOM_TP_ONE=1 runs the first only (for profiling).
   struct Config {
-    bool measure, absorb, occt;
+    bool measure, absorb, occt, edge_on;
     const char* what;
   };
-  const Config configs[] = {{false, true, false, "without mesh verification"},
-                            {false, true, true, "without mesh verification, OpenCASCADE Booleans"},
-                            {false, false, true, "without mesh verification, every OpenCASCADE Boolean run"},
-                            {true, true, false, "with verification"}};
+  const Config configs[] = {
+      {false, true, false, true, "without mesh verification"},
+      {false, true, false, false, "without mesh verification, edge-on triangles sampled"},
+      {false, true, true, false, "without mesh verification, OpenCASCADE Booleans, edge-on triangles sampled"},
+      {false, false, true, false, "without mesh verification, every OpenCASCADE Boolean run, edge-on triangles sampled"},
+      {true, true, false, true, "with verification"}};
   const std::size_t n_configs = std::getenv("LOOM_TP_ONE") ? 1 : std::size(configs);
   for (std::size_t c = 0; c < n_configs; ++c)
     for (int threads : {1, 2}) {
@@ -372,12 +375,13 @@ void throughput(const fs::path& out_dir, const std::vector<Set>& sets) {
         o.measure = cf.measure;
         o.absorb_box_prisms = cf.absorb;
         o.occt_booleans = cf.occt;
+        o.edge_on_segments = cf.edge_on;
         std::vector<AlphaSimResult> res;
         simplify_parts(sets[s].parts, o, &res);
       });
       const double sec = seconds_since(t0), cpu = cpu_seconds() - cpu0;
       tp_csv << threads << "," << all_tris << "," << sec << "," << all_tris / sec << "," << int(cf.measure) << ","
-             << cpu << "," << all_tris / cpu << "," << int(cf.absorb) << "," << int(cf.occt) << "\n";
+             << cpu << "," << all_tris / cpu << "," << int(cf.absorb) << "," << int(cf.occt) << "," << int(cf.edge_on) << "\n";
       std::printf("throughput (%s): %d thread(s): %zu triangles in %.2f s = %.3g triangles/s (CPU %.2f s = %.3g "
                   "triangles per CPU second)\n",
                   cf.what, threads, all_tris, sec, all_tris / sec, cpu, all_tris / cpu);

@@ -12,6 +12,7 @@
 #include <limits>
 #include <map>
 #include <queue>
+#include <stdexcept>
 #include <tuple>
 
 namespace loom {
@@ -82,6 +83,29 @@ struct BucketGrid {
       const auto& g = range[k];
       for (int y = g[2]; y <= g[3]; ++y)
         for (int x = g[0]; x <= g[1]; ++x) items[count[static_cast<std::size_t>(y) * nx + x]++] = k;
+    }
+  }
+  /// The items listed in every cell within `pad` of the segment ab (row by row: the
+  /// x-range of the segment's part in the row's padded slab); an item in several of those
+  /// cells is listed as often.
+  void items_near_segment(const Vec2& a, const Vec2& b, double pad, std::vector<std::uint32_t>& out) const {
+    out.clear();
+    if (empty()) return;
+    const double ymin = std::min(a.y(), b.y()), ymax = std::max(a.y(), b.y());
+    const double xmin = std::min(a.x(), b.x()), xmax = std::max(a.x(), b.x());
+    const double dx = b.x() - a.x(), dy = b.y() - a.y();
+    for (int j = cy(ymin - pad), j1 = cy(ymax + pad); j <= j1; ++j) {
+      const double s0 = std::clamp(origin.y() + j * cell - pad, ymin, ymax);
+      const double s1 = std::clamp(origin.y() + (j + 1) * cell + pad, ymin, ymax);
+      double xl = xmin, xr = xmax;
+      if (s0 > ymin || s1 < ymax) {  // the slab cuts the segment: its x-range there
+        const double xa = a.x() + dx * ((s0 - a.y()) / dy), xb = a.x() + dx * ((s1 - a.y()) / dy);
+        xl = std::max(xmin, std::min(xa, xb));
+        xr = std::min(xmax, std::max(xa, xb));
+      }
+      // One more cell each side: the cell index of a rounded x may be one off.
+      for (int i = std::max(0, cx(xl - pad) - 1), i1 = std::min(nx - 1, cx(xr + pad) + 1); i <= i1; ++i)
+        for_cell(i, j, [&](std::uint32_t k) { out.push_back(k); });
     }
   }
   template <class F>
@@ -455,6 +479,130 @@ double AlphaShape2D::cover(const std::vector<Vec2>& points, double tol, std::siz
 bool AlphaShape2D::contains(const Vec2& p, double tol) const {
   if (impl_->in_kept_triangle(p)) return true;
   return tol > 0.0 && impl_->boundary_distance(p, tol) <= tol;
+}
+
+namespace {
+
+/// Narrows [lo, hi] to the t where f0 + t·(f1 − f0) ≥ −slack (a half-plane along a line).
+void clip_half_plane(double f0, double f1, double slack, double& lo, double& hi) {
+  const double df = f1 - f0;
+  if (df == 0.0) {
+    if (f0 < -slack) hi = lo - 1.0;  // empty
+    return;
+  }
+  const double t = (-slack - f0) / df;
+  if (df > 0.0)
+    lo = std::max(lo, t);
+  else
+    hi = std::min(hi, t);
+}
+
+/// The t where |a + t·d − c| ≤ r, or an empty range (lo > hi).
+std::array<double, 2> disc_range(const Vec2& a, const Vec2& d, const Vec2& c, double r) {
+  const Vec2 w = a - c;
+  const double qa = d.squaredNorm(), qb = d.dot(w), qc = w.squaredNorm() - r * r;
+  const double disc = qb * qb - qa * qc;
+  if (!(qa > 0.0) || disc < 0.0) return {1.0, 0.0};
+  const double root = std::sqrt(disc);
+  return {(-qb - root) / qa, (-qb + root) / qa};
+}
+
+}  // namespace
+
+std::vector<Vec2> AlphaShape2D::segment_gaps(const Vec2& a, const Vec2& b, double tol, double spacing) const {
+  if (!(spacing > 0.0)) throw std::invalid_argument("AlphaShape2D::segment_gaps: spacing must be > 0");
+  const Impl& m = *impl_;
+  const Vec2 d = b - a;
+  const double len = d.norm();
+  if (!(len > 0.0)) return contains(a, tol) ? std::vector<Vec2>() : std::vector<Vec2>{a};
+  std::vector<Vec2> gaps;
+  if (m.tri_grid.empty()) {  // no region: all of ab is one gap
+    const int n = std::max(1, static_cast<int>(std::ceil(len / spacing)));
+    for (int i = 0; i < n; ++i) gaps.push_back(a + ((i + 0.5) / n) * d);
+    return gaps;
+  }
+  // Pieces no longer than a cell of the grids, so that each gathers a few candidates; a
+  // piece whose box lies in cells of the flag grid (wholly inside the region) is covered.
+  const FlagGrid& fg = m.flags;
+  const double piece_len = std::min(m.tri_grid.cell, fg.nx > 0 ? fg.cell : m.tri_grid.cell);
+  const int pieces = std::max(1, static_cast<int>(std::ceil(len / piece_len)));
+  std::vector<std::array<double, 2>> ranges;
+  std::vector<std::uint32_t> ids;
+  auto in_flagged_cells = [&](const Vec2& p, const Vec2& q) {
+    if (fg.nx == 0) return false;
+    const Vec2 lo = p.cwiseMin(q), hi = p.cwiseMax(q);
+    const double fx0 = (lo.x() - fg.origin.x()) / fg.cell, fy0 = (lo.y() - fg.origin.y()) / fg.cell;
+    const double fx1 = (hi.x() - fg.origin.x()) / fg.cell, fy1 = (hi.y() - fg.origin.y()) / fg.cell;
+    if (!(fx0 >= 0.0 && fy0 >= 0.0 && fx1 < fg.nx && fy1 < fg.ny)) return false;
+    for (int j = static_cast<int>(fy0); j <= static_cast<int>(fy1); ++j)
+      for (int i = static_cast<int>(fx0); i <= static_cast<int>(fx1); ++i)
+        if (!fg.inside_cell[static_cast<std::size_t>(j) * fg.nx + i]) return false;
+    return true;
+  };
+  for (int piece = 0; piece < pieces; ++piece) {
+    const double t0 = static_cast<double>(piece) / pieces, t1 = static_cast<double>(piece + 1) / pieces;
+    const Vec2 pa = a + t0 * d, pb = piece + 1 == pieces ? b : a + t1 * d, pd = pb - pa;
+    if (in_flagged_cells(pa, pb)) continue;
+    // Covered parameter ranges of the piece (a candidate met twice only repeats its range):
+    // each kept triangle it crosses (closed, the
+    // relative slack of in_kept_triangle_slow, so that shared edges and vertices leave no
+    // crack), and each boundary edge's capsule of radius tol (R ⊕ tol = R ∪ (∂R ⊕ tol):
+    // the nearest point of R to a point outside it lies on ∂R).
+    ranges.clear();
+    m.tri_grid.items_near_segment(pa, pb, 0.0, ids);
+    for (std::uint32_t k : ids) {
+      const auto& c = m.kept_coords[k];
+      double lo = 0.0, hi = 1.0;
+      for (int e = 0; e < 3 && lo <= hi; ++e) {
+        const Vec2 p = c[e], q = c[(e + 1) % 3], pq = q - p;
+        const double f0 = pq.x() * (pa.y() - p.y()) - pq.y() * (pa.x() - p.x());
+        const double f1 = pq.x() * (pb.y() - p.y()) - pq.y() * (pb.x() - p.x());
+        const double slack = 1e-12 * (std::abs(pq.x()) + std::abs(pq.y())) *
+                             (std::abs(pa.x() - p.x()) + std::abs(pa.y() - p.y()) + std::abs(pd.x()) + std::abs(pd.y()));
+        clip_half_plane(f0, f1, slack, lo, hi);
+      }
+      if (lo <= hi) ranges.push_back({lo, hi});
+    }
+    if (tol > 0.0) {
+      m.seg_grid.items_near_segment(pa, pb, tol, ids);
+      for (std::uint32_t k : ids) {
+        const Vec2 s0 = m.segments[k][0], s1 = m.segments[k][1];
+        for (const Vec2& c : {s0, s1}) {
+          const auto r = disc_range(pa, pd, c, tol);
+          if (r[0] <= r[1] && r[1] >= 0.0 && r[0] <= 1.0) ranges.push_back({std::max(r[0], 0.0), std::min(r[1], 1.0)});
+        }
+        const Vec2 u = s1 - s0;
+        const double ul = u.norm();
+        if (!(ul > 0.0)) continue;
+        const Vec2 un = u / ul, n(-un.y(), un.x());
+        // The rectangle 0 ≤ un·(P − s0) ≤ ul, |n·(P − s0)| ≤ tol.
+        double lo = 0.0, hi = 1.0;
+        const double ua = un.dot(pa - s0), ub = un.dot(pb - s0), na = n.dot(pa - s0), nb = n.dot(pb - s0);
+        clip_half_plane(ua, ub, 0.0, lo, hi);
+        clip_half_plane(ul - ua, ul - ub, 0.0, lo, hi);
+        clip_half_plane(tol - na, tol - nb, 0.0, lo, hi);
+        clip_half_plane(tol + na, tol + nb, 0.0, lo, hi);
+        if (lo <= hi) ranges.push_back({lo, hi});
+      }
+    }
+    std::sort(ranges.begin(), ranges.end());
+    const double plen = pd.norm();
+    auto gap = [&](double g0, double g1) {
+      // A stretch of relative length ≤ 1e-12 is rounding between two touching ranges.
+      if (g1 - g0 <= 1e-12) return;
+      const int n = std::max(1, static_cast<int>(std::ceil((g1 - g0) * plen / spacing)));
+      for (int i = 0; i < n; ++i) gaps.push_back(pa + (g0 + (i + 0.5) * (g1 - g0) / n) * pd);
+    };
+    double covered = 0.0;  // [0, covered] of the piece is covered
+    for (const auto& r : ranges) {
+      if (r[1] < covered) continue;
+      if (r[0] > covered) gap(covered, r[0]);
+      covered = std::max(covered, r[1]);
+      if (covered >= 1.0) break;
+    }
+    if (covered < 1.0) gap(covered, 1.0);
+  }
+  return gaps;
 }
 
 bool AlphaShape2D::contains_unaccelerated(const Vec2& p, double tol) const {

@@ -80,6 +80,12 @@ class AlphaShape2D {
   };
   /// The grid of the O(1) inside answers of contains() (rebuilt when the region changes).
   InsideGrid inside_grid() const;
+  /// Points of the segment ab (plane coordinates) farther than tol from the region: for
+  /// each stretch of ab that neither a kept triangle (closed, rounding slack) nor the
+  /// tol-neighbourhood of a boundary edge covers, its midpoint and points at most `spacing`
+  /// apart along it. Empty: all of ab lies in the region or within tol of it (exact up to
+  /// rounding, unlike a test of points sampled on ab). spacing > 0.
+  std::vector<Vec2> segment_gaps(const Vec2& a, const Vec2& b, double tol, double spacing) const;
   /// Signed distance to the region's boundary: negative inside, +inf if the region is empty.
   double signed_distance(const Vec2& p) const;
   /// Boundary loops grouped per connected piece (outer CCW, holes CW), in deterministic order.

@@ -39,6 +39,7 @@
 #include <mutex>
 #include <random>
 #include <stdexcept>
+#include <tuple>
 
 namespace loom {
 
@@ -140,9 +141,12 @@ std::vector<MeshEdge> unique_edges(const Mesh& mesh) {
 /// dense_surface_samples() with the mesh's unique edges given (when fixed_points): each
 /// edge's midpoint is taken once, not once per triangle that shares it (a closed mesh's
 /// edges are shared by two: 1.5 points per triangle fewer, the same set of points).
+/// `source`, if given, gets the triangle of each sample (kNoTriangle for the vertices and
+/// edge midpoints, which several triangles share).
+constexpr std::uint32_t kNoTriangle = std::numeric_limits<std::uint32_t>::max();
 std::vector<Vec3> dense_surface_samples(const Mesh& mesh, const std::vector<MeshEdge>& edges, double spacing,
                                         double density, std::size_t max_samples, std::uint64_t seed,
-                                        bool fixed_points) {
+                                        bool fixed_points, std::vector<std::uint32_t>* source = nullptr) {
   std::vector<Vec3> out;
   const std::size_t nt = mesh.triangles.size();
   if (fixed_points) {
@@ -153,6 +157,7 @@ std::vector<Vec3> dense_surface_samples(const Mesh& mesh, const std::vector<Mesh
       if (used[i]) out.push_back(mesh.vertices[i]);
     for (const MeshEdge& e : edges) out.push_back((mesh.vertices[e.a] + mesh.vertices[e.b]) / 2.0);
   }
+  if (source) source->assign(out.size(), kNoTriangle);
   // Random points: ≥ 2 per triangle, ≈ density per spacing² of area, capped.
   const double cell = spacing > 0.0 ? spacing * spacing : 1.0;
   std::vector<std::size_t> count(nt);
@@ -168,8 +173,9 @@ std::vector<Vec3> dense_surface_samples(const Mesh& mesh, const std::vector<Mesh
   std::uniform_real_distribution<double> uni(0.0, 1.0);
   for (std::size_t t = 0; t < nt; ++t) {
     const auto c = mesh.corners(t);
-    if (fixed_points) out.push_back((c[0] + c[1] + c[2]) / 3.0);
     const std::size_t k = std::max<std::size_t>(1, static_cast<std::size_t>(count[t] * scale));
+    if (fixed_points) out.push_back((c[0] + c[1] + c[2]) / 3.0);
+    if (source) source->resize(out.size() + k, static_cast<std::uint32_t>(t));
     for (std::size_t s = 0; s < k; ++s) {
       double a = uni(rng), b = uni(rng);
       if (a + b > 1.0) {
@@ -454,6 +460,89 @@ AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
   if (centres.active())
     merge_unique(s.checks, centres.points([&](long i, long j) { return snapped(centres.at(i, j)); }));
   return s;
+}
+
+/// The triangles a plane sees edge-on, and what is checked in place of their samples.
+struct EdgeOnTriangles {
+  std::vector<char> flag;                       ///< per triangle: 1 if seen edge-on
+  std::vector<std::array<Vec2, 2>> segments;    ///< their longest projected edges, snapped, unique
+};
+
+/// Triangles whose projection in `pr` is narrower than `width` (twice its area over its
+/// longest edge). Such a projection lies within `width` of its longest edge (the foot of
+/// the opposite corner falls on that edge, whose end angles are at most 90°), so the
+/// region covering that edge within tol − width − snap covers every sample of the
+/// triangle within tol: one exact segment test (AlphaShape2D::segment_gaps) replaces the
+/// random samples. A CAD part's faces along an axis are seen edge-on by the other two
+/// planes (~50–90% of a wing part's samples per plane), and their samples all fall on the
+/// outline, where each point test is slowest; hundreds of triangles along an extrusion
+/// share one segment.
+EdgeOnTriangles edge_on_triangles(const Mesh& mesh, const AlphaSimPrism& pr, double width, double snap) {
+  EdgeOnTriangles out;
+  out.flag.assign(mesh.triangles.size(), 0);
+  auto snapped = [snap](const Vec2& q) { return Vec2(std::round(q.x() / snap) * snap, std::round(q.y() / snap) * snap); };
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& f = mesh.triangles[t];
+    const std::array<Vec2, 3> q = {pr.project(mesh.vertices[f[0]]), pr.project(mesh.vertices[f[1]]),
+                                   pr.project(mesh.vertices[f[2]])};
+    int longest = 0;
+    double l2 = -1.0;
+    for (int e = 0; e < 3; ++e) {
+      const double d2 = (q[(e + 1) % 3] - q[e]).squaredNorm();
+      if (d2 > l2) {
+        l2 = d2;
+        longest = e;
+      }
+    }
+    const Vec2 ab = q[1] - q[0], ac = q[2] - q[0];
+    const double twice_area = std::abs(ab.x() * ac.y() - ab.y() * ac.x());
+    if (!(twice_area <= width * std::sqrt(l2))) continue;
+    out.flag[t] = 1;
+    Vec2 a = snapped(q[longest]), b = snapped(q[(longest + 1) % 3]);
+    if (b.x() < a.x() || (b.x() == a.x() && b.y() < a.y())) std::swap(a, b);
+    out.segments.push_back({a, b});
+  }
+  std::sort(out.segments.begin(), out.segments.end(), [](const auto& x, const auto& y) {
+    return std::tie(x[0].x(), x[0].y(), x[1].x(), x[1].y()) < std::tie(y[0].x(), y[0].y(), y[1].x(), y[1].y());
+  });
+  out.segments.erase(std::unique(out.segments.begin(), out.segments.end()), out.segments.end());
+  // Axis-parallel segments on one line (exact after snapping: a face along an axis seen
+  // edge-on, cut into many triangles) are merged where they overlap or touch; the others
+  // are kept as they are.
+  std::vector<std::array<Vec2, 2>> merged, other;
+  std::vector<std::array<double, 4>> axial;  // (axis, line coordinate, from, to)
+  for (const auto& sg : out.segments) {
+    if (sg[0].y() == sg[1].y())
+      axial.push_back({0.0, sg[0].y(), sg[0].x(), sg[1].x()});
+    else if (sg[0].x() == sg[1].x())
+      axial.push_back({1.0, sg[0].x(), sg[0].y(), sg[1].y()});
+    else
+      other.push_back(sg);
+  }
+  std::sort(axial.begin(), axial.end());
+  for (std::size_t i = 0; i < axial.size();) {
+    std::array<double, 4> run = axial[i];
+    std::size_t j = i + 1;
+    for (; j < axial.size() && axial[j][0] == run[0] && axial[j][1] == run[1] && axial[j][2] <= run[3]; ++j)
+      run[3] = std::max(run[3], axial[j][3]);
+    merged.push_back(run[0] == 0.0 ? std::array<Vec2, 2>{Vec2(run[2], run[1]), Vec2(run[3], run[1])}
+                                   : std::array<Vec2, 2>{Vec2(run[1], run[2]), Vec2(run[1], run[3])});
+    i = j;
+  }
+  merged.insert(merged.end(), other.begin(), other.end());
+  out.segments = std::move(merged);
+  return out;
+}
+
+/// The points of the edge-on segments that `shape` leaves farther than tol (see
+/// AlphaShape2D::segment_gaps), spaced ≤ spacing.
+std::vector<Vec2> edge_on_gaps(const AlphaShape2D& shape, const EdgeOnTriangles& eo, double tol, double spacing) {
+  std::vector<Vec2> gaps;
+  for (const auto& sg : eo.segments) {
+    const auto g = shape.segment_gaps(sg[0], sg[1], tol, spacing);
+    gaps.insert(gaps.end(), g.begin(), g.end());
+  }
+  return gaps;
 }
 
 /// Orthonormal frame (u, v, n = u × v) for a plane normal.
@@ -771,9 +860,10 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   // they catch the thin gaps that the regular checks miss, such as slivers between the
   // nearly coincident silhouettes of a faceted cylinder. Containment is verified below on
   // an independent set (another seed).
+  std::vector<std::uint32_t> cover_source;
   const std::vector<Vec3> cover_samples =
       opt.cover_samples ? dense_surface_samples(part.mesh, edges, r.l_max, opt.containment_density,
-                                                opt.containment_max_samples, opt.seed + 2, true)
+                                                opt.containment_max_samples, opt.seed + 2, true, &cover_source)
                         : std::vector<Vec3>();
 
   // 1–2. Sample each projection (L_max), 3. build its α-shape (planes in parallel).
@@ -787,6 +877,17 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   // faces) would otherwise give sliver triangles and spurious boundary loops.
   // A power of two, so that coordinates on a binary grid (integers, halves) stay exact.
   const double snap = std::exp2(std::floor(std::log2(tol / 4.0)));
+  // Triangles seen edge-on (narrower than edge_on_width in projection) are checked by
+  // their longest edge within edge_on_tol instead of by samples (edge_on_triangles):
+  // width + snap·√2/2 + edge_on_tol ≤ (1/4 + 0.18 + 1/2)·tol keeps their samples within tol.
+  const double edge_on_width = tol / 4.0, edge_on_tol = tol / 2.0;
+  // Spacing of the points a gap of an edge-on segment adds to the checks.
+  const double edge_on_gap_spacing = r.l_max / 4.0;
+  // Repairs of the gaps of the edge-on segments before the verification rounds.
+  constexpr int kEdgeOnRepairs = 3;
+  std::vector<EdgeOnTriangles> edge_on(specs.size());
+  // 1 while a plane's shape is unchanged since its edge-on segments were found covered.
+  std::vector<char> edge_on_clean(specs.size(), 0);
   tbb::parallel_for(std::size_t(0), specs.size(), [&](std::size_t k) {
     AlphaSimPrism pr = specs[k].frame;
     ProjectionReport& rep = r.projections[k];
@@ -813,9 +914,24 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       rep.status = ProjectionStatus::Empty;
       shape->keep_all();
     } else {
+      if (opt.edge_on_segments) edge_on[k] = edge_on_triangles(part.mesh, pr, edge_on_width, snap);
+      rep.edge_on_triangles = static_cast<std::size_t>(std::count(edge_on[k].flag.begin(), edge_on[k].flag.end(), 1));
+      rep.edge_on_segments = edge_on[k].segments.size();
+      const auto& eo = edge_on[k].flag;
       smp.checks.reserve(smp.checks.size() + cover_samples.size());
-      for (const auto& p : cover_samples) smp.checks.push_back(pr.project(p));
+      for (std::size_t i = 0; i < cover_samples.size(); ++i)
+        if (eo.empty() || cover_source[i] == kNoTriangle || !eo[cover_source[i]])
+          smp.checks.push_back(pr.project(cover_samples[i]));
       repair_projection(*shape, smp.checks, tol, opt.torn_fraction, rep);
+      for (int pass = 0; pass < kEdgeOnRepairs && !is_hull(rep.status); ++pass) {
+        const auto gaps = edge_on_gaps(*shape, edge_on[k], edge_on_tol, edge_on_gap_spacing);
+        if (gaps.empty()) {
+          edge_on_clean[k] = 1;
+          break;
+        }
+        smp.checks.insert(smp.checks.end(), gaps.begin(), gaps.end());
+        repair_projection(*shape, smp.checks, tol, opt.torn_fraction, rep);
+      }
     }
     pr.shape = shape;
     prisms[k] = pr;
@@ -834,6 +950,9 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   // every projected point).
   constexpr int kRefineRounds = 3;
   std::vector<Vec3> samples;
+  std::vector<std::uint32_t> sample_source;
+  // Misses of the samples (a sample of a triangle seen edge-on is left to its segment)
+  // and the gaps of the edge-on segments, per plane.
   auto plane_misses = [&](std::vector<std::vector<Vec2>>& missed) {
     std::vector<std::size_t> miss(specs.size(), 0);
     tbb::enumerable_thread_specific<std::vector<std::vector<Vec2>>> local_missed(
@@ -842,11 +961,17 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       auto& lm = local_missed.local();
       for (std::size_t i = rg.begin(); i != rg.end(); ++i)
         for (std::size_t k = 0; k < prisms.size(); ++k) {
+          const std::uint32_t t = sample_source[i];
+          if (t != kNoTriangle && !edge_on[k].flag.empty() && edge_on[k].flag[t]) continue;
           const Vec2 q = prisms[k].project(samples[i]);
           if (!prisms[k].shape->contains(q, tol)) lm[k].push_back(q);
         }
     });
     missed.assign(specs.size(), {});
+    tbb::parallel_for(std::size_t(0), specs.size(), [&](std::size_t k) {
+      if (!edge_on_clean[k]) missed[k] = edge_on_gaps(*prisms[k].shape, edge_on[k], edge_on_tol, edge_on_gap_spacing);
+      edge_on_clean[k] = missed[k].empty() ? 1 : 0;
+    });
     for (auto& lm : local_missed)
       for (std::size_t k = 0; k < specs.size(); ++k) missed[k].insert(missed[k].end(), lm[k].begin(), lm[k].end());
     for (std::size_t k = 0; k < specs.size(); ++k) {
@@ -862,7 +987,8 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     // the cover samples, which every repair keeps covered (without cover samples they are
     // tested here too).
     samples = dense_surface_samples(part.mesh, edges, r.l_max, opt.containment_density, opt.containment_max_samples,
-                                    opt.seed + 3 * static_cast<std::uint64_t>(round), !opt.cover_samples);
+                                    opt.seed + 3 * static_cast<std::uint64_t>(round), !opt.cover_samples,
+                                    &sample_source);
     std::vector<std::vector<Vec2>> missed;
     const auto miss = plane_misses(missed);
     bool any = false, hull_missed = false;
@@ -876,9 +1002,11 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
         auto& checks = plane_samples[k].checks;
         checks.insert(checks.end(), missed[k].begin(), missed[k].end());
         repair_projection(*shapes[k], checks, tol, opt.torn_fraction, rep);
+        edge_on_clean[k] = 0;
       } else {
         rep.status = ProjectionStatus::Eroded;
         shapes[k]->keep_all();
+        edge_on_clean[k] = 0;
       }
     }
     if (!any) break;
@@ -900,8 +1028,9 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   }
   auto solid = std::make_shared<AlphaSimSolid>(prisms);
   {
-    // Every sample lies in every 2D shape (checked above), so solid->contains(p, tol)
-    // reduces to the depth ranges: checked here without the 2D queries again.
+    // Every sample lies in every 2D shape within tol (checked above, directly or through
+    // the segment of its edge-on triangle), so solid->contains(p, tol) reduces to the
+    // depth ranges: checked here without the 2D queries again.
     const std::size_t in = tbb::parallel_reduce(
         tbb::blocked_range<std::size_t>(0, samples.size(), 4096), std::size_t(0),
         [&](const auto& rg, std::size_t acc) {

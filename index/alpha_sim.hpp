@@ -54,6 +54,11 @@ struct AlphaSimOptions {
   /// first repair; false leaves only the planes' own checks there (an ablation: the
   /// verification rounds, which then test the fixed points too, have to do the repair).
   bool cover_samples = true;
+  /// Triangles seen edge-on in a plane (narrower than tol/4 in projection) are checked by
+  /// their longest projected edge, exactly (AlphaShape2D::segment_gaps), instead of by
+  /// their random samples in that plane; false samples them like the others (the ablation
+  /// and bench baseline: the path before the twenty-fourth session).
+  bool edge_on_segments = true;
   /// Most samples in one projection plane (memory bound, ~100 bytes per point).
   std::size_t max_cloud_points = 4000000;
   /// The boundary polygons that are extruded may grow the α-shape (never shrink it) by
@@ -123,6 +128,8 @@ struct ProjectionReport {
   double alpha_area = 0.0;             ///< area of the plain α-shape (scene units²)
   double area = 0.0;                   ///< final area
   double hull_area = 0.0;              ///< convex hull area
+  std::size_t edge_on_triangles = 0;   ///< triangles seen edge-on: checked by their longest edge, not sampled
+  std::size_t edge_on_segments = 0;    ///< the unique edges those checks ran on
   std::size_t polygon_vertices = 0;    ///< boundary vertices after merging collinear ones
   std::size_t polygons = 0;            ///< connected pieces
   std::size_t holes = 0;

@@ -289,6 +289,83 @@ TEST(AlphaShape2D, InsideGridAgreesWithPointLocation) {
   expect_inside_grid_agrees(proj, smp.checks, 15);
 }
 
+TEST(AlphaShape2D, SegmentGapsOfASquareMatchClosedForm) {
+  // The square [0, 10]² (a grid at 0.5): a segment on its edge or inside has no gap, one
+  // parallel outside has none within tol and is one gap beyond; one that leaves the square
+  // has a gap from 10 + tol on.
+  const AlphaShape2D s(grid_points(0, 0, 10, 10, 0.5), 0.95);
+  const double tol = 1e-3, spacing = 0.25;
+  EXPECT_TRUE(s.segment_gaps({0, 0}, {10, 0}, tol, spacing).empty());
+  EXPECT_TRUE(s.segment_gaps({0.3, 0.1}, {9.7, 9.9}, tol, spacing).empty());
+  EXPECT_TRUE(s.segment_gaps({-0.5 * tol, 1}, {-0.5 * tol, 9}, tol, spacing).empty());
+  EXPECT_TRUE(s.segment_gaps({10, 10}, {10, 10}, tol, spacing).empty());  // a point
+  const auto off = s.segment_gaps({-2 * tol, 1}, {-2 * tol, 9}, tol, spacing);
+  ASSERT_GE(off.size(), 32u);  // all 8 of it, points ≤ 0.25 apart
+  for (std::size_t i = 0; i < off.size(); ++i) {
+    EXPECT_FALSE(s.contains(off[i], tol)) << off[i].transpose();
+    if (i > 0) {
+      EXPECT_LE((off[i] - off[i - 1]).norm(), spacing + 1e-12);
+    }
+  }
+  EXPECT_LE(off.front().y(), 1 + spacing);
+  EXPECT_GE(off.back().y(), 9 - spacing);
+  const auto out = s.segment_gaps({5, 5}, {11, 5}, tol, spacing);
+  ASSERT_FALSE(out.empty());
+  for (const auto& q : out) {
+    EXPECT_GT(q.x(), 10 + tol);
+    EXPECT_DOUBLE_EQ(q.y(), 5.0);
+  }
+  EXPECT_LE(out.front().x(), 10 + tol + spacing);
+  EXPECT_GE(out.back().x(), 11 - spacing);
+  EXPECT_THROW(s.segment_gaps({0, 0}, {1, 0}, tol, 0.0), std::invalid_argument);
+}
+
+TEST(AlphaShape2D, SegmentGapsAgreeWithDenseSamplingOnRaggedShapes) {
+  // Oracle: points every tol/4 along the segment, each tested by point location. A
+  // segment found gap-free has every such point within tol (plus the spacing) of the
+  // region; a gap point lies farther than tol; a segment with a point farther than
+  // tol + spacing has a gap. Random clouds with empty discs give notches, holes and
+  // islands; segments at random, and along the region's own boundary edges.
+  std::mt19937_64 rng(24);
+  for (int trial = 0; trial < 6; ++trial) {
+    std::uniform_real_distribution<double> u(-10.0, 10.0);
+    std::vector<Vec2> cloud;
+    const Vec2 c1(u(rng) * 0.5, u(rng) * 0.5), c2(u(rng) * 0.5, u(rng) * 0.5);
+    while (cloud.size() < 3000) {
+      const Vec2 p(u(rng), u(rng));
+      if ((p - c1).norm() > 2.0 && (p - c2).norm() > 1.2) cloud.push_back(p);
+    }
+    AlphaShape2D shape(cloud, 0.45);
+    const double tol = trial % 2 ? 1e-2 : 0.0;
+    std::vector<std::array<Vec2, 2>> segs;
+    for (int i = 0; i < 150; ++i) segs.push_back({Vec2(u(rng), u(rng)), Vec2(u(rng), u(rng))});
+    for (const auto& poly : shape.polygons())
+      for (std::size_t i = 0; i + 1 < poly.outer.size() && i < 60; ++i) segs.push_back({poly.outer[i], poly.outer[i + 1]});
+    int with_gaps = 0;
+    for (const auto& sg : segs) {
+      const auto gaps = shape.segment_gaps(sg[0], sg[1], tol, 0.1);
+      for (const auto& q : gaps) {
+        ASSERT_FALSE(shape.contains(q, tol * (1 - 1e-9))) << "trial " << trial << " gap point " << q.transpose();
+      }
+      const double len = (sg[1] - sg[0]).norm();
+      const double step = std::max(tol, 1e-3) / 4;
+      const int n = static_cast<int>(std::ceil(len / step));
+      bool far = false;
+      for (int k = 0; k <= n && !far; ++k) {
+        const Vec2 q = sg[0] + (sg[1] - sg[0]) * (static_cast<double>(k) / n);
+        far = !shape.contains(q, tol + step);
+      }
+      if (far) {
+        ASSERT_FALSE(gaps.empty()) << "trial " << trial << " segment " << sg[0].transpose() << " -> "
+                                   << sg[1].transpose();
+      }
+      with_gaps += gaps.empty() ? 0 : 1;
+    }
+    EXPECT_GT(with_gaps, 0);
+    EXPECT_LT(with_gaps, static_cast<int>(segs.size()));
+  }
+}
+
 TEST(AlphaShape2D, MergeCollinearKeepsCorners) {
   std::vector<Vec2> ring = {{0, 0}, {1, 0}, {2, 0}, {2, 0}, {2, 1}, {2, 2}, {0, 2}, {0, 1}};
   EXPECT_EQ(merge_collinear(ring, 1e-8), 4u);
@@ -930,6 +1007,38 @@ TEST(AlphaSim, LongBoxIsTwelveTriangles) {
   EXPECT_DOUBLE_EQ(sp.result.containment, 1.0);
 }
 
+TEST(AlphaSim, FacesSeenEdgeOnAreCheckedAsTheirEdges) {
+  // The long plate: in each plane the four faces along the normal (eight triangles) are
+  // seen edge-on and project onto the rectangle's four sides, one merged segment each.
+  Part web = make_part("web", box_mesh({0, 0, 0}, {1500, 6, 200}));
+  const auto sp = simplify_part(web, options(8.0));
+  ASSERT_EQ(sp.result.status, AlphaSimStatus::Ok) << sp.result.reason;
+  for (const auto& p : sp.result.projections) {
+    EXPECT_EQ(p.edge_on_triangles, 8u) << p.plane;
+    EXPECT_EQ(p.edge_on_segments, 4u) << p.plane;
+  }
+  // A faceted cylinder along x: its 48 side facets (96 triangles) are edge-on in the end
+  // view, each its own chord; the caps' 96 fan triangles in the two side views, one merged
+  // segment per cap. The result contains the original (oracle) with the segment checks
+  // and without them (the samples of those triangles tested instead).
+  Mesh cyl = cylinder_mesh(5.0, 20.0, 48);
+  for (auto& v : cyl.vertices) v = Vec3(v.z(), v.x(), v.y());  // along x
+  const Part c = make_part("cyl-x", cyl);
+  AlphaSimOptions sampled = options(1.0);
+  sampled.edge_on_segments = false;
+  for (const AlphaSimOptions& o : {options(1.0), sampled}) {
+    const auto r = simplify_part(c, o);
+    ASSERT_EQ(r.result.status, AlphaSimStatus::Ok) << r.result.reason;
+    for (const auto& p : r.result.projections) {
+      const bool end_view = std::abs(p.normal.x()) == 1.0;
+      EXPECT_EQ(p.edge_on_triangles, o.edge_on_segments ? 96u : 0u) << p.plane;
+      EXPECT_EQ(p.edge_on_segments, !o.edge_on_segments ? 0u : end_view ? 48u : 2u) << p.plane;
+    }
+    const auto samples = dense_surface_samples(c.mesh, 0.25, 4.0, 100000, 31);
+    EXPECT_DOUBLE_EQ(oracle_containment(r.mesh, samples, r.result.tolerance), 1.0);
+  }
+}
+
 TEST(AlphaSim, AbsorbedBoxPrismsGiveTheSolidOfEveryBoolean) {
   // A U-channel (rectangles from the side and the end: one prism left), the L-bracket
   // (a rectangle from two sides), a box (one box) and a cylinder across the axes (one
@@ -1073,8 +1182,11 @@ TEST(AlphaSim, VerificationRoundsRepairWhatTheFirstRepairMissed) {
   // contain an independent sample set.
   const char* rel = "trimesh/tube.obj";
   const Part p = make_part(rel, read_mesh_file(std::filesystem::path(LOOM_SHARED_DATA) / rel));
+  // Its facets along the axis, seen edge-on, are sampled like the others here: their
+  // exact segment checks (edge_on_segments) would repair those gaps before the rounds.
   AlphaSimOptions o = options(0.01 * p.mesh.bounds().diagonal());
   o.cover_samples = false;
+  o.edge_on_segments = false;
   const auto sp = simplify_part(p, o);
   ASSERT_EQ(sp.result.status, AlphaSimStatus::Ok) << sp.result.reason;
   EXPECT_GE(sp.result.repair_rounds, 1);
