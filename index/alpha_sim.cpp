@@ -169,6 +169,10 @@ std::vector<Vec3> dense_surface_samples(const Mesh& mesh, const std::vector<Mesh
     total += count[t];
   }
   const double scale = total > max_samples && total > 0 ? static_cast<double>(max_samples) / total : 1.0;
+  // The random points number at most total·scale + nt (each count rounded down, at least 1).
+  const std::size_t random_bound = static_cast<std::size_t>(static_cast<double>(total) * scale) + nt;
+  out.reserve(out.size() + random_bound + (fixed_points ? nt : 0));
+  if (source) source->reserve(out.capacity());
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> uni(0.0, 1.0);
   for (std::size_t t = 0; t < nt; ++t) {
