@@ -352,11 +352,13 @@ void AlphaShape2D::Impl::classify() {
   refresh();
 }
 
-std::size_t AlphaShape2D::refine(const std::vector<Vec2>& points, double tol) {
+std::size_t AlphaShape2D::refine(const std::vector<Vec2>& points, double tol, const std::vector<Vec2>& exact) {
   Impl& m = *impl_;
   std::vector<CPoint> add;
   for (const auto& p : points)
     if (!contains(p, tol)) add.emplace_back(p.x(), p.y());
+  for (const auto& p : exact)
+    if (!contains(p, 0.0)) add.emplace_back(p.x(), p.y());
   if (add.empty()) return 0;
   m.dt.insert(add.begin(), add.end());
   m.classify();

@@ -56,7 +56,9 @@ class AlphaShape2D {
   /// small triangles instead of the large ones cover() would add. Returns the number of
   /// points that were farther than tol (and inserted); 0: the region is unchanged and holds
   /// every point within tol, so cover() of the same points would only add vertex triangles.
-  std::size_t refine(const std::vector<Vec2>& points, double tol);
+  /// `exact` points are inserted unless they lie in the region (tolerance 0): points of
+  /// segment_gaps, whose segment must come within a smaller tolerance than tol.
+  std::size_t refine(const std::vector<Vec2>& points, double tol, const std::vector<Vec2>& exact = {});
   /// Keeps every finite Delaunay triangle: the region becomes the convex hull.
   void keep_all();
   /// Makes the region contain every triangulation vertex (an isolated one gets its incident

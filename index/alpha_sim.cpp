@@ -470,10 +470,11 @@ AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
 struct EdgeOnTriangles {
   std::vector<char> flag;                       ///< per triangle: 1 if seen edge-on
   std::vector<std::array<Vec2, 2>> segments;    ///< their longest projected edges, snapped, unique
+  std::vector<std::array<Vec2, 2>> thin_edges;  ///< edges of the thin others (sampled too), snapped, unique
 };
 
 /// Triangles whose projection in `pr` is narrower than `width` (twice its area over its
-/// longest edge). Such a projection lies within `width` of its longest edge (the foot of
+/// longest edge), and the edges of those narrower than `thin_width`. Such a projection lies within `width` of its longest edge (the foot of
 /// the opposite corner falls on that edge, whose end angles are at most 90°), so the
 /// region covering that edge within tol − width − snap covers every sample of the
 /// triangle within tol: one exact segment test (AlphaShape2D::segment_gaps) replaces the
@@ -481,7 +482,11 @@ struct EdgeOnTriangles {
 /// planes (~50–90% of a wing part's samples per plane), and their samples all fall on the
 /// outline, where each point test is slowest; hundreds of triangles along an extrusion
 /// share one segment.
-EdgeOnTriangles edge_on_triangles(const Mesh& mesh, const AlphaSimPrism& pr, double width, double snap) {
+/// A thin projection (a silhouette sliver of a curved surface, between lattice nodes) is
+/// not within tol of one edge: its samples are still tested, but its three edges are
+/// checked exactly too, so that the repair closes the whole sliver at once (random samples
+/// found such erosions one or two per round, and the bunny ended as three convex hulls).
+EdgeOnTriangles edge_on_triangles(const Mesh& mesh, const AlphaSimPrism& pr, double width, double thin_width, double snap) {
   EdgeOnTriangles out;
   out.flag.assign(mesh.triangles.size(), 0);
   auto snapped = [snap](const Vec2& q) { return Vec2(std::round(q.x() / snap) * snap, std::round(q.y() / snap) * snap); };
@@ -500,15 +505,26 @@ EdgeOnTriangles edge_on_triangles(const Mesh& mesh, const AlphaSimPrism& pr, dou
     }
     const Vec2 ab = q[1] - q[0], ac = q[2] - q[0];
     const double twice_area = std::abs(ab.x() * ac.y() - ab.y() * ac.x());
-    if (!(twice_area <= width * std::sqrt(l2))) continue;
+    if (!(twice_area <= width * std::sqrt(l2))) {
+      if (twice_area <= thin_width * std::sqrt(l2))
+        for (int e = 0; e < 3; ++e) {
+          Vec2 a = snapped(q[e]), b = snapped(q[(e + 1) % 3]);
+          if (b.x() < a.x() || (b.x() == a.x() && b.y() < a.y())) std::swap(a, b);
+          out.thin_edges.push_back({a, b});
+        }
+      continue;
+    }
     out.flag[t] = 1;
     Vec2 a = snapped(q[longest]), b = snapped(q[(longest + 1) % 3]);
     if (b.x() < a.x() || (b.x() == a.x() && b.y() < a.y())) std::swap(a, b);
     out.segments.push_back({a, b});
   }
-  std::sort(out.segments.begin(), out.segments.end(), [](const auto& x, const auto& y) {
+  auto less = [](const auto& x, const auto& y) {
     return std::tie(x[0].x(), x[0].y(), x[1].x(), x[1].y()) < std::tie(y[0].x(), y[0].y(), y[1].x(), y[1].y());
-  });
+  };
+  std::sort(out.thin_edges.begin(), out.thin_edges.end(), less);
+  out.thin_edges.erase(std::unique(out.thin_edges.begin(), out.thin_edges.end()), out.thin_edges.end());
+  std::sort(out.segments.begin(), out.segments.end(), less);
   out.segments.erase(std::unique(out.segments.begin(), out.segments.end()), out.segments.end());
   // Axis-parallel segments on one line (exact after snapping: a face along an axis seen
   // edge-on, cut into many triangles) are merged where they overlap or touch; the others
@@ -542,10 +558,11 @@ EdgeOnTriangles edge_on_triangles(const Mesh& mesh, const AlphaSimPrism& pr, dou
 /// AlphaShape2D::segment_gaps), spaced ≤ spacing.
 std::vector<Vec2> edge_on_gaps(const AlphaShape2D& shape, const EdgeOnTriangles& eo, double tol, double spacing) {
   std::vector<Vec2> gaps;
-  for (const auto& sg : eo.segments) {
-    const auto g = shape.segment_gaps(sg[0], sg[1], tol, spacing);
-    gaps.insert(gaps.end(), g.begin(), g.end());
-  }
+  for (const auto* list : {&eo.segments, &eo.thin_edges})
+    for (const auto& sg : *list) {
+      const auto g = shape.segment_gaps(sg[0], sg[1], tol, spacing);
+      gaps.insert(gaps.end(), g.begin(), g.end());
+    }
   return gaps;
 }
 
@@ -727,15 +744,19 @@ bool is_hull(ProjectionStatus s) {
   return s == ProjectionStatus::Empty || s == ProjectionStatus::Torn || s == ProjectionStatus::Eroded;
 }
 
-/// Densifies `shape` where it misses `checks` (refine), keeps the Delaunay triangles that
-/// still hold one (cover), and records the outcome in rep: Repaired, or Torn (replaced by
-/// the convex hull) when the added area exceeds torn_fraction of the region.
-void repair_projection(AlphaShape2D& shape, const std::vector<Vec2>& checks, double tol, double torn_fraction,
-                       ProjectionReport& rep) {
+/// Densifies `shape` where it misses `checks` by more than tol or `exact` at all (refine),
+/// keeps the Delaunay triangles that still hold one (cover), and records the outcome in
+/// rep: Repaired, or Torn (replaced by the convex hull) when the added area exceeds
+/// torn_fraction of the region. `exact` are gap points of segments checked within less
+/// than tol (edge_on_gaps): a gap point between that tolerance and tol must be covered
+/// too, or the same gap is found again.
+void repair_projection(AlphaShape2D& shape, const std::vector<Vec2>& checks, const std::vector<Vec2>& exact, double tol,
+                       double torn_fraction, ProjectionReport& rep) {
   // When refine finds no check outside, every one is within tol of the region already:
   // cover() then only has to attach isolated vertices (it need not test the checks again).
-  const bool changed = shape.refine(checks, tol) > 0;
-  const double added = shape.cover(changed ? checks : std::vector<Vec2>(), tol);
+  const bool changed = shape.refine(checks, tol, exact) > 0;
+  double added = shape.cover(changed ? checks : std::vector<Vec2>(), tol);
+  if (changed && !exact.empty()) added += shape.cover(exact, 0.0);
   if (added > torn_fraction * shape.area()) {
     rep.status = ProjectionStatus::Torn;
     shape.keep_all();
@@ -892,6 +913,9 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   std::vector<EdgeOnTriangles> edge_on(specs.size());
   // 1 while a plane's shape is unchanged since its edge-on segments were found covered.
   std::vector<char> edge_on_clean(specs.size(), 0);
+  // Gap points of the edge-on segments found so far, per plane: kept covered by every
+  // later repair (with the checks).
+  std::vector<std::vector<Vec2>> exact_checks(specs.size());
   tbb::parallel_for(std::size_t(0), specs.size(), [&](std::size_t k) {
     AlphaSimPrism pr = specs[k].frame;
     ProjectionReport& rep = r.projections[k];
@@ -918,7 +942,8 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       rep.status = ProjectionStatus::Empty;
       shape->keep_all();
     } else {
-      if (opt.edge_on_segments) edge_on[k] = edge_on_triangles(part.mesh, pr, edge_on_width, snap);
+      if (opt.edge_on_segments)
+        edge_on[k] = edge_on_triangles(part.mesh, pr, edge_on_width, opt.thin_edge_factor * r.l_max, snap);
       rep.edge_on_triangles = static_cast<std::size_t>(std::count(edge_on[k].flag.begin(), edge_on[k].flag.end(), 1));
       rep.edge_on_segments = edge_on[k].segments.size();
       const auto& eo = edge_on[k].flag;
@@ -926,15 +951,15 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       for (std::size_t i = 0; i < cover_samples.size(); ++i)
         if (eo.empty() || cover_source[i] == kNoTriangle || !eo[cover_source[i]])
           smp.checks.push_back(pr.project(cover_samples[i]));
-      repair_projection(*shape, smp.checks, tol, opt.torn_fraction, rep);
+      repair_projection(*shape, smp.checks, exact_checks[k], tol, opt.torn_fraction, rep);
       for (int pass = 0; pass < kEdgeOnRepairs && !is_hull(rep.status); ++pass) {
         const auto gaps = edge_on_gaps(*shape, edge_on[k], edge_on_tol, edge_on_gap_spacing);
         if (gaps.empty()) {
           edge_on_clean[k] = 1;
           break;
         }
-        smp.checks.insert(smp.checks.end(), gaps.begin(), gaps.end());
-        repair_projection(*shape, smp.checks, tol, opt.torn_fraction, rep);
+        exact_checks[k].insert(exact_checks[k].end(), gaps.begin(), gaps.end());
+        repair_projection(*shape, smp.checks, exact_checks[k], tol, opt.torn_fraction, rep);
       }
     }
     pr.shape = shape;
@@ -956,8 +981,8 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   std::vector<Vec3> samples;
   std::vector<std::uint32_t> sample_source;
   // Misses of the samples (a sample of a triangle seen edge-on is left to its segment)
-  // and the gaps of the edge-on segments, per plane.
-  auto plane_misses = [&](std::vector<std::vector<Vec2>>& missed) {
+  // and the gaps of the edge-on segments, per plane; returns the counts of both.
+  auto plane_misses = [&](std::vector<std::vector<Vec2>>& missed, std::vector<std::vector<Vec2>>& gapped) {
     std::vector<std::size_t> miss(specs.size(), 0);
     tbb::enumerable_thread_specific<std::vector<std::vector<Vec2>>> local_missed(
         [&] { return std::vector<std::vector<Vec2>>(specs.size()); });
@@ -972,9 +997,10 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
         }
     });
     missed.assign(specs.size(), {});
+    gapped.assign(specs.size(), {});
     tbb::parallel_for(std::size_t(0), specs.size(), [&](std::size_t k) {
-      if (!edge_on_clean[k]) missed[k] = edge_on_gaps(*prisms[k].shape, edge_on[k], edge_on_tol, edge_on_gap_spacing);
-      edge_on_clean[k] = missed[k].empty() ? 1 : 0;
+      if (!edge_on_clean[k]) gapped[k] = edge_on_gaps(*prisms[k].shape, edge_on[k], edge_on_tol, edge_on_gap_spacing);
+      edge_on_clean[k] = gapped[k].empty() ? 1 : 0;
     });
     for (auto& lm : local_missed)
       for (std::size_t k = 0; k < specs.size(); ++k) missed[k].insert(missed[k].end(), lm[k].begin(), lm[k].end());
@@ -982,7 +1008,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       // Deterministic order whatever the thread schedule.
       std::sort(missed[k].begin(), missed[k].end(),
                 [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
-      miss[k] = missed[k].size();
+      miss[k] = missed[k].size() + gapped[k].size();
     }
     return miss;
   };
@@ -993,8 +1019,8 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     samples = dense_surface_samples(part.mesh, edges, r.l_max, opt.containment_density, opt.containment_max_samples,
                                     opt.seed + 3 * static_cast<std::uint64_t>(round), !opt.cover_samples,
                                     &sample_source);
-    std::vector<std::vector<Vec2>> missed;
-    const auto miss = plane_misses(missed);
+    std::vector<std::vector<Vec2>> missed, gapped;
+    const auto miss = plane_misses(missed, gapped);
     bool any = false, hull_missed = false;
     for (std::size_t k = 0; k < specs.size(); ++k) {
       if (miss[k] == 0) continue;
@@ -1005,7 +1031,8 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       } else if (round < kRefineRounds) {
         auto& checks = plane_samples[k].checks;
         checks.insert(checks.end(), missed[k].begin(), missed[k].end());
-        repair_projection(*shapes[k], checks, tol, opt.torn_fraction, rep);
+        exact_checks[k].insert(exact_checks[k].end(), gapped[k].begin(), gapped[k].end());
+        repair_projection(*shapes[k], checks, exact_checks[k], tol, opt.torn_fraction, rep);
         edge_on_clean[k] = 0;
       } else {
         rep.status = ProjectionStatus::Eroded;

@@ -59,6 +59,11 @@ struct AlphaSimOptions {
   /// their random samples in that plane; false samples them like the others (the ablation
   /// and bench baseline: the path before the twenty-fourth session).
   bool edge_on_segments = true;
+  /// With edge_on_segments: the three edges of a triangle whose projection is narrower
+  /// than thin_edge_factor·L_max (a silhouette sliver) are checked exactly as well, and
+  /// their gaps repaired before the verification rounds (the triangle's samples are still
+  /// tested). 0: none.
+  double thin_edge_factor = 0.05;
   /// Most samples in one projection plane (memory bound, ~100 bytes per point).
   std::size_t max_cloud_points = 4000000;
   /// The boundary polygons that are extruded may grow the α-shape (never shrink it) by
