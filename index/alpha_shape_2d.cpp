@@ -528,7 +528,7 @@ std::vector<Vec2> AlphaShape2D::segment_gaps(const Vec2& a, const Vec2& b, doubl
   const FlagGrid& fg = m.flags;
   const double piece_len = std::min(m.tri_grid.cell, fg.nx > 0 ? fg.cell : m.tri_grid.cell);
   const int pieces = std::max(1, static_cast<int>(std::ceil(len / piece_len)));
-  std::vector<std::array<double, 2>> ranges;
+  std::vector<std::array<double, 2>> ranges, open;
   std::vector<std::uint32_t> ids;
   auto in_flagged_cells = [&](const Vec2& p, const Vec2& q) {
     if (fg.nx == 0) return false;
@@ -546,10 +546,10 @@ std::vector<Vec2> AlphaShape2D::segment_gaps(const Vec2& a, const Vec2& b, doubl
     const Vec2 pa = a + t0 * d, pb = piece + 1 == pieces ? b : a + t1 * d, pd = pb - pa;
     if (in_flagged_cells(pa, pb)) continue;
     // Covered parameter ranges of the piece (a candidate met twice only repeats its range):
-    // each kept triangle it crosses (closed, the
-    // relative slack of in_kept_triangle_slow, so that shared edges and vertices leave no
-    // crack), and each boundary edge's capsule of radius tol (R ⊕ tol = R ∪ (∂R ⊕ tol):
-    // the nearest point of R to a point outside it lies on ∂R).
+    // each kept triangle it crosses (closed, the relative slack of in_kept_triangle_slow,
+    // so that shared edges and vertices leave no crack), and, unless those cover it all,
+    // each boundary edge's capsule of radius tol (R ⊕ tol = R ∪ (∂R ⊕ tol): the nearest
+    // point of R to a point outside it lies on ∂R).
     ranges.clear();
     m.tri_grid.items_near_segment(pa, pb, 0.0, ids);
     for (std::uint32_t k : ids) {
@@ -565,6 +565,22 @@ std::vector<Vec2> AlphaShape2D::segment_gaps(const Vec2& a, const Vec2& b, doubl
       }
       if (lo <= hi) ranges.push_back({lo, hi});
     }
+    // The uncovered stretches of [0, 1] (relative length > 1e-12: shorter ones are rounding
+    // between two touching ranges).
+    auto uncovered = [&ranges](std::vector<std::array<double, 2>>& out) {
+      out.clear();
+      std::sort(ranges.begin(), ranges.end());
+      double covered = 0.0;  // [0, covered] is covered
+      for (const auto& r : ranges) {
+        if (r[1] < covered) continue;
+        if (r[0] > covered + 1e-12) out.push_back({covered, r[0]});
+        covered = std::max(covered, r[1]);
+        if (covered >= 1.0) break;
+      }
+      if (covered < 1.0 - 1e-12) out.push_back({covered, 1.0});
+    };
+    uncovered(open);
+    if (open.empty()) continue;
     if (tol > 0.0) {
       m.seg_grid.items_near_segment(pa, pb, tol, ids);
       for (std::uint32_t k : ids) {
@@ -586,23 +602,13 @@ std::vector<Vec2> AlphaShape2D::segment_gaps(const Vec2& a, const Vec2& b, doubl
         clip_half_plane(tol + na, tol + nb, 0.0, lo, hi);
         if (lo <= hi) ranges.push_back({lo, hi});
       }
+      uncovered(open);
     }
-    std::sort(ranges.begin(), ranges.end());
     const double plen = pd.norm();
-    auto gap = [&](double g0, double g1) {
-      // A stretch of relative length ≤ 1e-12 is rounding between two touching ranges.
-      if (g1 - g0 <= 1e-12) return;
-      const int n = std::max(1, static_cast<int>(std::ceil((g1 - g0) * plen / spacing)));
-      for (int i = 0; i < n; ++i) gaps.push_back(pa + (g0 + (i + 0.5) * (g1 - g0) / n) * pd);
-    };
-    double covered = 0.0;  // [0, covered] of the piece is covered
-    for (const auto& r : ranges) {
-      if (r[1] < covered) continue;
-      if (r[0] > covered) gap(covered, r[0]);
-      covered = std::max(covered, r[1]);
-      if (covered >= 1.0) break;
+    for (const auto& g : open) {
+      const int n = std::max(1, static_cast<int>(std::ceil((g[1] - g[0]) * plen / spacing)));
+      for (int i = 0; i < n; ++i) gaps.push_back(pa + (g[0] + (i + 0.5) * (g[1] - g[0]) / n) * pd);
     }
-    if (covered < 1.0) gap(covered, 1.0);
   }
   return gaps;
 }
