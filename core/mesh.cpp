@@ -94,9 +94,10 @@ std::size_t weld_identical_vertices(Mesh& mesh) {
 
 MeshTopology analyse_topology(const Mesh& mesh) {
   MeshTopology topo;
-  // Directed edge (a,b) keyed as 64-bit; count uses per undirected edge.
-  std::unordered_map<std::uint64_t, std::pair<int, int>> edges;  // (forward a<b count, backward count)
-  edges.reserve(mesh.triangles.size() * 2);
+  // Each triangle edge as (a << 32 | b with a < b, backward), sorted: the uses of one
+  // undirected edge form a run (a sort is faster than a hash map of the edges).
+  std::vector<std::pair<std::uint64_t, bool>> uses;
+  uses.reserve(mesh.triangles.size() * 3);
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     const auto& f = mesh.triangles[t];
     if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2]) {
@@ -106,19 +107,22 @@ MeshTopology analyse_topology(const Mesh& mesh) {
     const auto c = mesh.corners(t);
     if ((c[1] - c[0]).cross(c[2] - c[0]).squaredNorm() == 0.0) ++topo.degenerate_triangles;
     for (int k = 0; k < 3; ++k) {
-      std::uint32_t a = f[k], b = f[(k + 1) % 3];
-      const bool fwd = a < b;
-      if (!fwd) std::swap(a, b);
-      auto& e = edges[(static_cast<std::uint64_t>(a) << 32) | b];
-      (fwd ? e.first : e.second)++;
+      std::uint64_t a = f[k], b = f[(k + 1) % 3];
+      const bool backward = b < a;
+      if (backward) std::swap(a, b);
+      uses.emplace_back((a << 32) | b, backward);
     }
   }
-  for (const auto& [key, c] : edges) {
-    (void)key;
-    const int n = c.first + c.second;
+  std::sort(uses.begin(), uses.end());
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i;
+    int forward = 0;
+    for (; j < uses.size() && uses[j].first == uses[i].first; ++j) forward += uses[j].second ? 0 : 1;
+    const std::size_t n = j - i;
     if (n == 1) ++topo.boundary_edges;
     else if (n > 2) ++topo.nonmanifold_edges;
-    else if (c.first != 1) ++topo.misoriented_edges;
+    else if (forward != 1) ++topo.misoriented_edges;
+    i = j;
   }
   topo.closed = !mesh.triangles.empty() && topo.boundary_edges == 0 && topo.nonmanifold_edges == 0 &&
                 topo.misoriented_edges == 0;
