@@ -554,11 +554,13 @@ EdgeOnTriangles edge_on_triangles(const Mesh& mesh, const AlphaSimPrism& pr, dou
   return out;
 }
 
-/// The points of the edge-on segments that `shape` leaves farther than tol (see
-/// AlphaShape2D::segment_gaps), spaced ≤ spacing.
-std::vector<Vec2> edge_on_gaps(const AlphaShape2D& shape, const EdgeOnTriangles& eo, double tol, double spacing) {
+/// The points of the edge-on segments that `shape` leaves farther than segment_tol, and of
+/// the thin triangles' edges farther than thin_tol (see AlphaShape2D::segment_gaps), spaced
+/// ≤ spacing.
+std::vector<Vec2> edge_on_gaps(const AlphaShape2D& shape, const EdgeOnTriangles& eo, double segment_tol,
+                               double thin_tol, double spacing) {
   std::vector<Vec2> gaps;
-  for (const auto* list : {&eo.segments, &eo.thin_edges})
+  for (const auto& [list, tol] : {std::make_pair(&eo.segments, segment_tol), std::make_pair(&eo.thin_edges, thin_tol)})
     for (const auto& sg : *list) {
       const auto g = shape.segment_gaps(sg[0], sg[1], tol, spacing);
       gaps.insert(gaps.end(), g.begin(), g.end());
@@ -906,6 +908,8 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   // their longest edge within edge_on_tol instead of by samples (edge_on_triangles):
   // width + snap·√2/2 + edge_on_tol ≤ (1/4 + 0.18 + 1/2)·tol keeps their samples within tol.
   const double edge_on_width = tol / 4.0, edge_on_tol = tol / 2.0;
+  // A thin triangle's edges are checked like its samples, within tol, less their snapping.
+  const double thin_edge_tol = tol - snap * M_SQRT1_2;
   // Spacing of the points a gap of an edge-on segment adds to the checks.
   const double edge_on_gap_spacing = r.l_max / 4.0;
   // Repairs of the gaps of the edge-on segments before the verification rounds.
@@ -953,7 +957,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
           smp.checks.push_back(pr.project(cover_samples[i]));
       repair_projection(*shape, smp.checks, exact_checks[k], tol, opt.torn_fraction, rep);
       for (int pass = 0; pass < kEdgeOnRepairs && !is_hull(rep.status); ++pass) {
-        const auto gaps = edge_on_gaps(*shape, edge_on[k], edge_on_tol, edge_on_gap_spacing);
+        const auto gaps = edge_on_gaps(*shape, edge_on[k], edge_on_tol, thin_edge_tol, edge_on_gap_spacing);
         if (gaps.empty()) {
           edge_on_clean[k] = 1;
           break;
@@ -999,7 +1003,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     missed.assign(specs.size(), {});
     gapped.assign(specs.size(), {});
     tbb::parallel_for(std::size_t(0), specs.size(), [&](std::size_t k) {
-      if (!edge_on_clean[k]) gapped[k] = edge_on_gaps(*prisms[k].shape, edge_on[k], edge_on_tol, edge_on_gap_spacing);
+      if (!edge_on_clean[k]) gapped[k] = edge_on_gaps(*prisms[k].shape, edge_on[k], edge_on_tol, thin_edge_tol, edge_on_gap_spacing);
       edge_on_clean[k] = gapped[k].empty() ? 1 : 0;
     });
     for (auto& lm : local_missed)
