@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <numeric>
 #include <set>
 #include <stdexcept>
@@ -101,71 +102,42 @@ FaceVertexMerge merge_face_vertices(FacedMesh& m, double tol) {
   std::vector<std::vector<std::uint32_t>> members(nt);
   for (std::uint32_t t = 0; t < nt; ++t) members[face_id[t]].push_back(t);
   std::vector<char> removable(nv, 0), redo(nt, 0);
-  // True if the boundary of the face made of `face`'s triangles uses a vertex twice or has
-  // two vertices at one point.
-  auto self_touching = [&](const std::vector<std::uint32_t>& face) {
-    const std::size_t r = face_id[face.front()];
-    std::set<std::uint32_t> starts;
-    std::set<std::tuple<double, double, double>> at;
-    for (std::uint32_t f : face)
-      for (int e = 0; e < 3; ++e) {
-        const std::uint32_t a = T[f][e], b = T[f][(e + 1) % 3];
-        if (face_id[across(a, b)] == r) continue;
-        if (!starts.insert(a).second || !at.emplace(V[a].x(), V[a].y(), V[a].z()).second) return true;
-      }
-    return false;
+  for (std::uint32_t v = 0; v < nv; ++v) removable[v] = candidate[v];
+  // Crease candidates in chains between kept vertices: Douglas–Peucker along each.
+  // walk(v, nb): the vertices from v's neighbour nb along the crease line up to the first
+  // kept one (included), or back to v (a closed chain: v is the last entry).
+  auto walk = [&](std::uint32_t v, std::uint32_t nb) {
+    std::vector<std::uint32_t> path{nb};
+    std::uint32_t prev = v, cur = nb;
+    while (cur != v && removable[cur] && !interior[cur]) {
+      const std::uint32_t next = crease[cur][0] == prev ? crease[cur][1] : crease[cur][0];
+      prev = cur;
+      cur = next;
+      path.push_back(cur);
+    }
+    return path;
   };
-  // A face whose boundary touches itself (a vertex used twice, or two vertices at one
-  // point: corefinement's copies of a vertex where pieces meet) cannot be re-triangulated
-  // from boundary loops: such faces keep their triangles and all their vertices, and the
-  // removals are decided again without those vertices.
-  std::vector<char> forced(nv, 0);
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (std::uint32_t v = 0; v < nv; ++v) removable[v] = candidate[v] && !forced[v];
-    // Crease candidates in chains between kept vertices: Douglas–Peucker along each.
-    // walk(v, nb): the vertices from v's neighbour nb along the crease line up to the first
-    // kept one (included), or back to v (a closed chain: v is the last entry).
-    auto walk = [&](std::uint32_t v, std::uint32_t nb) {
-      std::vector<std::uint32_t> path{nb};
-      std::uint32_t prev = v, cur = nb;
-      while (cur != v && removable[cur] && !interior[cur]) {
-        const std::uint32_t next = crease[cur][0] == prev ? crease[cur][1] : crease[cur][0];
-        prev = cur;
-        cur = next;
-        path.push_back(cur);
-      }
-      return path;
-    };
-    std::vector<char> seen(nv, 0);
-    for (std::uint32_t v = 0; v < nv; ++v) {
-      if (!removable[v] || interior[v] || seen[v]) continue;
-      std::vector<std::uint32_t> chain;
-      const std::vector<std::uint32_t> one = walk(v, crease[v][0]);
-      if (one.back() == v) {
-        removable[v] = 0;  // a closed chain: v is kept, as both its ends
-        chain.push_back(v);
-        chain.insert(chain.end(), one.begin(), one.end());
-      } else {
-        const std::vector<std::uint32_t> other = walk(v, crease[v][1]);
-        chain.assign(other.rbegin(), other.rend());
-        chain.push_back(v);
-        chain.insert(chain.end(), one.begin(), one.end());
-      }
-      for (std::uint32_t k : chain) seen[k] = 1;
-      keep_far_vertices(V, chain, 0, chain.size() - 1, tol, removable);
+  std::vector<char> seen(nv, 0);
+  for (std::uint32_t v = 0; v < nv; ++v) {
+    if (!removable[v] || interior[v] || seen[v]) continue;
+    std::vector<std::uint32_t> chain;
+    const std::vector<std::uint32_t> one = walk(v, crease[v][0]);
+    if (one.back() == v) {
+      removable[v] = 0;  // a closed chain: v is kept, as both its ends
+      chain.push_back(v);
+      chain.insert(chain.end(), one.begin(), one.end());
+    } else {
+      const std::vector<std::uint32_t> other = walk(v, crease[v][1]);
+      chain.assign(other.rbegin(), other.rend());
+      chain.push_back(v);
+      chain.insert(chain.end(), one.begin(), one.end());
     }
-    std::fill(redo.begin(), redo.end(), 0);
-    for (std::uint32_t t = 0; t < nt; ++t)
-      for (int e = 0; e < 3; ++e)
-        if (removable[T[t][e]]) redo[face_id[t]] = 1;
-    for (std::size_t r = 0; r < nt; ++r) {
-      if (!redo[r] || !self_touching(members[r])) continue;
-      for (std::uint32_t f : members[r])
-        for (std::uint32_t k : T[f]) forced[k] = 1;
-      changed = true;
-    }
+    for (std::uint32_t k : chain) seen[k] = 1;
+    keep_far_vertices(V, chain, 0, chain.size() - 1, tol, removable);
   }
+  for (std::uint32_t t = 0; t < nt; ++t)
+    for (int e = 0; e < 3; ++e)
+      if (removable[T[t][e]]) redo[face_id[t]] = 1;
 
   FaceVertexMerge result;
   for (std::uint32_t v = 0; v < nv; ++v)
@@ -201,55 +173,49 @@ FaceVertexMerge merge_face_vertices(FacedMesh& m, double tol) {
     for (std::uint32_t f : face)
       for (std::uint32_t k : T[f])
         if (std::abs((V[k] - c).dot(n)) > tol) throw failure("a face is not planar within the tolerance");
-    // Boundary loops: edges whose neighbour is in another face, chained head to tail.
-    std::unordered_map<std::uint32_t, std::uint32_t> next_of;
+    // Boundary: the directed edges whose neighbour is in another face. From each kept
+    // vertex the boundary runs through removed vertices (each has one boundary edge out of
+    // it in this face: it lies on one crease line or inside) to the next kept one, and that
+    // chord is a constraint of the triangulation. A boundary that touches itself (a vertex
+    // used twice, or corefinement's copies of a vertex at one point, which become one
+    // point) needs no loops: the triangulation takes the region from its constraints.
+    Vec3 u = n.unitOrthogonal();
+    const Vec3 w = n.cross(u);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> boundary;
+    std::unordered_map<std::uint32_t, std::uint32_t> out_of;  // removed vertex → next on the boundary
+    double perimeter = 0.0;
     for (std::uint32_t f : face)
       for (int e = 0; e < 3; ++e) {
         const std::uint32_t a = T[f][e], b = T[f][(e + 1) % 3];
         if (face_id[across(a, b)] == r) continue;
-        if (!next_of.emplace(a, b).second) throw failure("a face touches itself at a vertex");
+        boundary.emplace_back(a, b);
+        perimeter += (V[b] - V[a]).norm();
+        if (removable[a] && !out_of.emplace(a, b).second) throw failure("a face's boundary passes a removed vertex twice");
       }
-    Vec3 u = n.unitOrthogonal();
-    const Vec3 w = n.cross(u);
     std::vector<Vec2> points;
     std::vector<std::uint32_t> global;
-    std::vector<std::vector<int>> rings;
-    std::set<std::pair<double, double>> distinct;
-    double perimeter = 0.0;
-    std::set<std::uint32_t> done;
-    for (const auto& [first, unused] : next_of) {
-      (void)unused;
-      if (done.count(first)) continue;
-      std::vector<int> ring;
-      std::uint32_t a = first;
-      do {
-        done.insert(a);
-        const auto it = next_of.find(a);
-        if (it == next_of.end()) throw failure("a face boundary is not closed");
-        perimeter += (V[it->second] - V[a]).norm();
-        if (!removable[a]) {
-          const Vec2 q((V[a] - c).dot(u), (V[a] - c).dot(w));
-          if (!distinct.emplace(q.x(), q.y()).second) throw failure("two boundary vertices of a face coincide in its plane");
-          ring.push_back(static_cast<int>(points.size()));
-          points.push_back(q);
-          global.push_back(a);
-        }
-        a = it->second;
-      } while (a != first);
-      if (ring.size() < 3) throw failure("a boundary loop keeps fewer than three vertices");
-      rings.push_back(std::move(ring));
+    std::map<std::pair<double, double>, int> index_at;  // one index per point of the plane
+    auto index_of = [&](std::uint32_t g) {
+      const Vec2 q((V[g] - c).dot(u), (V[g] - c).dot(w));
+      const auto [it, added] = index_at.emplace(std::make_pair(q.x(), q.y()), static_cast<int>(points.size()));
+      if (added) {
+        points.push_back(q);
+        global.push_back(g);
+      }
+      return it->second;
+    };
+    std::vector<std::vector<int>> sorted_rings;  // chords as two-point rings, in boundary order
+    for (const auto& [a, b] : boundary) {
+      if (removable[a]) continue;
+      std::uint32_t z = b;
+      for (std::size_t steps = 0; removable[z]; ++steps) {
+        const auto it = out_of.find(z);
+        if (it == out_of.end() || steps > boundary.size()) throw failure("a face boundary is not closed");
+        z = it->second;
+      }
+      const int ia = index_of(a), iz = index_of(z);
+      if (ia != iz) sorted_rings.push_back({ia, iz});
     }
-    // The walk above follows next_of's hash order: sort the rings by their first global
-    // vertex so that the triangulation is the same on every run.
-    std::vector<std::size_t> ring_order(rings.size());
-    std::iota(ring_order.begin(), ring_order.end(), std::size_t(0));
-    for (auto& ring : rings) std::rotate(ring.begin(), std::min_element(ring.begin(), ring.end(),
-                                                                          [&](int x, int y) { return global[x] < global[y]; }),
-                                          ring.end());
-    std::sort(ring_order.begin(), ring_order.end(),
-              [&](std::size_t x, std::size_t y) { return global[rings[x][0]] < global[rings[y][0]]; });
-    std::vector<std::vector<int>> sorted_rings;
-    for (std::size_t k : ring_order) sorted_rings.push_back(rings[k]);
     std::vector<std::array<int, 3>> cap;
     try {
       cap = triangulate_rings(points, sorted_rings);
