@@ -60,9 +60,9 @@ struct AlphaSimOptions {
   /// and bench baseline: the path before the twenty-fourth session).
   bool edge_on_segments = true;
   /// With edge_on_segments: the three edges of a triangle whose projection is narrower
-  /// than thin_edge_factor·L_max (a silhouette sliver) are checked exactly as well, and
-  /// their gaps repaired before the verification rounds (the triangle's samples are still
-  /// tested). 0: none.
+  /// than thin_edge_factor·L_max (a silhouette sliver) are checked exactly as well, from
+  /// the first verification round in which the plane's samples miss, and their gaps
+  /// repaired with those misses (the triangle's samples are still tested). 0: none.
   double thin_edge_factor = 0.05;
   /// Most samples in one projection plane (memory bound, ~100 bytes per point).
   std::size_t max_cloud_points = 4000000;

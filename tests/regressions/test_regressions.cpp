@@ -243,7 +243,9 @@ TEST(Regression, AlphaSimMeshHoldsTheImplicitSolidOfTwoTurnedBoxes) {
 // silhouette triangles (seen nearly edge-on) project to between the lattice nodes; each
 // repair closed the points found, the next round found others, and after three rounds
 // the plane became its hull. The slivers' edges are now checked exactly (segment_gaps)
-// and closed before the rounds (AlphaSimOptions::thin_edge_factor).
+// and closed in the first repair of a plane's sample misses
+// (AlphaSimOptions::thin_edge_factor), and a plane becomes its hull only after three
+// repairs of its own (the rounds were counted for all planes together).
 TEST(Regression, AlphaSimBunnyIsNotThreeConvexHulls) {
   loom::Part bunny;
   bunny.name = "bunny";
@@ -252,7 +254,7 @@ TEST(Regression, AlphaSimBunnyIsNotThreeConvexHulls) {
   o.dim_pre = 0.02 * bunny.mesh.bounds().diagonal();
   const loom::AlphaSimPart sp = loom::simplify_part(bunny, o);
   EXPECT_EQ(sp.result.status, loom::AlphaSimStatus::Ok) << sp.result.reason;
-  EXPECT_EQ(sp.result.repair_rounds, 0);
+  EXPECT_LE(sp.result.repair_rounds, 3);
   for (const auto& p : sp.result.projections) {
     EXPECT_NE(p.status, loom::ProjectionStatus::Eroded) << p.plane;
     EXPECT_LT(p.area, p.hull_area) << p.plane;  // not the hull
