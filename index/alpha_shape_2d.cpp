@@ -41,6 +41,17 @@ double point_segment_distance(const Vec2& p, const Vec2& a, const Vec2& b) {
   return (a + t * ab - p).norm();
 }
 
+/// The x-range of the part of segment ab with y in [s0, s1] (both within ab's y-range),
+/// widened by err where the slab cuts the segment (the interpolation's rounding).
+std::array<double, 2> slab_x_range(const Vec2& a, const Vec2& b, double s0, double s1, double err) {
+  const double ymin = std::min(a.y(), b.y()), ymax = std::max(a.y(), b.y());
+  const double xmin = std::min(a.x(), b.x()), xmax = std::max(a.x(), b.x());
+  if (!(s0 > ymin || s1 < ymax)) return {xmin, xmax};
+  const double dx = b.x() - a.x(), dy = b.y() - a.y();
+  const double xa = a.x() + dx * ((s0 - a.y()) / dy), xb = a.x() + dx * ((s1 - a.y()) / dy);
+  return {std::max(xmin, std::min(xa, xb) - err), std::min(xmax, std::max(xa, xb) + err)};
+}
+
 /// Uniform bucket grid over triangles and segments (CSR storage).
 struct BucketGrid {
   Vec2 origin = Vec2::Zero();
@@ -92,17 +103,10 @@ struct BucketGrid {
     out.clear();
     if (empty()) return;
     const double ymin = std::min(a.y(), b.y()), ymax = std::max(a.y(), b.y());
-    const double xmin = std::min(a.x(), b.x()), xmax = std::max(a.x(), b.x());
-    const double dx = b.x() - a.x(), dy = b.y() - a.y();
     for (int j = cy(ymin - pad), j1 = cy(ymax + pad); j <= j1; ++j) {
       const double s0 = std::clamp(origin.y() + j * cell - pad, ymin, ymax);
       const double s1 = std::clamp(origin.y() + (j + 1) * cell + pad, ymin, ymax);
-      double xl = xmin, xr = xmax;
-      if (s0 > ymin || s1 < ymax) {  // the slab cuts the segment: its x-range there
-        const double xa = a.x() + dx * ((s0 - a.y()) / dy), xb = a.x() + dx * ((s1 - a.y()) / dy);
-        xl = std::max(xmin, std::min(xa, xb));
-        xr = std::min(xmax, std::max(xa, xb));
-      }
+      const auto [xl, xr] = slab_x_range(a, b, s0, s1, 0.0);
       // One more cell each side: the cell index of a rounded x may be one off.
       for (int i = std::max(0, cx(xl - pad) - 1), i1 = std::min(nx - 1, cx(xr + pad) + 1); i <= i1; ++i)
         for_cell(i, j, [&](std::uint32_t k) { out.push_back(k); });
@@ -137,6 +141,17 @@ struct FlagGrid {
     const double fx = (p.x() - origin.x()) / cell, fy = (p.y() - origin.y()) / cell;
     if (!(fx >= 0.0 && fy >= 0.0 && fx < nx && fy < ny)) return false;  // also NaN
     return inside_cell[static_cast<std::size_t>(fy) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(fx)] != 0;
+  }
+  /// True if every cell that the box lo..hi meets is flagged (the box lies in R).
+  bool box_inside(const Vec2& lo, const Vec2& hi) const {
+    if (nx == 0) return false;
+    const double fx0 = (lo.x() - origin.x()) / cell, fy0 = (lo.y() - origin.y()) / cell;
+    const double fx1 = (hi.x() - origin.x()) / cell, fy1 = (hi.y() - origin.y()) / cell;
+    if (!(fx0 >= 0.0 && fy0 >= 0.0 && fx1 < nx && fy1 < ny)) return false;  // also NaN
+    for (int j = static_cast<int>(fy0); j <= static_cast<int>(fy1); ++j)
+      for (int i = static_cast<int>(fx0); i <= static_cast<int>(fx1); ++i)
+        if (!inside_cell[static_cast<std::size_t>(j) * nx + i]) return false;
+    return true;
   }
 };
 
@@ -292,19 +307,14 @@ void AlphaShape2D::Impl::build_flags(const Vec2& lo, const Vec2& hi) {
   for (const auto& sgm : segments) {
     const Vec2 a = sgm[0], b = sgm[1];
     const double ymin = std::min(a.y(), b.y()), ymax = std::max(a.y(), b.y());
-    const double xmin = std::min(a.x(), b.x()), xmax = std::max(a.x(), b.x());
     const double dx = b.x() - a.x(), dy = b.y() - a.y();
+    // Rounding of the interpolated x (only used where the slab cuts the segment, dy ≠ 0).
+    const double err = dy != 0.0 ? std::abs(dx) * 4.0 * eps * magnitude / std::abs(dy) + 4.0 * eps * magnitude : 0.0;
     const int j0 = index(ymin - pad, g.origin.y(), g.ny), j1 = index(ymax + pad, g.origin.y(), g.ny);
     for (int j = j0; j <= j1; ++j) {
       const double s0 = std::clamp(g.origin.y() + j * cell - pad, ymin, ymax);
       const double s1 = std::clamp(g.origin.y() + (j + 1) * cell + pad, ymin, ymax);
-      double xl = xmin, xr = xmax;
-      if (s0 > ymin || s1 < ymax) {  // the slab cuts the segment: interpolate
-        const double xa = a.x() + dx * ((s0 - a.y()) / dy), xb = a.x() + dx * ((s1 - a.y()) / dy);
-        const double err = std::abs(dx) * 4.0 * eps * magnitude / std::abs(dy) + 4.0 * eps * magnitude;
-        xl = std::max(xmin, std::min(xa, xb) - err);
-        xr = std::min(xmax, std::max(xa, xb) + err);
-      }
+      const auto [xl, xr] = slab_x_range(a, b, s0, s1, err);
       const int i0 = index(xl - pad, g.origin.x(), g.nx), i1 = index(xr + pad, g.origin.x(), g.nx);
       std::fill(touched.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(j) * g.nx + i0),
                 touched.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(j) * g.nx + i1 + 1), 1);
@@ -499,6 +509,14 @@ void clip_half_plane(double f0, double f1, double slack, double& lo, double& hi)
     hi = std::min(hi, t);
 }
 
+/// Appends the centres of n equal pieces of the stretch a + t·d, t in [t0, t1], n the
+/// fewest that keep them ≤ spacing apart (len = |d|).
+void stretch_points(const Vec2& a, const Vec2& d, double len, double t0, double t1, double spacing,
+                    std::vector<Vec2>& out) {
+  const int n = std::max(1, static_cast<int>(std::ceil((t1 - t0) * len / spacing)));
+  for (int i = 0; i < n; ++i) out.push_back(a + (t0 + (i + 0.5) * (t1 - t0) / n) * d);
+}
+
 /// The t where |a + t·d − c| ≤ r, or an empty range (lo > hi).
 std::array<double, 2> disc_range(const Vec2& a, const Vec2& d, const Vec2& c, double r) {
   const Vec2 w = a - c;
@@ -519,8 +537,7 @@ std::vector<Vec2> AlphaShape2D::segment_gaps(const Vec2& a, const Vec2& b, doubl
   if (!(len > 0.0)) return contains(a, tol) ? std::vector<Vec2>() : std::vector<Vec2>{a};
   std::vector<Vec2> gaps;
   if (m.tri_grid.empty()) {  // no region: all of ab is one gap
-    const int n = std::max(1, static_cast<int>(std::ceil(len / spacing)));
-    for (int i = 0; i < n; ++i) gaps.push_back(a + ((i + 0.5) / n) * d);
+    stretch_points(a, d, len, 0.0, 1.0, spacing, gaps);
     return gaps;
   }
   // Pieces no longer than a cell of the grids, so that each gathers a few candidates; a
@@ -530,21 +547,10 @@ std::vector<Vec2> AlphaShape2D::segment_gaps(const Vec2& a, const Vec2& b, doubl
   const int pieces = std::max(1, static_cast<int>(std::ceil(len / piece_len)));
   std::vector<std::array<double, 2>> ranges, open;
   std::vector<std::uint32_t> ids;
-  auto in_flagged_cells = [&](const Vec2& p, const Vec2& q) {
-    if (fg.nx == 0) return false;
-    const Vec2 lo = p.cwiseMin(q), hi = p.cwiseMax(q);
-    const double fx0 = (lo.x() - fg.origin.x()) / fg.cell, fy0 = (lo.y() - fg.origin.y()) / fg.cell;
-    const double fx1 = (hi.x() - fg.origin.x()) / fg.cell, fy1 = (hi.y() - fg.origin.y()) / fg.cell;
-    if (!(fx0 >= 0.0 && fy0 >= 0.0 && fx1 < fg.nx && fy1 < fg.ny)) return false;
-    for (int j = static_cast<int>(fy0); j <= static_cast<int>(fy1); ++j)
-      for (int i = static_cast<int>(fx0); i <= static_cast<int>(fx1); ++i)
-        if (!fg.inside_cell[static_cast<std::size_t>(j) * fg.nx + i]) return false;
-    return true;
-  };
   for (int piece = 0; piece < pieces; ++piece) {
     const double t0 = static_cast<double>(piece) / pieces, t1 = static_cast<double>(piece + 1) / pieces;
     const Vec2 pa = a + t0 * d, pb = piece + 1 == pieces ? b : a + t1 * d, pd = pb - pa;
-    if (in_flagged_cells(pa, pb)) continue;
+    if (fg.box_inside(pa.cwiseMin(pb), pa.cwiseMax(pb))) continue;
     // Covered parameter ranges of the piece (a candidate met twice only repeats its range):
     // each kept triangle it crosses (closed, the relative slack of in_kept_triangle_slow,
     // so that shared edges and vertices leave no crack), and, unless those cover it all,
@@ -604,11 +610,7 @@ std::vector<Vec2> AlphaShape2D::segment_gaps(const Vec2& a, const Vec2& b, doubl
       }
       uncovered(open);
     }
-    const double plen = pd.norm();
-    for (const auto& g : open) {
-      const int n = std::max(1, static_cast<int>(std::ceil((g[1] - g[0]) * plen / spacing)));
-      for (int i = 0; i < n; ++i) gaps.push_back(pa + (g[0] + (i + 0.5) * (g[1] - g[0]) / n) * pd);
-    }
+    for (const auto& g : open) stretch_points(pa, pd, pd.norm(), g[0], g[1], spacing, gaps);
   }
   return gaps;
 }

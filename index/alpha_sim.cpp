@@ -388,11 +388,16 @@ void merge_unique(std::vector<Vec2>& sorted, const std::vector<Vec2>& more) {
 /// lattice cells inside each triangle and its centroid.
 /// Coordinates are snapped to the grid `snap`; points and checks are sorted and unique.
 /// lattice_bitmap = false sorts every point (no LatticeBitmap): the same sets, slower.
+/// q moved to the nearest point of the grid of spacing `snap` (plane coordinates).
+Vec2 snap_to_grid(const Vec2& q, double snap) {
+  return Vec2(std::round(q.x() / snap) * snap, std::round(q.y() / snap) * snap);
+}
+
 AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
                                        const std::vector<MeshEdge>& edges,
                                        const AlphaSimPrism& pr, double l_max, double snap, bool lattice_bitmap) {
   AlphaSimPlaneSamples s;
-  auto snapped = [snap](const Vec2& q) { return Vec2(std::round(q.x() / snap) * snap, std::round(q.y() / snap) * snap); };
+  auto snapped = [snap](const Vec2& q) { return snap_to_grid(q, snap); };
   std::vector<Vec2> proj(mesh.vertices.size());
   std::vector<char> used(mesh.vertices.size(), 0);
   for (const auto& f : mesh.triangles)
@@ -477,8 +482,9 @@ struct EdgeOnTriangles {
 };
 
 /// Triangles whose projection in `pr` is narrower than `width` (twice its area over its
-/// longest edge), and the edges of those narrower than `thin_width`. Such a projection lies within `width` of its longest edge (the foot of
-/// the opposite corner falls on that edge, whose end angles are at most 90°), so the
+/// longest edge), and the edges of those narrower than `thin_width`. Such a projection
+/// lies within `width` of its longest edge (the foot of the opposite corner falls on that
+/// edge, whose end angles are at most 90°), so the
 /// region covering that edge within tol − width − snap covers every sample of the
 /// triangle within tol: one exact segment test (AlphaShape2D::segment_gaps) replaces the
 /// random samples. A CAD part's faces along an axis are seen edge-on by the other two
@@ -494,7 +500,12 @@ struct EdgeOnTriangles {
 EdgeOnTriangles edge_on_triangles(const Mesh& mesh, const AlphaSimPrism& pr, double width, double thin_width, double snap) {
   EdgeOnTriangles out;
   out.flag.assign(mesh.triangles.size(), 0);
-  auto snapped = [snap](const Vec2& q) { return Vec2(std::round(q.x() / snap) * snap, std::round(q.y() / snap) * snap); };
+  // The segment pq snapped, ends in lexicographic order (so that equal segments compare equal).
+  auto snapped_segment = [snap](const Vec2& p, const Vec2& q) {
+    Vec2 a = snap_to_grid(p, snap), b = snap_to_grid(q, snap);
+    if (b.x() < a.x() || (b.x() == a.x() && b.y() < a.y())) std::swap(a, b);
+    return std::array<Vec2, 2>{a, b};
+  };
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     const auto& f = mesh.triangles[t];
     const std::array<Vec2, 3> q = {pr.project(mesh.vertices[f[0]]), pr.project(mesh.vertices[f[1]]),
@@ -512,17 +523,11 @@ EdgeOnTriangles edge_on_triangles(const Mesh& mesh, const AlphaSimPrism& pr, dou
     const double twice_area = std::abs(ab.x() * ac.y() - ab.y() * ac.x());
     if (!(twice_area <= width * std::sqrt(l2))) {
       if (twice_area <= thin_width * std::sqrt(l2))
-        for (int e = 0; e < 3; ++e) {
-          Vec2 a = snapped(q[e]), b = snapped(q[(e + 1) % 3]);
-          if (b.x() < a.x() || (b.x() == a.x() && b.y() < a.y())) std::swap(a, b);
-          out.thin_edges.push_back({a, b});
-        }
+        for (int e = 0; e < 3; ++e) out.thin_edges.push_back(snapped_segment(q[e], q[(e + 1) % 3]));
       continue;
     }
     out.flag[t] = 1;
-    Vec2 a = snapped(q[longest]), b = snapped(q[(longest + 1) % 3]);
-    if (b.x() < a.x() || (b.x() == a.x() && b.y() < a.y())) std::swap(a, b);
-    out.segments.push_back({a, b});
+    out.segments.push_back(snapped_segment(q[longest], q[(longest + 1) % 3]));
   }
   auto less = [](const auto& x, const auto& y) {
     return std::tie(x[0].x(), x[0].y(), x[1].x(), x[1].y()) < std::tie(y[0].x(), y[0].y(), y[1].x(), y[1].y());

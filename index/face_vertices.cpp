@@ -6,11 +6,8 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
-#include <numeric>
-#include <set>
 #include <stdexcept>
 #include <string>
-#include <tuple>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -204,7 +201,7 @@ FaceVertexMerge merge_face_vertices(FacedMesh& m, double tol) {
       }
       return it->second;
     };
-    std::vector<std::vector<int>> sorted_rings;  // chords as two-point rings, in boundary order
+    std::vector<std::vector<int>> chords;  // chords as two-point rings, in boundary order
     for (const auto& [a, b] : boundary) {
       if (removable[a]) continue;
       std::uint32_t z = b;
@@ -214,11 +211,11 @@ FaceVertexMerge merge_face_vertices(FacedMesh& m, double tol) {
         z = it->second;
       }
       const int ia = index_of(a), iz = index_of(z);
-      if (ia != iz) sorted_rings.push_back({ia, iz});
+      if (ia != iz) chords.push_back({ia, iz});
     }
     std::vector<std::array<int, 3>> cap;
     try {
-      cap = triangulate_rings(points, sorted_rings);
+      cap = triangulate_rings(points, chords);
     } catch (const std::runtime_error&) {
       throw failure("a face's boundary loops cross in its plane");
     }
