@@ -81,6 +81,8 @@ int run_simplify(const SimplifyCommandOptions& o) {
                              {"hull_area", finite_or_zero(p.hull_area)},
                              {"edge_on_triangles", p.edge_on_triangles},
                              {"edge_on_segments", p.edge_on_segments},
+                             {"exact_triangles", p.exact_triangles},
+                             {"exact_gaps", p.exact_gaps},
                              {"polygon_vertices", p.polygon_vertices},
                              {"holes", p.holes}});
     parts.push_back({{"name", r.name},

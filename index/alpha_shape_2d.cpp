@@ -15,6 +15,9 @@
 #include <stdexcept>
 #include <tuple>
 
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 namespace loom {
 
 namespace {
@@ -66,19 +69,7 @@ struct BucketGrid {
   /// Builds the grid over `boxes` (min, max per item) covering `lo`..`hi`, with about
   /// `boxes_per_cell` boxes per cell of the bounding box (more cells when smaller).
   void build(const std::vector<std::array<Vec2, 2>>& boxes, const Vec2& lo, const Vec2& hi, double boxes_per_cell) {
-    start.clear();
-    items.clear();
-    nx = ny = 0;
-    if (boxes.empty()) return;
-    const Vec2 ext = (hi - lo).cwiseMax(Vec2::Constant(1e-300));
-    // At most 2^22 cells.
-    const double target = std::clamp(static_cast<double>(boxes.size()) / boxes_per_cell, 1.0, 4194304.0);
-    cell = std::sqrt(ext.x() * ext.y() / target);
-    if (!(cell > 0.0) || !std::isfinite(cell)) cell = std::max(ext.x(), ext.y());
-    cell = std::max(cell, std::max(ext.x(), ext.y()) / 2048.0);
-    origin = lo;
-    nx = std::max(1, static_cast<int>(std::ceil(ext.x() / cell)));
-    ny = std::max(1, static_cast<int>(std::ceil(ext.y() / cell)));
+    if (!size_for(boxes.size(), lo, hi, boxes_per_cell)) return;
     // Cell ranges of the boxes, computed once for both passes.
     std::vector<std::array<int, 4>> range(boxes.size());
     for (std::size_t k = 0; k < boxes.size(); ++k)
@@ -96,6 +87,64 @@ struct BucketGrid {
         for (int x = g[0]; x <= g[1]; ++x) items[count[static_cast<std::size_t>(y) * nx + x]++] = k;
     }
   }
+  /// Clears the grid and sizes it over lo..hi for `count` items (none: empty, false).
+  bool size_for(std::size_t count, const Vec2& lo, const Vec2& hi, double boxes_per_cell) {
+    start.clear();
+    items.clear();
+    nx = ny = 0;
+    if (count == 0) return false;
+    const Vec2 ext = (hi - lo).cwiseMax(Vec2::Constant(1e-300));
+    // At most 2^22 cells.
+    const double target = std::clamp(static_cast<double>(count) / boxes_per_cell, 1.0, 4194304.0);
+    cell = std::sqrt(ext.x() * ext.y() / target);
+    if (!(cell > 0.0) || !std::isfinite(cell)) cell = std::max(ext.x(), ext.y());
+    cell = std::max(cell, std::max(ext.x(), ext.y()) / 2048.0);
+    origin = lo;
+    nx = std::max(1, static_cast<int>(std::ceil(ext.x() / cell)));
+    ny = std::max(1, static_cast<int>(std::ceil(ext.y() / cell)));
+    return true;
+  }
+  /// Builds the grid over triangles like build() over their boxes, but lists each
+  /// triangle only in the cells its area meets (for_triangle_cells): a long thin triangle
+  /// across a grid is listed along itself, not over its box.
+  void build_triangles(const std::vector<std::array<Vec2, 3>>& tris, const Vec2& lo, const Vec2& hi,
+                       double boxes_per_cell) {
+    if (!size_for(tris.size(), lo, hi, boxes_per_cell)) return;
+    std::vector<std::uint32_t> count(static_cast<std::size_t>(nx) * ny + 1, 0);
+    for (const auto& c : tris)
+      for_triangle_cells(c, [&](int x, int y) { ++count[static_cast<std::size_t>(y) * nx + x + 1]; });
+    for (std::size_t i = 1; i < count.size(); ++i) count[i] += count[i - 1];
+    start = count;
+    items.assign(count.back(), 0);
+    for (std::uint32_t k = 0; k < tris.size(); ++k)
+      for_triangle_cells(tris[k], [&](int x, int y) { items[count[static_cast<std::size_t>(y) * nx + x]++] = k; });
+  }
+  /// Calls f(i, j) for each cell (i, j) that the closed triangle c meets, and the cells
+  /// beside those in its row (row by row: the x-range of the triangle's part in the row's
+  /// slab, which its edges' parts there span; one more cell each side for the rounding).
+  template <class F>
+  void for_triangle_cells(const std::array<Vec2, 3>& c, F&& f) const {
+    if (empty()) return;
+    const double ymin = std::min({c[0].y(), c[1].y(), c[2].y()}), ymax = std::max({c[0].y(), c[1].y(), c[2].y()});
+    for (int j = cy(ymin), j1 = cy(ymax); j <= j1; ++j) {
+      const double s0 = std::max(origin.y() + j * cell, ymin), s1 = std::min(origin.y() + (j + 1) * cell, ymax);
+      double xl = std::numeric_limits<double>::infinity(), xr = -xl;
+      for (int e = 0; e < 3; ++e) {
+        const Vec2& a = c[e];
+        const Vec2& b = c[(e + 1) % 3];
+        const double ey0 = std::min(a.y(), b.y()), ey1 = std::max(a.y(), b.y());
+        if (ey1 < s0 || ey0 > s1) continue;
+        const auto r = slab_x_range(a, b, std::max(s0, ey0), std::min(s1, ey1), 0.0);
+        xl = std::min(xl, r[0]);
+        xr = std::max(xr, r[1]);
+      }
+      if (!(xl <= xr)) {  // the row's slab meets the triangle only within rounding
+        xl = std::min({c[0].x(), c[1].x(), c[2].x()});
+        xr = std::max({c[0].x(), c[1].x(), c[2].x()});
+      }
+      for (int i = std::max(0, cx(xl) - 1), i1 = std::min(nx - 1, cx(xr) + 1); i <= i1; ++i) f(i, j);
+    }
+  }
   /// The items listed in every cell within `pad` of the segment ab (row by row: the
   /// x-range of the segment's part in the row's padded slab); an item in several of those
   /// cells is listed as often.
@@ -111,6 +160,14 @@ struct BucketGrid {
       for (int i = std::max(0, cx(xl - pad) - 1), i1 = std::min(nx - 1, cx(xr + pad) + 1); i <= i1; ++i)
         for_cell(i, j, [&](std::uint32_t k) { out.push_back(k); });
     }
+  }
+  /// Calls f(item, i, j) for the items listed in each cell (i, j) that the box lo..hi
+  /// meets (clamped to the grid): an item in several of those cells, once per cell.
+  template <class F>
+  void for_box(const Vec2& lo, const Vec2& hi, F&& f) const {
+    if (empty()) return;
+    for (int j = cy(lo.y()), j1 = cy(hi.y()); j <= j1; ++j)
+      for (int i = cx(lo.x()), i1 = cx(hi.x()); i <= i1; ++i) for_cell(i, j, [&](std::uint32_t k) { f(k, i, j); });
   }
   template <class F>
   void for_cell(int x, int y, F&& f) const {
@@ -155,6 +212,52 @@ struct FlagGrid {
   }
 };
 
+/// A convex polygon (CCW): a triangle and the pieces clipped from it.
+using ClipPolygon = std::vector<Vec2>;
+
+/// Keeps the part of `poly` where n·x ≥ c (closed); `scratch` is reused storage.
+void clip_polygon(ClipPolygon& poly, const Vec2& n, double c, ClipPolygon& scratch) {
+  scratch.clear();
+  const std::size_t count = poly.size();
+  for (std::size_t i = 0; i < count; ++i) {
+    const Vec2& p = poly[i];
+    const Vec2& q = poly[(i + 1) % count];
+    const double fp = n.dot(p) - c, fq = n.dot(q) - c;
+    if (fp >= 0.0) scratch.push_back(p);
+    if ((fp >= 0.0) != (fq >= 0.0)) scratch.push_back(p + (q - p) * (fp / (fp - fq)));
+  }
+  poly.swap(scratch);
+}
+
+/// Twice the signed area of a polygon (positive when counter-clockwise).
+double twice_area(const ClipPolygon& poly) {
+  double a = 0.0;
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const Vec2& p = poly[i];
+    const Vec2& q = poly[(i + 1) % poly.size()];
+    a += p.x() * q.y() - p.y() * q.x();
+  }
+  return a;
+}
+
+
+/// The pieces (convex, CCW) of `poly` outside the convex polygon given by the half-planes
+/// n·x ≥ c (appended to `out`), those of twice their area above min_twice_area only:
+/// the part beyond the first half-plane, then beyond the second of what is inside the
+/// first, and so on.
+void subtract_convex(const ClipPolygon& poly, const std::array<Vec2, 8>& n, const std::array<double, 8>& c, int count,
+                     double min_twice_area, std::vector<ClipPolygon>& out, ClipPolygon& scratch) {
+  ClipPolygon rest = poly, outside;
+  for (int i = 0; i < count && rest.size() >= 3; ++i) {
+    outside = rest;
+    clip_polygon(outside, -n[i], -c[i], scratch);
+    if (outside.size() >= 3 && twice_area(outside) > min_twice_area) out.push_back(outside);
+    clip_polygon(rest, n[i], c[i], scratch);
+  }
+}
+
+struct GapScratch;
+
 }  // namespace
 
 // Bucket densities: a point location scans the triangles listed in its cell, each box
@@ -174,7 +277,11 @@ struct AlphaShape2D::Impl {
   std::vector<std::array<Vec2, 3>> kept_coords;  // corners of kept_list, contiguous
   std::vector<std::array<Vec2, 2>> segments;  // boundary edges, kept side on the left
   std::vector<std::array<int, 2>> segment_edge;  // (face id, edge index)
-  BucketGrid tri_grid, seg_grid;
+  // The finite faces not kept (the complement of R in the convex hull), their corners
+  // (CCW) and, per edge e (opposite corner e), whether the face across it is kept.
+  std::vector<std::array<Vec2, 3>> removed_coords;
+  std::vector<std::array<bool, 3>> removed_kept_edge;
+  BucketGrid tri_grid, seg_grid, removed_grid;
   FlagGrid flags;
   double area = 0.0;
 
@@ -190,11 +297,22 @@ struct AlphaShape2D::Impl {
     segments.clear();
     segment_edge.clear();
     area = 0.0;
+    removed_coords.clear();
+    removed_kept_edge.clear();
     Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity());
-    Vec2 hi = -lo;
+    Vec2 hi = -lo, removed_lo = lo, removed_hi = hi;
     std::vector<std::array<Vec2, 2>> tri_boxes, seg_boxes;
     for (std::uint32_t i = 0; i < faces.size(); ++i) {
-      if (!kept[i]) continue;
+      if (!kept[i]) {
+        const auto& c = coords[i];
+        removed_coords.push_back(c);
+        removed_kept_edge.push_back({is_kept(faces[i]->neighbor(0)), is_kept(faces[i]->neighbor(1)),
+                                     is_kept(faces[i]->neighbor(2))});
+        const Vec2 bl = c[0].cwiseMin(c[1]).cwiseMin(c[2]), bh = c[0].cwiseMax(c[1]).cwiseMax(c[2]);
+        removed_lo = removed_lo.cwiseMin(bl);
+        removed_hi = removed_hi.cwiseMax(bh);
+        continue;
+      }
       kept_list.push_back(i);
       kept_coords.push_back(coords[i]);
       const auto& c = coords[i];
@@ -213,8 +331,22 @@ struct AlphaShape2D::Impl {
     }
     tri_grid.build(tri_boxes, lo, hi, kTriangleBoxesPerCell);
     seg_grid.build(seg_boxes, lo, hi, kSegmentBoxesPerCell);
+    removed_grid.build_triangles(removed_coords, removed_lo, removed_hi, kTriangleBoxesPerCell);
     build_flags(lo, hi);
   }
+
+  /// Appends the gap points of triangle t (plane coordinates, inside the hull; with area)
+  /// to `gaps` (see AlphaShape2D::triangle_gaps); `serial` is distinct per triangle of one
+  /// scratch (marks the removed faces already listed for it).
+  void triangle_gaps(std::array<Vec2, 3> t, std::uint32_t serial, double tol, double spacing, GapScratch& g,
+                     std::vector<Vec2>& gaps) const;
+
+  /// Replaces `poly` by its pieces (in `pieces`) outside every tol-rectangle of a boundary
+  /// edge (the points within tol of the edge's line whose foot lies on the edge) and every
+  /// tol-octagon inscribed in the disc around a boundary vertex, near it; pieces of twice
+  /// their area at most min_twice_area are dropped. What it removes lies within tol of ∂R.
+  void subtract_boundary_neighbourhood(const ClipPolygon& poly, double tol, double min_twice_area,
+                                       std::vector<ClipPolygon>& pieces, ClipPolygon& scratch) const;
 
   /// Fills `flags` over lo..hi (the kept triangles' bounding box); see FlagGrid.
   void build_flags(const Vec2& lo, const Vec2& hi);
@@ -394,6 +526,75 @@ double AlphaShape2D::hull_area() const {
 void AlphaShape2D::keep_all() {
   std::fill(impl_->kept.begin(), impl_->kept.end(), 1);
   impl_->refresh();
+}
+
+double AlphaShape2D::fill_pinches() {
+  Impl& m = *impl_;
+  const double before = m.area;
+  // Filling the faces around one vertex can pinch a neighbour: a few rounds.
+  constexpr int kMaxRounds = 8;
+  bool any = false;
+  std::vector<Face> ring;
+  for (int round = 0; round < kMaxRounds; ++round) {
+    bool changed = false;
+    for (auto v = m.dt.finite_vertices_begin(); v != m.dt.finite_vertices_end(); ++v) {
+      ring.clear();
+      auto fc = m.dt.incident_faces(v), done = fc;
+      do ring.push_back(fc);
+      while (++fc != done);
+      const std::size_t n = ring.size();
+      auto kept_at = [&](std::size_t i) { return m.is_kept(ring[i % n]); };
+      std::size_t runs = 0, first_gap = n;
+      for (std::size_t i = 0; i < n; ++i)
+        if (kept_at(i) && !kept_at(i + n - 1)) {
+          ++runs;
+          if (first_gap == n) first_gap = i + 1;  // a gap starts after a kept run ends... found below
+        }
+      if (runs < 2) continue;
+      // The gaps (runs of faces not kept), each with its angle at v; the one the hull's
+      // outside lies in (an infinite face) stays open, else the widest.
+      struct Gap {
+        std::size_t begin, count;
+        double angle;
+        bool outside;
+      };
+      std::vector<Gap> gaps;
+      std::size_t start = 0;
+      while (!(kept_at(start) && !kept_at(start + 1))) ++start;  // the end of a kept run
+      for (std::size_t i = start + 1; i <= start + n; ++i) {
+        if (kept_at(i)) continue;
+        if (gaps.empty() || kept_at(i - 1)) gaps.push_back({i, 0, 0.0, false});
+        Gap& g = gaps.back();
+        ++g.count;
+        const Face f = ring[i % n];
+        if (m.dt.is_infinite(f)) {
+          g.outside = true;
+          continue;
+        }
+        const int j = f->index(v);
+        const Vec2 p = to_vec(v->point()), a = to_vec(f->vertex(DT::ccw(j))->point()) - p,
+                   b = to_vec(f->vertex(DT::cw(j))->point()) - p;
+        g.angle += std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+      }
+      std::size_t open = 0;
+      for (std::size_t k = 1; k < gaps.size(); ++k)
+        if (gaps[k].outside > gaps[open].outside ||
+            (gaps[k].outside == gaps[open].outside && gaps[k].angle > gaps[open].angle))
+          open = k;
+      for (std::size_t k = 0; k < gaps.size(); ++k) {
+        if (k == open) continue;
+        for (std::size_t i = gaps[k].begin; i < gaps[k].begin + gaps[k].count; ++i) {
+          const Face f = ring[i % n];
+          if (!m.dt.is_infinite(f)) m.kept[static_cast<std::size_t>(f->info())] = 1;
+        }
+      }
+      changed = true;
+    }
+    if (!changed) break;
+    any = true;
+  }
+  if (any) m.refresh();
+  return m.area - before;
 }
 
 double AlphaShape2D::cover(const std::vector<Vec2>& points, double tol, std::size_t* uncovered) {
@@ -613,6 +814,205 @@ std::vector<Vec2> AlphaShape2D::segment_gaps(const Vec2& a, const Vec2& b, doubl
     for (const auto& g : open) stretch_points(pa, pd, pd.norm(), g[0], g[1], spacing, gaps);
   }
   return gaps;
+}
+
+namespace {
+
+/// True if d lies right of the line of one of t's edges or on it (t CCW; within a
+/// relative 1e-12, the rounding of touching triangles): t ∩ d has no area. The cheap
+/// rejection before clipping; called both ways.
+bool separated_by_edge_of(const std::array<Vec2, 3>& t, const std::array<Vec2, 3>& d) {
+  for (int e = 0; e < 3; ++e) {
+    const Vec2 a = t[e], ab = t[(e + 1) % 3] - a;
+    const double ab_scale = std::abs(ab.x()) + std::abs(ab.y());
+    bool all_right = true;
+    for (const Vec2& p : d) {
+      const double o = ab.x() * (p.y() - a.y()) - ab.y() * (p.x() - a.x());
+      all_right = all_right && o <= 1e-12 * ab_scale * (std::abs(p.x() - a.x()) + std::abs(p.y() - a.y()));
+    }
+    if (all_right) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+void AlphaShape2D::Impl::subtract_boundary_neighbourhood(const ClipPolygon& poly, double tol, double min_twice_area,
+                                                         std::vector<ClipPolygon>& pieces, ClipPolygon& scratch) const {
+  pieces.assign(1, poly);
+  if (!(tol > 0.0) || seg_grid.empty()) return;
+  Vec2 lo = poly[0], hi = poly[0];
+  for (const Vec2& v : poly) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  const Vec2 pad = Vec2::Constant(tol);
+  std::vector<std::uint32_t> near;
+  seg_grid.for_box(lo - pad, hi + pad, [&](std::uint32_t k, int, int) { near.push_back(k); });
+  std::sort(near.begin(), near.end());
+  near.erase(std::unique(near.begin(), near.end()), near.end());
+  std::array<Vec2, 8> n;
+  n.fill(Vec2::Zero());
+  std::array<double, 8> c{};
+  std::vector<ClipPolygon> next;
+  auto subtract = [&](int count) {
+    next.clear();
+    for (const ClipPolygon& piece : pieces) subtract_convex(piece, n, c, count, min_twice_area, next, scratch);
+    pieces.swap(next);
+  };
+  for (std::uint32_t k : near) {
+    if (pieces.empty()) return;
+    const Vec2 a = segments[k][0], b = segments[k][1];
+    const double len = (b - a).norm();
+    if (!(len > 0.0)) continue;
+    const Vec2 u = (b - a) / len, v(-u.y(), u.x());
+    n[0] = u;
+    n[1] = -u;
+    n[2] = v;
+    n[3] = -v;
+    c[0] = u.dot(a);
+    c[1] = -u.dot(b);
+    c[2] = v.dot(a) - tol;
+    c[3] = -v.dot(a) - tol;
+    subtract(4);
+  }
+  // The discs around the vertices, by their inscribed octagons (apothem tol·cos(π/8)).
+  const double apothem = tol * std::cos(M_PI / 8.0);
+  for (std::uint32_t k : near)
+    for (const Vec2& p : segments[k]) {
+      if (pieces.empty()) return;
+      for (int i = 0; i < 8; ++i) {
+        const Vec2 d(std::cos(i * M_PI / 4.0), std::sin(i * M_PI / 4.0));
+        n[i] = -d;
+        c[i] = -d.dot(p) - apothem;
+      }
+      subtract(8);
+    }
+}
+
+namespace {
+
+/// Reused storage of the gap search of one thread (triangles_gaps).
+struct GapScratch {
+  std::vector<std::uint32_t> seen;  ///< per removed face: the last triangle that listed it
+  std::vector<std::uint32_t> ids;
+  ClipPolygon poly, clip;
+  std::vector<ClipPolygon> pieces;
+};
+
+}  // namespace
+
+void AlphaShape2D::Impl::triangle_gaps(std::array<Vec2, 3> t, std::uint32_t serial, double tol, double spacing,
+                                       GapScratch& g, std::vector<Vec2>& gaps) const {
+  const double t_area = tri_area(t);
+  const double t_scale2 =
+      std::max({(t[1] - t[0]).squaredNorm(), (t[2] - t[1]).squaredNorm(), (t[0] - t[2]).squaredNorm()});
+  if (t_area < 0.0) std::swap(t[1], t[2]);
+  const Vec2 lo = t[0].cwiseMin(t[1]).cwiseMin(t[2]), hi = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
+  // The removed faces listed in the cells t meets (both listed along their area only),
+  // each once.
+  g.ids.clear();
+  removed_grid.for_triangle_cells(t, [&](int x, int y) {
+    removed_grid.for_cell(x, y, [&](std::uint32_t k) {
+      if (g.seen[k] == serial) return;
+      g.seen[k] = serial;
+      g.ids.push_back(k);
+    });
+  });
+  for (std::uint32_t k : g.ids) {
+    const auto& d = removed_coords[k];
+    const Vec2 dlo = d[0].cwiseMin(d[1]).cwiseMin(d[2]), dhi = d[0].cwiseMax(d[1]).cwiseMax(d[2]);
+    if ((dlo.array() > hi.array()).any() || (dhi.array() < lo.array()).any()) continue;
+    if (separated_by_edge_of(t, d) || separated_by_edge_of(d, t)) continue;
+    ClipPolygon& poly = g.poly;
+    poly.assign(t.begin(), t.end());
+    // t ∩ d, then less the strip along each edge of d that a kept face lies across: that
+    // edge is on ∂R, and a point of d whose barycentric weight on the opposite corner r is
+    // below tol / max(|r − p|, |r − q|) lies within tol of the edge pq (it is within that
+    // weight times |r − y| of a point y of pq), i.e. closer to pq's line than w below.
+    double d_scale2 = 0.0;
+    for (int e = 0; e < 3 && poly.size() >= 3; ++e) {
+      const Vec2 p = d[(e + 1) % 3], q = d[(e + 2) % 3], r = d[e];
+      const Vec2 pq = q - p;
+      d_scale2 = std::max(d_scale2, pq.squaredNorm());
+      const Vec2 inward(-pq.y(), pq.x());  // left of p→q: d's side, d being CCW
+      clip_polygon(poly, inward, inward.dot(p), g.clip);
+      if (!removed_kept_edge[k][e] || !(tol > 0.0) || poly.size() < 3) continue;
+      const double len = pq.norm();
+      const double height = inward.dot(r - p) / len;
+      const double w = tol * height / std::max((r - p).norm(), (r - q).norm());
+      clip_polygon(poly, inward / len, (inward / len).dot(p) + w, g.clip);
+    }
+    // What is left lies in d, farther than the strips from d's edges on ∂R (a piece of no
+    // area at the scale of the two triangles is rounding of the clipping).
+    const double min_twice_area = 2e-12 * std::max(t_scale2, d_scale2);
+    if (poly.size() < 3 || !(twice_area(poly) > min_twice_area)) continue;
+    // The strips are narrow where d is flat, and a piece near a corner of ∂R may be
+    // covered by several edges: the piece less every boundary edge's tol-rectangle and
+    // boundary vertex's inscribed tol-octagon nearby (all within R ⊕ tol) is what remains.
+    subtract_boundary_neighbourhood(poly, tol, min_twice_area, g.pieces, g.clip);
+    for (const ClipPolygon& piece : g.pieces) {
+      Vec2 c = Vec2::Zero();
+      for (const Vec2& v : piece) c += v;
+      c /= static_cast<double>(piece.size());
+      gaps.push_back(c);
+      // Points along the piece's sides (a quarter of the way in: inside the convex piece),
+      // at most `spacing` apart, so that one repair closes a long sliver.
+      for (std::size_t i = 0; i < piece.size(); ++i) {
+        const Vec2 p = piece[i], pq = piece[(i + 1) % piece.size()] - p;
+        const int n = static_cast<int>(std::ceil(pq.norm() / spacing));
+        for (int j = 0; j < n && n > 1; ++j) {
+          const Vec2 q = p + pq * ((j + 0.5) / n);
+          gaps.push_back(q + 0.25 * (c - q));
+        }
+      }
+    }
+  }
+}
+
+std::vector<Vec2> AlphaShape2D::triangles_gaps(const std::vector<std::array<Vec2, 3>>& triangles, double tol,
+                                               double spacing) const {
+  if (!(spacing > 0.0)) throw std::invalid_argument("AlphaShape2D::triangles_gaps: spacing must be > 0");
+  if (triangles.size() >= std::numeric_limits<std::uint32_t>::max())
+    throw std::invalid_argument("AlphaShape2D::triangles_gaps: too many triangles");
+  const Impl& m = *impl_;
+  tbb::enumerable_thread_specific<std::vector<Vec2>> found;
+  tbb::enumerable_thread_specific<GapScratch> scratch([&m] {
+    GapScratch g;
+    g.seen.assign(m.removed_coords.size(), std::numeric_limits<std::uint32_t>::max());
+    return g;
+  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles.size(), 512), [&](const auto& rg) {
+    auto& out = found.local();
+    auto& g = scratch.local();
+    for (std::size_t i = rg.begin(); i != rg.end(); ++i) {
+      const auto& t = triangles[i];
+      const double t_scale2 =
+          std::max({(t[1] - t[0]).squaredNorm(), (t[2] - t[1]).squaredNorm(), (t[0] - t[2]).squaredNorm()});
+      // A triangle without area (within rounding) is its longest edge: checked as a segment.
+      if (!(std::abs(tri_area(t)) > 1e-12 * t_scale2)) {
+        int longest = 0;
+        for (int e = 1; e < 3; ++e)
+          if ((t[(e + 1) % 3] - t[e]).squaredNorm() > (t[(longest + 1) % 3] - t[longest]).squaredNorm()) longest = e;
+        const auto seg = segment_gaps(t[longest], t[(longest + 1) % 3], tol, spacing);
+        out.insert(out.end(), seg.begin(), seg.end());
+        continue;
+      }
+      // Every finite face kept: the hull is the region.
+      if (!m.removed_grid.empty()) m.triangle_gaps(t, static_cast<std::uint32_t>(i), tol, spacing, g, out);
+    }
+  });
+  std::vector<Vec2> gaps;
+  for (const auto& f : found) gaps.insert(gaps.end(), f.begin(), f.end());
+  // The same list whatever the thread schedule.
+  std::sort(gaps.begin(), gaps.end(), [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+  gaps.erase(std::unique(gaps.begin(), gaps.end()), gaps.end());
+  return gaps;
+}
+
+std::vector<Vec2> AlphaShape2D::triangle_gaps(const Vec2& a, const Vec2& b, const Vec2& c, double tol,
+                                              double spacing) const {
+  return triangles_gaps({{a, b, c}}, tol, spacing);
 }
 
 bool AlphaShape2D::contains_unaccelerated(const Vec2& p, double tol) const {

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstddef>
 #include <memory>
 #include <vector>
@@ -68,6 +69,13 @@ class AlphaShape2D {
   /// Returns the area added (scene units²).
   double cover(const std::vector<Vec2>& points, double tol, std::size_t* uncovered = nullptr);
 
+  /// Keeps the faces that make the region a 2-manifold at every vertex: where its kept
+  /// faces around a vertex form several fans (pieces touching at the vertex, which an
+  /// extrusion turns into pieces touching along an edge), the gaps between them are filled,
+  /// all but the widest (or the one open to the outside of the hull). Returns the area
+  /// added (scene units²).
+  double fill_pinches();
+
   /// True if p lies in the region or within tol of it. Points deep inside are answered in
   /// O(1) from a grid of cells known to lie wholly inside the region.
   bool contains(const Vec2& p, double tol = 0.0) const;
@@ -88,6 +96,19 @@ class AlphaShape2D {
   /// apart along it. Empty: all of ab lies in the region or within tol of it (exact up to
   /// rounding, unlike a test of points sampled on ab). spacing > 0.
   std::vector<Vec2> segment_gaps(const Vec2& a, const Vec2& b, double tol, double spacing) const;
+  /// Points of the closed triangle abc (plane coordinates, inside the convex hull of the
+  /// points) farther than tol from the region: for each piece of it that a removed
+  /// Delaunay triangle d holds, less the strips along d's edges on the boundary that lie
+  /// within tol of those edges, the piece's centroid and points along its sides at most
+  /// `spacing` apart (all inside d). Empty: the triangle lies in the region or within tol
+  /// of it (exact up to rounding; the strips of a flat d are narrower than tol, so such a
+  /// d may be reported where it lies within tol). A triangle without area is checked as
+  /// its longest edge (segment_gaps). spacing > 0.
+  std::vector<Vec2> triangle_gaps(const Vec2& a, const Vec2& b, const Vec2& c, double tol, double spacing) const;
+  /// triangle_gaps of every triangle (corners a, b, c), in parallel: their gap points,
+  /// sorted (x, then y) and unique, whatever the thread schedule.
+  std::vector<Vec2> triangles_gaps(const std::vector<std::array<Vec2, 3>>& triangles, double tol,
+                                   double spacing) const;
   /// Signed distance to the region's boundary: negative inside, +inf if the region is empty.
   double signed_distance(const Vec2& p) const;
   /// Boundary loops grouped per connected piece (outer CCW, holes CW), in deterministic order.

@@ -306,16 +306,17 @@ class LatticeBitmap {
     const std::size_t k = bit(i, j);
     return k != kOutside && ((bits_[k / 64] >> (k % 64)) & 1u);
   }
-  /// The marked points, mapped by `point(i, j)`, in increasing (i, j), which is
-  /// increasing (x, y) since the mapping is monotone in each index.
-  template <class F>
-  std::vector<Vec2> points(F&& point) const {
+  /// The marked points for which keep(i, j) holds, mapped by `point(i, j)`, in increasing
+  /// (i, j), which is increasing (x, y) since the mapping is monotone in each index.
+  template <class F, class K>
+  std::vector<Vec2> points(F&& point, K&& keep) const {
     std::vector<Vec2> out;
     for (std::size_t w = 0; w < bits_.size(); ++w)
       for (std::uint64_t word = bits_[w]; word != 0; word &= word - 1) {
         const std::size_t k = w * 64 + static_cast<std::size_t>(__builtin_ctzll(word));
-        out.push_back(point(i0_ + static_cast<long>(k / static_cast<std::size_t>(ny_)),
-                            j0_ + static_cast<long>(k % static_cast<std::size_t>(ny_))));
+        const long i = i0_ + static_cast<long>(k / static_cast<std::size_t>(ny_)),
+                   j = j0_ + static_cast<long>(k % static_cast<std::size_t>(ny_));
+        if (keep(i, j)) out.push_back(point(i, j));
       }
     return out;
   }
@@ -356,6 +357,11 @@ std::vector<Eigen::Matrix3d> axis_rotations(bool all) {
 /// index box (a huge sparse projection) falls back to sorting the lattice points.
 constexpr std::size_t kMaxLatticeBitmapBits = std::size_t(1) << 26;
 
+/// The interior lattice is coarsened (AlphaSimOptions::coarse_interior) only where its
+/// cells' circumradius √2·L_max is below this fraction of α: a Delaunay triangle of the
+/// snapped nodes may be that much larger than the ideal one.
+constexpr double kCoarseCellAlphaMargin = 0.9;
+
 /// Lexicographic order (x, then y) of plane points.
 struct Vec2Less {
   bool operator()(const Vec2& p, const Vec2& q) const { return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y()); }
@@ -395,7 +401,8 @@ Vec2 snap_to_grid(const Vec2& q, double snap) {
 
 AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
                                        const std::vector<MeshEdge>& edges,
-                                       const AlphaSimPrism& pr, double l_max, double snap, bool lattice_bitmap) {
+                                       const AlphaSimPrism& pr, double l_max, double snap, bool lattice_bitmap,
+                                       bool coarse_interior) {
   AlphaSimPlaneSamples s;
   auto snapped = [snap](const Vec2& q) { return snap_to_grid(q, snap); };
   std::vector<Vec2> proj(mesh.vertices.size());
@@ -415,10 +422,7 @@ AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
   for (const auto& f : mesh.triangles) {
     const Vec2 a = proj[f[0]], b = proj[f[1]], c = proj[f[2]];
     lattice_in_triangle(a, b, c, l_max, 0.0, [&](long i, long j) {
-      if (!nodes.active() || !nodes.set(i, j)) {
-        s.points.push_back(snapped(nodes.at(i, j)));
-        node_list.emplace_back(i, j);
-      }
+      if (!nodes.active() || !nodes.set(i, j)) node_list.emplace_back(i, j);
     });
     lattice_in_triangle(a, b, c, l_max, 0.5, [&](long i, long j) {
       if (!centres.active() || !centres.set(i, j)) s.checks.push_back(snapped(centres.at(i, j)));
@@ -426,9 +430,32 @@ AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
     s.checks.push_back(snapped((a + b + c) / 3.0));
   }
   std::sort(node_list.begin(), node_list.end());
+  node_list.erase(std::unique(node_list.begin(), node_list.end()), node_list.end());
   auto has_node = [&](long i, long j) {
     return (nodes.active() && nodes.test(i, j)) || std::binary_search(node_list.begin(), node_list.end(), std::make_pair(i, j));
   };
+  // Deep inside the projection the lattice may be twice as coarse: the cells of spacing
+  // 2·L_max whose nine nodes are all met keep only their corners (even i and j), whose
+  // triangles have circumradius √2·L_max < α (the caller asks for this only then), so the
+  // α-shape keeps them; every cell of spacing L_max with four corner nodes lies in such a
+  // cell or keeps its corners, so the region the nodes cover does not shrink, and points
+  // near the outline (where a node is missing within two cells) are all kept. A face-on
+  // plate costs a quarter of the nodes and of their Delaunay triangles.
+  auto complete_coarse_cell = [&](long ci, long cj) {  // (ci, cj): its lower-left node, even
+    for (long a = 0; a <= 2; ++a)
+      for (long b = 0; b <= 2; ++b)
+        if (!has_node(ci + a, cj + b)) return false;
+    return true;
+  };
+  auto keep_node = [&](long i, long j) {
+    const bool i_odd = (i & 1) != 0, j_odd = (j & 1) != 0;  // two's complement: -1 is odd
+    if (!coarse_interior || (!i_odd && !j_odd)) return true;
+    if (i_odd && j_odd) return !complete_coarse_cell(i - 1, j - 1);
+    if (i_odd) return !(complete_coarse_cell(i - 1, j - 2) && complete_coarse_cell(i - 1, j));
+    return !(complete_coarse_cell(i - 2, j - 1) && complete_coarse_cell(i, j - 1));
+  };
+  for (const auto& [i, j] : node_list)
+    if (keep_node(i, j)) s.points.push_back(snapped(nodes.at(i, j)));
   // A point in a lattice cell whose four corners are nodes adds nothing to the region: the
   // corners already give the α-shape that cell (two triangles of circumradius L_max/√2,
   // below α = 1.9·L_max at the default factors), and the checks, all kept, repair it
@@ -465,9 +492,11 @@ AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
   }
   sort_unique(s.points);
   sort_unique(s.checks);
-  if (nodes.active()) merge_unique(s.points, nodes.points([&](long i, long j) { return snapped(nodes.at(i, j)); }));
+  if (nodes.active())
+    merge_unique(s.points, nodes.points([&](long i, long j) { return snapped(nodes.at(i, j)); }, keep_node));
   if (centres.active())
-    merge_unique(s.checks, centres.points([&](long i, long j) { return snapped(centres.at(i, j)); }));
+    merge_unique(s.checks, centres.points([&](long i, long j) { return snapped(centres.at(i, j)); },
+                                          [](long, long) { return true; }));
   return s;
 }
 
@@ -783,6 +812,74 @@ void repair_projection(AlphaShape2D& shape, const std::vector<Vec2>& checks, con
   }
 }
 
+/// Makes `shape` hold every triangle of `mesh` projected by `pr` within tol, exactly (up
+/// to rounding), or replaces it by its convex hull (status Eroded, or Torn as
+/// repair_projection decides): the regular checks first (repair_projection), then up to
+/// kExactRepairs passes that find the gaps of every triangle — those seen edge-on by their
+/// longest edge within tol/2 (edge_on_triangles), the others whole
+/// (AlphaShape2D::triangle_gaps) — and repair them. The triangles are tested with their
+/// corners snapped (to `snap`, as the samples are, so that they lie in the hull of the
+/// samples) within tol − snap·√2/2: a point of the triangle lies within snap·√2/2 of the
+/// same combination of the snapped corners. `edge_on` and `exact` (the gap points, kept
+/// covered by later repairs) are filled for the caller.
+void exact_projection(const Mesh& mesh, const AlphaSimPrism& pr, double snap, double tol, AlphaShape2D& shape,
+                      const std::vector<Vec2>& checks, EdgeOnTriangles& edge_on, std::vector<Vec2>& exact,
+                      double torn_fraction, double l_max, ProjectionReport& rep) {
+  // Passes of gap finding and repair; a plane with gaps after the last is replaced by its hull.
+  constexpr int kExactRepairs = 3;
+  // The first passes repair by inserting the gap points (a notch closes with small
+  // triangles), the later ones by keeping the faces that hold them.
+  constexpr int kRefinePasses = 1;
+  const double edge_on_width = tol / 4.0, edge_on_tol = tol / 2.0;  // as in simplify_part
+  const double triangle_tol = tol - snap * M_SQRT1_2;
+  const double gap_spacing = l_max / 4.0;
+  edge_on = edge_on_triangles(mesh, pr, edge_on_width, 0.0, snap);
+  rep.edge_on_triangles = static_cast<std::size_t>(std::count(edge_on.flag.begin(), edge_on.flag.end(), 1));
+  rep.edge_on_segments = edge_on.segments.size();
+  std::vector<Vec2> proj(mesh.vertices.size());
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) proj[i] = snap_to_grid(pr.project(mesh.vertices[i]), snap);
+  std::vector<std::array<Vec2, 3>> tested;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    if (!edge_on.flag[t]) {
+      const auto& f = mesh.triangles[t];
+      tested.push_back({proj[f[0]], proj[f[1]], proj[f[2]]});
+    }
+  rep.exact_triangles = tested.size();
+  repair_projection(shape, checks, exact, tol, torn_fraction, rep);
+  for (int pass = 0; !is_hull(rep.status); ++pass) {
+    std::vector<Vec2> gaps = edge_on_gaps(shape, edge_on, edge_on_tol, triangle_tol, gap_spacing);
+    const std::vector<Vec2> inside = shape.triangles_gaps(tested, triangle_tol, gap_spacing);
+    gaps.insert(gaps.end(), inside.begin(), inside.end());
+    if (gaps.empty()) {
+      shape.fill_pinches();
+      return;
+    }
+    if (pass == kExactRepairs) break;
+    sort_unique(gaps);  // the same set whatever the thread schedule
+    rep.exact_gaps += gaps.size();
+    if (pass < kRefinePasses) {
+      exact.insert(exact.end(), gaps.begin(), gaps.end());
+      repair_projection(shape, checks, exact, tol, torn_fraction, rep);
+      continue;
+    }
+    // Then the removed faces that hold the gaps are kept: each gap point lies inside the
+    // face that holds its piece, which then covers all of it, so one such pass closes
+    // every gap (keeping faces only shrinks the others). Inserted points may not: around a
+    // silhouette sliver their new triangles are thin, above α, and only those holding a
+    // point are kept.
+    const double added = shape.cover(gaps, 0.0);
+    if (added > torn_fraction * shape.area()) {
+      rep.status = ProjectionStatus::Torn;
+      shape.keep_all();
+    } else if (added > 0.0) {
+      rep.status = ProjectionStatus::Repaired;
+    }
+  }
+  if (is_hull(rep.status)) return;
+  rep.status = ProjectionStatus::Eroded;
+  shape.keep_all();
+}
+
 void keep_original(AlphaSimPart& out, const Part& part, AlphaSimStatus status, const std::string& reason) {
   out.mesh = part.mesh;
   out.solid.reset();
@@ -823,9 +920,9 @@ std::vector<ProjectionReport> turned_projections(const std::vector<ProjectionRep
 }  // namespace
 
 AlphaSimPlaneSamples alpha_sim_plane_samples(const Mesh& mesh, const AlphaSimPrism& frame, double l_max, double snap,
-                                             bool lattice_bitmap) {
+                                             bool lattice_bitmap, bool coarse_interior) {
   if (!(l_max > 0.0 && snap > 0.0)) throw std::invalid_argument("alpha-sim: l_max and snap must be > 0");
-  return sample_projection(mesh, unique_edges(mesh), frame, l_max, snap, lattice_bitmap);
+  return sample_projection(mesh, unique_edges(mesh), frame, l_max, snap, lattice_bitmap, coarse_interior);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -905,7 +1002,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   // an independent set (another seed).
   std::vector<std::uint32_t> cover_source;
   const std::vector<Vec3> cover_samples =
-      opt.cover_samples ? dense_surface_samples(part.mesh, edges, r.l_max, opt.containment_density,
+      opt.cover_samples && !opt.exact_containment ? dense_surface_samples(part.mesh, edges, r.l_max, opt.containment_density,
                                                 opt.containment_max_samples, opt.seed + 2, true, &cover_source)
                         : std::vector<Vec3>();
 
@@ -930,6 +1027,9 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   const double edge_on_gap_spacing = r.l_max / 4.0;
   // Repairs of the gaps of the edge-on segments before the verification rounds.
   constexpr int kEdgeOnRepairs = 3;
+  // Interior lattice cells of 2·L_max (sample_projection) are kept by the α-shape only if
+  // their circumradius √2·L_max stays below α, with a margin for the snapping.
+  const bool coarse_interior = opt.coarse_interior && M_SQRT2 * r.l_max < kCoarseCellAlphaMargin * r.alpha;
   std::vector<EdgeOnTriangles> edge_on(specs.size());
   // 1 while a plane's shape is unchanged since its edge-on segments were found covered.
   std::vector<char> edge_on_clean(specs.size(), 0);
@@ -950,7 +1050,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
         pr.depth_max = std::max(pr.depth_max, d);
       }
     AlphaSimPlaneSamples& smp = plane_samples[k];
-    smp = sample_projection(part.mesh, edges, pr, r.l_max, snap, true);
+    smp = sample_projection(part.mesh, edges, pr, r.l_max, snap, true, coarse_interior);
     const std::vector<Vec2>& pts = smp.points;
     rep.points = pts.size();
     auto shape = std::make_shared<AlphaShape2D>(pts, r.alpha, std::min(opt.short_edge_factor * r.l_max, r.alpha));
@@ -961,6 +1061,9 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     if (shape->kept_triangle_count() == 0) {
       rep.status = ProjectionStatus::Empty;
       shape->keep_all();
+    } else if (opt.exact_containment) {
+      exact_projection(part.mesh, pr, snap, tol, *shape, smp.checks, edge_on[k], exact_checks[k], opt.torn_fraction,
+                       r.l_max, rep);
     } else {
       if (opt.edge_on_segments)
         edge_on[k] = edge_on_triangles(part.mesh, pr, edge_on_width, opt.thin_edge_factor * r.l_max, snap);
@@ -1034,7 +1137,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     }
     return miss;
   };
-  for (int round = 0;; ++round) {
+  for (int round = 0; !opt.exact_containment; ++round) {
     // Random points only: the fixed ones (vertices, edge midpoints, centroids) are among
     // the cover samples, which every repair keeps covered (without cover samples they are
     // tested here too).
@@ -1086,7 +1189,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     hull = hull || is_hull(rep.status);
   }
   auto solid = std::make_shared<AlphaSimSolid>(prisms);
-  {
+  if (!opt.exact_containment) {
     // Every sample lies in every 2D shape within tol (checked above, directly or through
     // the segment of its edge-on triangle), so solid->contains(p, tol) reduces to the
     // depth ranges: checked here without the 2D queries again.
@@ -1252,6 +1355,18 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     samples = dense_surface_samples(part.mesh, edges, r.l_max, opt.containment_density, opt.containment_max_samples,
                                     opt.seed + 3 * static_cast<std::uint64_t>(kRefineRounds + 1), true);
     r.containment_samples = samples.size();
+    if (opt.exact_containment) {
+      // Contained by construction (exact_projection): verified here on the implicit solid,
+      // independently of how the shapes were repaired.
+      const std::size_t in = tbb::parallel_reduce(
+          tbb::blocked_range<std::size_t>(0, samples.size(), 4096), std::size_t(0),
+          [&](const auto& rg, std::size_t acc) {
+            for (std::size_t i = rg.begin(); i != rg.end(); ++i) acc += solid->contains(samples[i], tol) ? 1 : 0;
+            return acc;
+          },
+          std::plus<std::size_t>());
+      r.containment_implicit = samples.empty() ? 1.0 : static_cast<double>(in) / samples.size();
+    }
     const EmbreeIndex simplified = mesh_index(out.mesh, true);
     const std::size_t in = count_contained_mesh(simplified, samples, tol);
     r.containment = samples.empty() ? 1.0 : static_cast<double>(in) / samples.size();

@@ -54,11 +54,26 @@ struct AlphaSimOptions {
   /// first repair; false leaves only the planes' own checks there (an ablation: the
   /// verification rounds, which then test the fixed points too, have to do the repair).
   bool cover_samples = true;
+  /// Containment of every triangle in every projection is made exact (up to rounding):
+  /// after the regular checks, each triangle's gaps — pieces of it farther than the
+  /// tolerance from the α-shape (AlphaShape2D::triangle_gaps; those seen edge-on by their
+  /// longest edge, segment_gaps) — are found and repaired, a few passes, then the plane
+  /// falls back to its hull. No random samples (cover_samples, the verification rounds,
+  /// edge_on_segments and thin_edge_factor apply only when false: the path before the
+  /// twenty-fifth session, kept as the ablation and bench baseline). The `measure` pass
+  /// still verifies dense random samples, against the mesh and the implicit solid.
+  bool exact_containment = true;
   /// Triangles seen edge-on in a plane (narrower than tol/4 in projection) are checked by
   /// their longest projected edge, exactly (AlphaShape2D::segment_gaps), instead of by
   /// their random samples in that plane; false samples them like the others (the ablation
   /// and bench baseline: the path before the twenty-fourth session).
   bool edge_on_segments = true;
+  /// Inside a projection, where a cell of 2·L_max has all nine lattice nodes, only its
+  /// corners are sampled (its triangles' circumradius √2·L_max is below α at the default
+  /// factors; not done otherwise): a quarter of the interior points and Delaunay
+  /// triangles. false samples the whole lattice at L_max (the ablation, and the path
+  /// before the twenty-fifth session).
+  bool coarse_interior = true;
   /// With edge_on_segments: the three edges of a triangle whose projection is narrower
   /// than thin_edge_factor·L_max (a silhouette sliver) are checked exactly as well, from
   /// the first verification round in which the plane's samples miss, and their gaps
@@ -135,6 +150,8 @@ struct ProjectionReport {
   double hull_area = 0.0;              ///< convex hull area
   std::size_t edge_on_triangles = 0;   ///< triangles seen edge-on: checked by their longest edge, not sampled
   std::size_t edge_on_segments = 0;    ///< the unique edges those checks ran on
+  std::size_t exact_triangles = 0;     ///< the others, tested whole (exact_containment)
+  std::size_t exact_gaps = 0;          ///< gap points those exact tests found and repaired
   std::size_t polygon_vertices = 0;    ///< boundary vertices after merging collinear ones
   std::size_t polygons = 0;            ///< connected pieces
   std::size_t holes = 0;
@@ -153,7 +170,9 @@ struct AlphaSimResult {
   bool closed_before = false, closed_after = false;
   double volume_before = 0.0, volume_after = 0.0;  ///< 0 when the mesh is not closed
   double containment = 1.0;           ///< fraction of dense original samples inside/on the output mesh
-  double containment_implicit = 1.0;  ///< same against the implicit solid
+  /// Same against the implicit solid (1 by construction with exact_containment when not
+  /// measured).
+  double containment_implicit = 1.0;
   std::size_t containment_samples = 0;
   /// Verification rounds that found random samples outside a shape and repaired it.
   int repair_rounds = 0;
@@ -244,8 +263,10 @@ struct AlphaSimPlaneSamples {
 /// Vertices and subdivision points in a lattice cell whose four corners are nodes are
 /// left out of the points (the corners already cover that cell); every check is kept.
 /// lattice_bitmap = false deduplicates by sorting every point (the reference; same sets).
+/// coarse_interior drops the nodes of odd index inside the cells of spacing 2·l_max whose
+/// nine nodes are all met (the interior; AlphaSimOptions::coarse_interior).
 AlphaSimPlaneSamples alpha_sim_plane_samples(const Mesh& mesh, const AlphaSimPrism& frame, double l_max, double snap,
-                                             bool lattice_bitmap = true);
+                                             bool lattice_bitmap = true, bool coarse_interior = false);
 
 /// Dense samples of a mesh surface: the fixed points — vertices and edge midpoints (each
 /// once) and centroids — unless fixed_points is false, and random points (≈ density per

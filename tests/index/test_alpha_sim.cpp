@@ -320,23 +320,43 @@ TEST(AlphaShape2D, SegmentGapsOfASquareMatchClosedForm) {
   EXPECT_THROW(s.segment_gaps({0, 0}, {1, 0}, tol, 0.0), std::invalid_argument);
 }
 
+namespace {
+/// 3000 random points in [-10, 10]² outside two discs (radius 2 and 1.2, random centres):
+/// with α = 0.45 their α-shape has notches, holes and islands.
+std::vector<Vec2> ragged_cloud(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-10.0, 10.0);
+  std::vector<Vec2> cloud;
+  const Vec2 c1(u(rng) * 0.5, u(rng) * 0.5), c2(u(rng) * 0.5, u(rng) * 0.5);
+  while (cloud.size() < 3000) {
+    const Vec2 p(u(rng), u(rng));
+    if ((p - c1).norm() > 2.0 && (p - c2).norm() > 1.2) cloud.push_back(p);
+  }
+  return cloud;
+}
+
+/// Calls f(trial, cloud, shape, tol, rng) for six ragged_cloud shapes (α = 0.45) of the
+/// seed, with tol 0 and 1e-2 in turn.
+template <class F>
+void for_ragged_shapes(std::uint64_t seed, F&& f) {
+  std::mt19937_64 rng(seed);
+  for (int trial = 0; trial < 6; ++trial) {
+    const std::vector<Vec2> cloud = ragged_cloud(rng);
+    const AlphaShape2D shape(cloud, 0.45);
+    f(trial, cloud, shape, trial % 2 ? 1e-2 : 0.0, rng);
+  }
+}
+}  // namespace
+
 TEST(AlphaShape2D, SegmentGapsAgreeWithDenseSamplingOnRaggedShapes) {
   // Oracle: points every tol/4 along the segment, each tested by point location. A
   // segment found gap-free has every such point within tol (plus the spacing) of the
   // region; a gap point lies farther than tol; a segment with a point farther than
   // tol + spacing has a gap. Random clouds with empty discs give notches, holes and
   // islands; segments at random, and along the region's own boundary edges.
-  std::mt19937_64 rng(24);
-  for (int trial = 0; trial < 6; ++trial) {
+  for_ragged_shapes(24, [](int trial, const std::vector<Vec2>& cloud, const AlphaShape2D& shape, double tol,
+                           std::mt19937_64& rng) {
+    (void)cloud;
     std::uniform_real_distribution<double> u(-10.0, 10.0);
-    std::vector<Vec2> cloud;
-    const Vec2 c1(u(rng) * 0.5, u(rng) * 0.5), c2(u(rng) * 0.5, u(rng) * 0.5);
-    while (cloud.size() < 3000) {
-      const Vec2 p(u(rng), u(rng));
-      if ((p - c1).norm() > 2.0 && (p - c2).norm() > 1.2) cloud.push_back(p);
-    }
-    AlphaShape2D shape(cloud, 0.45);
-    const double tol = trial % 2 ? 1e-2 : 0.0;
     std::vector<std::array<Vec2, 2>> segs;
     for (int i = 0; i < 150; ++i) segs.push_back({Vec2(u(rng), u(rng)), Vec2(u(rng), u(rng))});
     for (const auto& poly : shape.polygons())
@@ -363,7 +383,147 @@ TEST(AlphaShape2D, SegmentGapsAgreeWithDenseSamplingOnRaggedShapes) {
     }
     EXPECT_GT(with_gaps, 0);
     EXPECT_LT(with_gaps, static_cast<int>(segs.size()));
+  });
+}
+
+namespace {
+/// Points of triangle abc on a barycentric lattice of n steps per side (its corners and
+/// edges included).
+std::vector<Vec2> triangle_lattice(const Vec2& a, const Vec2& b, const Vec2& c, int n) {
+  std::vector<Vec2> pts;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; i + j <= n; ++j)
+      pts.push_back(a + (b - a) * (static_cast<double>(i) / n) + (c - a) * (static_cast<double>(j) / n));
+  return pts;
+}
+}  // namespace
+
+TEST(AlphaShape2D, TriangleGapsOfAnAnnulusMatchClosedForm) {
+  // The annulus of HoleKeptOrFilledByAlpha: the square [0, 20]² less a hole of about
+  // [6, 14]². A triangle in the ring has no gap; one across the hole has gaps, all in the
+  // hole, farther than tol from the ring; one that enters the hole by less than tol has
+  // none, by more it has.
+  std::vector<Vec2> pts;
+  for (const auto& p : grid_points(0, 0, 20, 20, 0.5))
+    if (!(p.x() > 6 && p.x() < 14 && p.y() > 6 && p.y() < 14)) pts.push_back(p);
+  const AlphaShape2D s(pts, 0.95);
+  const double tol = 1e-3, spacing = 0.25;
+  EXPECT_TRUE(s.triangle_gaps({0, 0}, {20, 0}, {0, 6}, tol, spacing).empty());
+  EXPECT_TRUE(s.triangle_gaps({0, 0}, {20, 0}, {20, 6}, tol, spacing).empty());
+  EXPECT_TRUE(s.triangle_gaps({1, 1}, {1, 19}, {6 + 0.5 * tol, 10}, tol, spacing).empty());
+  EXPECT_FALSE(s.triangle_gaps({1, 1}, {1, 19}, {6 + 4 * tol, 10}, tol, spacing).empty());
+  const auto across = s.triangle_gaps({0, 0}, {20, 20}, {0, 20}, tol, spacing);
+  ASSERT_FALSE(across.empty());
+  for (const Vec2& q : across) {
+    EXPECT_FALSE(s.contains(q, tol)) << q.transpose();
+    EXPECT_GE(q.y(), q.x() - 1e-9) << q.transpose();  // inside the triangle
   }
+  // The batch gives the same points, sorted and unique.
+  auto sorted = across;
+  std::sort(sorted.begin(), sorted.end(), [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+  sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+  const std::vector<std::array<Vec2, 3>> batch = {{Vec2(0, 0), Vec2(20, 20), Vec2(0, 20)}, {Vec2(0, 0), Vec2(20, 0), Vec2(0, 6)}};
+  EXPECT_TRUE(s.triangles_gaps(batch, tol, spacing) == sorted);
+  // A triangle without area is its longest edge.
+  EXPECT_TRUE(s.triangle_gaps({1, 1}, {19, 1}, {10, 1}, tol, spacing).empty());
+  EXPECT_FALSE(s.triangle_gaps({1, 10}, {19, 10}, {10, 10}, tol, spacing).empty());
+  EXPECT_THROW(s.triangle_gaps({0, 0}, {1, 0}, {0, 1}, tol, 0.0), std::invalid_argument);
+}
+
+TEST(AlphaShape2D, TriangleGapsAgreeWithDenseSamplingOnRaggedShapes) {
+  // Oracle: a barycentric lattice on the triangle, 1/64 of its longest edge apart, each
+  // point tested by point location. The claims: a triangle found gap-free has every lattice point within tol of the
+  // region (exact: the lattice points lie in the triangle); a triangle with a lattice
+  // point farther than tol + its lattice step from the region has gaps; every gap point
+  // lies in the triangle and off the region by more than tol·cos(π/8) (the octagons
+  // inscribed in the vertices' tol-discs). Random clouds with empty discs give notches,
+  // holes and islands; the triangles' corners are cloud points (inside the hull), some
+  // large, some small.
+  for_ragged_shapes(25, [](int trial, const std::vector<Vec2>& cloud, const AlphaShape2D& shape, double tol,
+                           std::mt19937_64& rng) {
+    std::uniform_real_distribution<double> u(-10.0, 10.0);
+    std::uniform_int_distribution<std::size_t> pick(0, cloud.size() - 1);
+    std::vector<std::array<Vec2, 3>> tris;
+    for (int i = 0; i < 200; ++i) {
+      const Vec2 a = cloud[pick(rng)];
+      if (i % 2 == 0) {
+        tris.push_back({a, cloud[pick(rng)], cloud[pick(rng)]});
+        continue;
+      }
+      // A small triangle: corners are the cloud points nearest to a + random offsets.
+      std::array<Vec2, 3> t{a, a, a};
+      for (int k = 1; k < 3; ++k) {
+        const Vec2 target = a + Vec2(u(rng), u(rng)) * 0.15;
+        double best = std::numeric_limits<double>::infinity();
+        for (const Vec2& q : cloud)
+          if ((q - target).squaredNorm() < best) {
+            best = (q - target).squaredNorm();
+            t[k] = q;
+          }
+      }
+      tris.push_back(t);
+    }
+    int with_gaps = 0;
+    for (const auto& t : tris) {
+      const auto gaps = shape.triangle_gaps(t[0], t[1], t[2], tol, 0.1);
+      const double longest = std::max({(t[1] - t[0]).norm(), (t[2] - t[1]).norm(), (t[0] - t[2]).norm()});
+      const double area2 = std::abs((t[1] - t[0]).x() * (t[2] - t[0]).y() - (t[1] - t[0]).y() * (t[2] - t[0]).x());
+      for (const auto& q : gaps) {
+        ASSERT_FALSE(shape.contains(q, tol * std::cos(M_PI / 8) * (1 - 1e-9)))
+            << "trial " << trial << " gap point " << q.transpose();
+        if (area2 > 1e-9 * longest * longest) {
+          // Inside the triangle (barycentric coordinates ≥ 0 up to rounding).
+          for (int e = 0; e < 3; ++e) {
+            const Vec2 p = t[e], pq = t[(e + 1) % 3] - p, r = t[(e + 2) % 3] - p, pv = q - p;
+            const double side = (pq.x() * pv.y() - pq.y() * pv.x()) * (pq.x() * r.y() - pq.y() * r.x());
+            ASSERT_GE(side, -1e-9 * longest * longest * longest * longest) << "trial " << trial;
+          }
+        }
+      }
+      const int n = 64;
+      const double step = longest / n;
+      bool far = false, all_within = true;
+      for (const Vec2& q : triangle_lattice(t[0], t[1], t[2], n)) {
+        far = far || !shape.contains(q, tol + step);
+        all_within = all_within && shape.contains(q, tol * (1 + 1e-9) + 1e-12 * longest);
+      }
+      if (far) {
+        ASSERT_FALSE(gaps.empty()) << "trial " << trial << " triangle " << t[0].transpose() << ", "
+                                   << t[1].transpose() << ", " << t[2].transpose();
+      }
+      if (gaps.empty()) {
+        ASSERT_TRUE(all_within) << "trial " << trial << " triangle " << t[0].transpose() << ", "
+                                << t[1].transpose() << ", " << t[2].transpose();
+      }
+      with_gaps += gaps.empty() ? 0 : 1;
+    }
+    EXPECT_GT(with_gaps, 0);
+    EXPECT_LT(with_gaps, static_cast<int>(tris.size()));
+  });
+}
+
+TEST(AlphaShape2D, FillPinchesJoinsPiecesThatTouchAtAVertex) {
+  // Two small triangles meeting at the origin, opposite each other (a bow tie), and α
+  // between their circumradius (0.57) and that of every other Delaunay triangle (flat
+  // ones across): the α-shape is two pieces touching at a vertex (an extrusion of it
+  // touches along an edge). fill_pinches keeps the faces of one side of the origin: one
+  // piece, grown only; a region without pinches is left alone.
+  const std::vector<Vec2> pts = {{0, 0}, {1, 0}, {0.5, 0.3}, {-1, 0}, {-0.5, -0.3}};
+  AlphaShape2D s(pts, 0.6);
+  ASSERT_EQ(s.polygons().size(), 2u);
+  const double before = s.area();
+  EXPECT_NEAR(before, 2 * 0.15, 1e-12);
+  const double added = s.fill_pinches();
+  EXPECT_GT(added, 0.0);
+  EXPECT_NEAR(s.area(), before + added, 1e-12);
+  const auto polys = s.polygons();
+  ASSERT_EQ(polys.size(), 1u);
+  EXPECT_TRUE(polys[0].holes.empty());
+  for (const auto& p : pts) EXPECT_TRUE(s.contains(p));
+  EXPECT_EQ(s.fill_pinches(), 0.0);
+  AlphaShape2D square(grid_points(0, 0, 4, 4, 0.5), 0.4);
+  EXPECT_EQ(square.fill_pinches(), 0.0);
+  EXPECT_NEAR(square.area(), 16.0, 1e-9);
 }
 
 TEST(AlphaShape2D, MergeCollinearKeepsCorners) {
@@ -832,8 +992,20 @@ TEST_P(AlphaSimReal, ContainsTheOriginal) {
   if (r.fallback != AlphaSimFallback::Original) {
     EXPECT_TRUE(r.closed_after);
     ASSERT_TRUE(sp.solid);
-    // Every original vertex is inside the implicit solid.
+    // Every original vertex is inside the implicit solid, and (exact containment) every
+    // point of every triangle: a barycentric lattice at L_max/4 of each, corners and
+    // edges included.
     for (const auto& v : p.mesh.vertices) ASSERT_TRUE(sp.solid->contains(v, r.tolerance));
+    std::size_t outside = 0, tested = 0;
+    for (const auto& f : p.mesh.triangles) {
+      const Vec3 a = p.mesh.vertices[f[0]], b = p.mesh.vertices[f[1]], c = p.mesh.vertices[f[2]];
+      const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+      const int n = std::max(1, static_cast<int>(std::ceil(longest / (r.l_max / 4.0))));
+      for (int i = 0; i <= n; ++i)
+        for (int j = 0; i + j <= n; ++j, ++tested)
+          outside += sp.solid->contains(a + (b - a) * (double(i) / n) + (c - a) * (double(j) / n), r.tolerance) ? 0 : 1;
+    }
+    EXPECT_EQ(outside, 0u) << "of " << tested << " lattice points of the triangles";
     if (r.closed_before) {
       EXPECT_GE(r.volume_after, r.volume_before * (1 - 1e-6));
     }
@@ -883,15 +1055,24 @@ TEST(AlphaSim, LatticeBitmapGivesTheSortedSampleSets) {
   }
 }
 
+namespace {
+/// A w × h rectangle of two triangles in the XY plane from (0.3, 0.3): its corners lie off
+/// the lattices of spacing 1 and 2.
+Mesh offset_rectangle(double w, double h) {
+  Mesh m;
+  m.vertices = {{0.3, 0.3, 0}, {0.3 + w, 0.3, 0}, {0.3 + w, 0.3 + h, 0}, {0.3, 0.3 + h, 0}};
+  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  return m;
+}
+}  // namespace
+
 TEST(AlphaSim, OnlyOutlineEdgesAreSubdivided) {
   // A 10 × 5 rectangle of two triangles in the XY plane, placed so that no lattice node
   // (spacing 1) lies on its diagonal: the diagonal is interior to the projection (its two
   // triangles lie on either side) and gets no subdivision points — the lattice nodes of
   // the two triangles sample the area around it — while the four sides are subdivided to
   // ≤ L_max. Seen edge-on (XZ) every edge is an outline and is subdivided.
-  Mesh m;
-  m.vertices = {{0.3, 0.3, 0}, {10.3, 0.3, 0}, {10.3, 5.3, 0}, {0.3, 5.3, 0}};
-  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  const Mesh m = offset_rectangle(10.0, 5.0);
   const double l_max = 1.0, snap = std::exp2(-30.0);
   AlphaSimPrism xy;
   const auto smp = alpha_sim_plane_samples(m, xy, l_max, snap);
@@ -958,6 +1139,41 @@ TEST(AlphaSim, PointsInCoveredLatticeCellsAreLeftOutChecksAreKept) {
   EXPECT_EQ(fin_corners, 4u);
 }
 
+TEST(AlphaSim, CoarseInteriorKeepsTheCornersOfFullCellsOnly) {
+  // A 20 × 10 plate face-on (two triangles, corners off the lattice), L_max = 1: with the
+  // coarse interior the nodes of odd index are dropped only where the cells of spacing 2
+  // around them have all nine nodes; every even node, every point near the outline and
+  // every check stays, and the α-shape (α = 1.9) is the same rectangle. The bitmap and
+  // the sorting path agree.
+  const Mesh m = offset_rectangle(20.0, 10.0);
+  const double l_max = 1.0, snap = std::exp2(-30.0);
+  AlphaSimPrism xy;
+  const auto fine = alpha_sim_plane_samples(m, xy, l_max, snap, true, false);
+  const auto coarse = alpha_sim_plane_samples(m, xy, l_max, snap, true, true);
+  const auto coarse_sorted = alpha_sim_plane_samples(m, xy, l_max, snap, false, true);
+  EXPECT_TRUE(coarse.points == coarse_sorted.points);
+  EXPECT_TRUE(coarse.checks == fine.checks);
+  auto less = [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); };
+  EXPECT_TRUE(std::includes(fine.points.begin(), fine.points.end(), coarse.points.begin(), coarse.points.end(), less));
+  std::size_t dropped = 0;
+  for (const Vec2& p : fine.points) {
+    if (std::binary_search(coarse.points.begin(), coarse.points.end(), p, less)) continue;
+    ++dropped;
+    const long i = std::lround(p.x()), j = std::lround(p.y());
+    EXPECT_TRUE((i & 1) || (j & 1)) << p.transpose();  // an odd node
+    // The nodes 1..20 × 1..10 are met: a dropped node has its 2-cells inside them.
+    EXPECT_TRUE(i >= 2 && i <= 19 && j >= 2 && j <= 9) << p.transpose();
+  }
+  // Nodes 1..20 × 1..10: the complete 2-cells have even lower corners in 2..18 × 2..8.
+  // Dropped: odd/odd 3..19 × 3..9 (9 × 4), odd/even 3..19 × 4..8 (9 × 3), even/odd
+  // 4..18 × 3..9 (8 × 4).
+  EXPECT_EQ(dropped, 36u + 27u + 32u);
+  const AlphaShape2D a(fine.points, 1.9), b(coarse.points, 1.9);
+  EXPECT_NEAR(a.area(), 200.0, 1e-6);
+  EXPECT_NEAR(b.area(), a.area(), 1e-6);
+  for (const Vec2& c : fine.checks) EXPECT_TRUE(b.contains(c, 1e-9)) << c.transpose();
+}
+
 // ---------------------------------------------------------- determinism, indices
 
 TEST(AlphaSim, DeterministicAcrossRuns) {
@@ -1020,19 +1236,24 @@ TEST(AlphaSim, FacesSeenEdgeOnAreCheckedAsTheirEdges) {
   // A faceted cylinder along x: its 48 side facets (96 triangles) are edge-on in the end
   // view, each its own chord; the caps' 96 fan triangles in the two side views, one merged
   // segment per cap. The result contains the original (oracle) with the segment checks
-  // and without them (the samples of those triangles tested instead).
+  // (exact containment, and the random-sample path) and without them (the samples of
+  // those triangles tested instead); with exact containment the other triangles are
+  // tested whole.
   Mesh cyl = cylinder_mesh(5.0, 20.0, 48);
   for (auto& v : cyl.vertices) v = Vec3(v.z(), v.x(), v.y());  // along x
   const Part c = make_part("cyl-x", cyl);
-  AlphaSimOptions sampled = options(1.0);
+  AlphaSimOptions random_samples = options(1.0), sampled = options(1.0);
+  random_samples.exact_containment = false;
+  sampled.exact_containment = false;
   sampled.edge_on_segments = false;
-  for (const AlphaSimOptions& o : {options(1.0), sampled}) {
+  for (const AlphaSimOptions& o : {options(1.0), random_samples, sampled}) {
     const auto r = simplify_part(c, o);
     ASSERT_EQ(r.result.status, AlphaSimStatus::Ok) << r.result.reason;
     for (const auto& p : r.result.projections) {
       const bool end_view = std::abs(p.normal.x()) == 1.0;
       EXPECT_EQ(p.edge_on_triangles, o.edge_on_segments ? 96u : 0u) << p.plane;
       EXPECT_EQ(p.edge_on_segments, !o.edge_on_segments ? 0u : end_view ? 48u : 2u) << p.plane;
+      EXPECT_EQ(p.exact_triangles, o.exact_containment ? c.mesh.triangle_count() - 96u : 0u) << p.plane;
     }
     const auto samples = dense_surface_samples(c.mesh, 0.25, 4.0, 100000, 31);
     EXPECT_DOUBLE_EQ(oracle_containment(r.mesh, samples, r.result.tolerance), 1.0);
@@ -1185,6 +1406,7 @@ TEST(AlphaSim, VerificationRoundsRepairWhatTheFirstRepairMissed) {
   // Its facets along the axis, seen edge-on, are sampled like the others here: their
   // exact segment checks (edge_on_segments) would repair those gaps before the rounds.
   AlphaSimOptions o = options(0.01 * p.mesh.bounds().diagonal());
+  o.exact_containment = false;  // the random-sample path, whose rounds this tests
   o.cover_samples = false;
   o.edge_on_segments = false;
   const auto sp = simplify_part(p, o);
