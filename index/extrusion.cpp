@@ -497,14 +497,33 @@ ExtrusionsMesh mesh_extrusions_in_order(const std::vector<Extrusion>& kept, doub
   // The pair slicer takes two axis extrusions whose normals are different axes; it is far
   // cheaper than a general Boolean, so the first two go through it whenever it can.
   const bool pair = kept.size() >= 2 && axis_aligned(kept[0]) && axis_aligned(kept[1]) && kept[0].n.dot(kept[1].n) == 0.0;
+  // A share of tol for removing, before a Boolean, the vertices the slicing left on the
+  // sliced pair's straight edges (where the slab planes cut them: on the edge lines up to
+  // rounding): half the triangles for the corefinement to cut, which then takes half the
+  // time (the bunny's 1,164 -> 584 triangles, 90 -> 40 ms). The rest of tol is used after.
+  constexpr double kSliceMergeShare = 1e-3;
+  const bool boolean_follows = kept.size() > (pair ? 2u : 1u);
   ExtrusionsMesh acc;
-  if (pair) acc = extrusion_pair_mesh(kept[0], kept[1]);
-  else static_cast<FacedMesh&>(acc) = labelled_extrusion_mesh(kept[0]);
+  if (pair) {
+    acc = extrusion_pair_mesh(kept[0], kept[1]);
+    if (boolean_follows) {
+      // Only fewer triangles for the Boolean to cut: a face merge_face_vertices refuses
+      // (its boundary loops cross in its plane) is left to the Boolean as sliced.
+      FacedMesh merged = acc;
+      try {
+        merge_face_vertices(merged, kSliceMergeShare * tol);
+        static_cast<FacedMesh&>(acc) = std::move(merged);
+      } catch (const std::runtime_error&) {
+      }
+    }
+  } else {
+    static_cast<FacedMesh&>(acc) = labelled_extrusion_mesh(kept[0]);
+  }
   for (std::size_t i = pair ? 2 : 1; i < kept.size(); ++i) {
     static_cast<FacedMesh&>(acc) = mesh_intersection(acc, labelled_extrusion_mesh(kept[i]));
     ++acc.booleans;
   }
-  if (acc.booleans > 0) merge_face_vertices(acc, tol);
+  if (acc.booleans > 0) merge_face_vertices(acc, (pair ? 1.0 - kSliceMergeShare : 1.0) * tol);
   return acc;
 }
 

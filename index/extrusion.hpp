@@ -83,7 +83,8 @@ ExtrusionsMesh extrusion_pair_mesh(const Extrusion& a, const Extrusion& b);
 /// intersected with the rest by exact corefinement of the meshes (mesh_intersection), one
 /// general Boolean each, after which the vertices the corefinement left inside faces and
 /// along straight edges are removed (merge_face_vertices; the solid moves by at most
-/// `tol`, scene units). Of three, the pair sliced first is the first of (0, 1), (0, 2),
+/// `tol`, scene units; a thousandth of it is used before the Boolean, on the vertices the
+/// slicing left on straight edges). Of three, the pair sliced first is the first of (0, 1), (0, 2),
 /// (1, 2) whose Boolean succeeds (pieces that touch make CGAL refuse it). Faces: as those
 /// give them. Throws std::runtime_error for an empty list, and what those throw.
 ExtrusionsMesh mesh_extrusions(const std::vector<Extrusion>& kept, double tol);
