@@ -402,7 +402,7 @@ Vec2 snap_to_grid(const Vec2& q, double snap) {
 AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
                                        const std::vector<MeshEdge>& edges,
                                        const AlphaSimPrism& pr, double l_max, double snap, bool lattice_bitmap,
-                                       bool coarse_interior) {
+                                       bool coarse_interior, bool all_checks) {
   AlphaSimPlaneSamples s;
   auto snapped = [snap](const Vec2& q) { return snap_to_grid(q, snap); };
   std::vector<Vec2> proj(mesh.vertices.size());
@@ -418,16 +418,17 @@ AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
   }
   const std::size_t max_bits = lattice_bitmap ? kMaxLatticeBitmapBits : 0;
   LatticeBitmap nodes(lo, hi, l_max, 0.0, max_bits), centres(lo, hi, l_max, 0.5, max_bits);
-  std::vector<std::pair<long, long>> node_list;  // without the bitmap: every node met, sorted below
+  // Without the bitmaps: every node and cell centre met, sorted below.
+  std::vector<std::pair<long, long>> node_list, centre_list;
   for (const auto& f : mesh.triangles) {
     const Vec2 a = proj[f[0]], b = proj[f[1]], c = proj[f[2]];
     lattice_in_triangle(a, b, c, l_max, 0.0, [&](long i, long j) {
       if (!nodes.active() || !nodes.set(i, j)) node_list.emplace_back(i, j);
     });
     lattice_in_triangle(a, b, c, l_max, 0.5, [&](long i, long j) {
-      if (!centres.active() || !centres.set(i, j)) s.checks.push_back(snapped(centres.at(i, j)));
+      if (!centres.active() || !centres.set(i, j)) centre_list.emplace_back(i, j);
     });
-    s.checks.push_back(snapped((a + b + c) / 3.0));
+    if (all_checks) s.checks.push_back(snapped((a + b + c) / 3.0));
   }
   std::sort(node_list.begin(), node_list.end());
   node_list.erase(std::unique(node_list.begin(), node_list.end()), node_list.end());
@@ -456,6 +457,13 @@ AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
   };
   for (const auto& [i, j] : node_list)
     if (keep_node(i, j)) s.points.push_back(snapped(nodes.at(i, j)));
+  // A cell centre in a complete cell of 2·L_max is in the region (its two triangles are
+  // kept): no check.
+  auto keep_centre = [&](long i, long j) {
+    return !coarse_interior || !complete_coarse_cell(i - ((i & 1) != 0), j - ((j & 1) != 0));
+  };
+  for (const auto& [i, j] : centre_list)
+    if (keep_centre(i, j)) s.checks.push_back(snapped(centres.at(i, j)));
   // A point in a lattice cell whose four corners are nodes adds nothing to the region: the
   // corners already give the α-shape that cell (two triangles of circumradius L_max/√2,
   // below α = 1.9·L_max at the default factors), and the checks, all kept, repair it
@@ -488,15 +496,15 @@ AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
         const Vec2 q = pa + (pb - pa) * (static_cast<double>(k) / n);
         if (!in_covered_cell(q)) s.points.push_back(snapped(q));
       }
-    for (int k = 0; k < n; ++k) s.checks.push_back(snapped(pa + (pb - pa) * ((k + 0.5) / n)));
+    if (e[4] != 0.0 || all_checks)
+      for (int k = 0; k < n; ++k) s.checks.push_back(snapped(pa + (pb - pa) * ((k + 0.5) / n)));
   }
   sort_unique(s.points);
   sort_unique(s.checks);
   if (nodes.active())
     merge_unique(s.points, nodes.points([&](long i, long j) { return snapped(nodes.at(i, j)); }, keep_node));
   if (centres.active())
-    merge_unique(s.checks, centres.points([&](long i, long j) { return snapped(centres.at(i, j)); },
-                                          [](long, long) { return true; }));
+    merge_unique(s.checks, centres.points([&](long i, long j) { return snapped(centres.at(i, j)); }, keep_centre));
   return s;
 }
 
@@ -920,9 +928,9 @@ std::vector<ProjectionReport> turned_projections(const std::vector<ProjectionRep
 }  // namespace
 
 AlphaSimPlaneSamples alpha_sim_plane_samples(const Mesh& mesh, const AlphaSimPrism& frame, double l_max, double snap,
-                                             bool lattice_bitmap, bool coarse_interior) {
+                                             bool lattice_bitmap, bool coarse_interior, bool all_checks) {
   if (!(l_max > 0.0 && snap > 0.0)) throw std::invalid_argument("alpha-sim: l_max and snap must be > 0");
-  return sample_projection(mesh, unique_edges(mesh), frame, l_max, snap, lattice_bitmap, coarse_interior);
+  return sample_projection(mesh, unique_edges(mesh), frame, l_max, snap, lattice_bitmap, coarse_interior, all_checks);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -1050,7 +1058,8 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
         pr.depth_max = std::max(pr.depth_max, d);
       }
     AlphaSimPlaneSamples& smp = plane_samples[k];
-    smp = sample_projection(part.mesh, edges, pr, r.l_max, snap, true, coarse_interior);
+    // The exact test finds what centroids and midpoints of interior edges would.
+    smp = sample_projection(part.mesh, edges, pr, r.l_max, snap, true, coarse_interior, !opt.exact_containment);
     const std::vector<Vec2>& pts = smp.points;
     rep.points = pts.size();
     auto shape = std::make_shared<AlphaShape2D>(pts, r.alpha, std::min(opt.short_edge_factor * r.l_max, r.alpha));

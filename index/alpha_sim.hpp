@@ -263,10 +263,13 @@ struct AlphaSimPlaneSamples {
 /// Vertices and subdivision points in a lattice cell whose four corners are nodes are
 /// left out of the points (the corners already cover that cell); every check is kept.
 /// lattice_bitmap = false deduplicates by sorting every point (the reference; same sets).
-/// coarse_interior drops the nodes of odd index inside the cells of spacing 2·l_max whose
-/// nine nodes are all met (the interior; AlphaSimOptions::coarse_interior).
+/// coarse_interior drops the nodes of odd index, and the cell centres, inside the cells of
+/// spacing 2·l_max whose nine nodes are all met (the interior;
+/// AlphaSimOptions::coarse_interior). all_checks = false leaves out the centroids and the
+/// midpoints of edges inside the projection (exact_containment tests those triangles whole).
 AlphaSimPlaneSamples alpha_sim_plane_samples(const Mesh& mesh, const AlphaSimPrism& frame, double l_max, double snap,
-                                             bool lattice_bitmap = true, bool coarse_interior = false);
+                                             bool lattice_bitmap = true, bool coarse_interior = false,
+                                             bool all_checks = true);
 
 /// Dense samples of a mesh surface: the fixed points — vertices and edge midpoints (each
 /// once) and centroids — unless fixed_points is false, and random points (≈ density per

@@ -1142,8 +1142,9 @@ TEST(AlphaSim, PointsInCoveredLatticeCellsAreLeftOutChecksAreKept) {
 TEST(AlphaSim, CoarseInteriorKeepsTheCornersOfFullCellsOnly) {
   // A 20 × 10 plate face-on (two triangles, corners off the lattice), L_max = 1: with the
   // coarse interior the nodes of odd index are dropped only where the cells of spacing 2
-  // around them have all nine nodes; every even node, every point near the outline and
-  // every check stays, and the α-shape (α = 1.9) is the same rectangle. The bitmap and
+  // around them have all nine nodes, and so are the cell centres (checks) in such cells;
+  // every even node, every point near the outline and every other check stays, and the
+  // α-shape (α = 1.9) is the same rectangle and holds every check of the fine lattice. The bitmap and
   // the sorting path agree.
   const Mesh m = offset_rectangle(20.0, 10.0);
   const double l_max = 1.0, snap = std::exp2(-30.0);
@@ -1152,8 +1153,11 @@ TEST(AlphaSim, CoarseInteriorKeepsTheCornersOfFullCellsOnly) {
   const auto coarse = alpha_sim_plane_samples(m, xy, l_max, snap, true, true);
   const auto coarse_sorted = alpha_sim_plane_samples(m, xy, l_max, snap, false, true);
   EXPECT_TRUE(coarse.points == coarse_sorted.points);
-  EXPECT_TRUE(coarse.checks == fine.checks);
+  EXPECT_TRUE(coarse.checks == coarse_sorted.checks);
   auto less = [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); };
+  // The cell centres inside complete 2-cells are no checks either: 2 × 2 per such cell.
+  EXPECT_TRUE(std::includes(fine.checks.begin(), fine.checks.end(), coarse.checks.begin(), coarse.checks.end(), less));
+  EXPECT_EQ(fine.checks.size() - coarse.checks.size(), 9u * 4u * 4u);
   EXPECT_TRUE(std::includes(fine.points.begin(), fine.points.end(), coarse.points.begin(), coarse.points.end(), less));
   std::size_t dropped = 0;
   for (const Vec2& p : fine.points) {
