@@ -281,7 +281,8 @@ struct AlphaShape2D::Impl {
   // (CCW) and, per edge e (opposite corner e), whether the face across it is kept.
   std::vector<std::array<Vec2, 3>> removed_coords;
   std::vector<std::array<bool, 3>> removed_kept_edge;
-  BucketGrid tri_grid, seg_grid, removed_grid;
+  Vec2 removed_lo, removed_hi;  // the removed faces' bounding box
+  BucketGrid tri_grid, seg_grid;
   FlagGrid flags;
   double area = 0.0;
 
@@ -300,7 +301,9 @@ struct AlphaShape2D::Impl {
     removed_coords.clear();
     removed_kept_edge.clear();
     Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity());
-    Vec2 hi = -lo, removed_lo = lo, removed_hi = hi;
+    Vec2 hi = -lo;
+    removed_lo = lo;
+    removed_hi = hi;
     std::vector<std::array<Vec2, 2>> tri_boxes, seg_boxes;
     for (std::uint32_t i = 0; i < faces.size(); ++i) {
       if (!kept[i]) {
@@ -331,15 +334,14 @@ struct AlphaShape2D::Impl {
     }
     tri_grid.build(tri_boxes, lo, hi, kTriangleBoxesPerCell);
     seg_grid.build(seg_boxes, lo, hi, kSegmentBoxesPerCell);
-    removed_grid.build_triangles(removed_coords, removed_lo, removed_hi, kTriangleBoxesPerCell);
     build_flags(lo, hi);
   }
 
   /// Appends the gap points of triangle t (plane coordinates, inside the hull; with area)
   /// to `gaps` (see AlphaShape2D::triangle_gaps); `serial` is distinct per triangle of one
   /// scratch (marks the removed faces already listed for it).
-  void triangle_gaps(std::array<Vec2, 3> t, std::uint32_t serial, double tol, double spacing, GapScratch& g,
-                     std::vector<Vec2>& gaps) const;
+  void triangle_gaps(std::array<Vec2, 3> t, std::uint32_t serial, const BucketGrid& removed_grid, double tol,
+                     double spacing, GapScratch& g, std::vector<Vec2>& gaps) const;
 
   /// Replaces `poly` by its pieces (in `pieces`) outside every tol-rectangle of a boundary
   /// edge (the points within tol of the edge's line whose foot lies on the edge) and every
@@ -902,8 +904,8 @@ struct GapScratch {
 
 }  // namespace
 
-void AlphaShape2D::Impl::triangle_gaps(std::array<Vec2, 3> t, std::uint32_t serial, double tol, double spacing,
-                                       GapScratch& g, std::vector<Vec2>& gaps) const {
+void AlphaShape2D::Impl::triangle_gaps(std::array<Vec2, 3> t, std::uint32_t serial, const BucketGrid& removed_grid,
+                                       double tol, double spacing, GapScratch& g, std::vector<Vec2>& gaps) const {
   const double t_area = tri_area(t);
   const double t_scale2 =
       std::max({(t[1] - t[0]).squaredNorm(), (t[2] - t[1]).squaredNorm(), (t[0] - t[2]).squaredNorm()});
@@ -976,6 +978,10 @@ std::vector<Vec2> AlphaShape2D::triangles_gaps(const std::vector<std::array<Vec2
   if (triangles.size() >= std::numeric_limits<std::uint32_t>::max())
     throw std::invalid_argument("AlphaShape2D::triangles_gaps: too many triangles");
   const Impl& m = *impl_;
+  // The removed faces on a grid, listed along their area (built here, not with every
+  // change of the region: most changes are followed by no such query).
+  BucketGrid removed_grid;
+  removed_grid.build_triangles(m.removed_coords, m.removed_lo, m.removed_hi, kTriangleBoxesPerCell);
   tbb::enumerable_thread_specific<std::vector<Vec2>> found;
   tbb::enumerable_thread_specific<GapScratch> scratch([&m] {
     GapScratch g;
@@ -999,7 +1005,7 @@ std::vector<Vec2> AlphaShape2D::triangles_gaps(const std::vector<std::array<Vec2
         continue;
       }
       // Every finite face kept: the hull is the region.
-      if (!m.removed_grid.empty()) m.triangle_gaps(t, static_cast<std::uint32_t>(i), tol, spacing, g, out);
+      if (!removed_grid.empty()) m.triangle_gaps(t, static_cast<std::uint32_t>(i), removed_grid, tol, spacing, g, out);
     }
   });
   std::vector<Vec2> gaps;

@@ -265,8 +265,9 @@ struct AlphaSimPlaneSamples {
 /// lattice_bitmap = false deduplicates by sorting every point (the reference; same sets).
 /// coarse_interior drops the nodes of odd index, and the cell centres, inside the cells of
 /// spacing 2·l_max whose nine nodes are all met (the interior;
-/// AlphaSimOptions::coarse_interior). all_checks = false leaves out the centroids and the
-/// midpoints of edges inside the projection (exact_containment tests those triangles whole).
+/// AlphaSimOptions::coarse_interior). all_checks = false leaves out the cell centres, the
+/// centroids and the midpoints of edges inside the projection (exact_containment tests
+/// the triangles whole; the outline's sub-edge midpoints stay).
 AlphaSimPlaneSamples alpha_sim_plane_samples(const Mesh& mesh, const AlphaSimPrism& frame, double l_max, double snap,
                                              bool lattice_bitmap = true, bool coarse_interior = false,
                                              bool all_checks = true);
