@@ -535,11 +535,19 @@ double AlphaShape2D::fill_pinches() {
   const double before = m.area;
   // Filling the faces around one vertex can pinch a neighbour: a few rounds.
   constexpr int kMaxRounds = 8;
-  bool any = false;
   std::vector<Face> ring;
+  std::vector<DT::Vertex_handle> candidates;
   for (int round = 0; round < kMaxRounds; ++round) {
     bool changed = false;
-    for (auto v = m.dt.finite_vertices_begin(); v != m.dt.finite_vertices_end(); ++v) {
+    // A pinched vertex has kept faces on both sides of a gap: it ends boundary edges.
+    candidates.clear();
+    for (const auto& se : m.segment_edge) {
+      const Face f = m.faces[static_cast<std::size_t>(se[0])];
+      candidates.push_back(f->vertex(DT::ccw(se[1])));
+    }
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    for (const auto& v : candidates) {
       ring.clear();
       auto fc = m.dt.incident_faces(v), done = fc;
       do ring.push_back(fc);
@@ -593,9 +601,8 @@ double AlphaShape2D::fill_pinches() {
       changed = true;
     }
     if (!changed) break;
-    any = true;
+    m.refresh();  // the region, and the boundary edges of the next round
   }
-  if (any) m.refresh();
   return m.area - before;
 }
 
