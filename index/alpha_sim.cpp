@@ -362,6 +362,11 @@ constexpr std::size_t kMaxLatticeBitmapBits = std::size_t(1) << 26;
 /// snapped nodes may be that much larger than the ideal one.
 constexpr double kCoarseCellAlphaMargin = 0.9;
 
+/// Triangles seen edge-on (narrower than kEdgeOnWidthShare·tol in projection) are checked
+/// by their longest edge within kEdgeOnTolShare·tol (edge_on_triangles): with the snap
+/// (≤ tol/4, moving a point by ≤ 0.18·tol) that keeps every point of them within tol.
+constexpr double kEdgeOnWidthShare = 0.25, kEdgeOnTolShare = 0.5;
+
 /// Lexicographic order (x, then y) of plane points.
 struct Vec2Less {
   bool operator()(const Vec2& p, const Vec2& q) const { return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y()); }
@@ -842,7 +847,7 @@ void exact_projection(const Mesh& mesh, const AlphaSimPrism& pr, double snap, do
   // The first passes repair by inserting the gap points (a notch closes with small
   // triangles), the later ones by keeping the faces that hold them.
   constexpr int kRefinePasses = 1;
-  const double edge_on_width = tol / 4.0, edge_on_tol = tol / 2.0;  // as in simplify_part
+  const double edge_on_width = kEdgeOnWidthShare * tol, edge_on_tol = kEdgeOnTolShare * tol;
   const double triangle_tol = tol - snap * M_SQRT1_2;
   const double gap_spacing = l_max / 4.0;
   edge_on = edge_on_triangles(mesh, pr, edge_on_width, 0.0, snap);
@@ -859,10 +864,9 @@ void exact_projection(const Mesh& mesh, const AlphaSimPrism& pr, double snap, do
   rep.exact_triangles = tested.size();
   // Front and back faces of a plate, and the walls of a hole seen along its axis, project
   // onto the same triangles: each is tested once (the spar's end view: 12,252 -> 632).
-  const auto less = [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); };
-  for (auto& t : tested) std::sort(t.begin(), t.end(), less);
-  std::sort(tested.begin(), tested.end(), [&](const auto& a, const auto& b) {
-    return std::lexicographical_compare(a.begin(), a.end(), b.begin(), b.end(), less);
+  for (auto& t : tested) std::sort(t.begin(), t.end(), Vec2Less());
+  std::sort(tested.begin(), tested.end(), [](const auto& a, const auto& b) {
+    return std::lexicographical_compare(a.begin(), a.end(), b.begin(), b.end(), Vec2Less());
   });
   tested.erase(std::unique(tested.begin(), tested.end()), tested.end());
   repair_projection(shape, checks, exact, tol, torn_fraction, rep);
@@ -1037,10 +1041,9 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   // faces) would otherwise give sliver triangles and spurious boundary loops.
   // A power of two, so that coordinates on a binary grid (integers, halves) stay exact.
   const double snap = std::exp2(std::floor(std::log2(tol / 4.0)));
-  // Triangles seen edge-on (narrower than edge_on_width in projection) are checked by
-  // their longest edge within edge_on_tol instead of by samples (edge_on_triangles):
-  // width + snap·√2/2 + edge_on_tol ≤ (1/4 + 0.18 + 1/2)·tol keeps their samples within tol.
-  const double edge_on_width = tol / 4.0, edge_on_tol = tol / 2.0;
+  // Triangles seen edge-on are checked by their longest edge instead of by samples
+  // (kEdgeOnWidthShare, kEdgeOnTolShare).
+  const double edge_on_width = kEdgeOnWidthShare * tol, edge_on_tol = kEdgeOnTolShare * tol;
   // A thin triangle's edges are checked like its samples, within tol, less their snapping.
   const double thin_edge_tol = tol - snap * M_SQRT1_2;
   // Spacing of the points a gap of an edge-on segment adds to the checks.
