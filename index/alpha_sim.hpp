@@ -110,11 +110,11 @@ struct AlphaSimOptions {
 
 /// What happened to one projection plane.
 enum class ProjectionStatus {
-  Ok,        ///< the α-shape covered every sample
-  Repaired,  ///< a few Delaunay triangles were added so that every sample is covered
+  Ok,        ///< the α-shape covered every triangle (exact_containment; else every sample)
+  Repaired,  ///< Delaunay triangles were added (or points inserted) so that it does
   Empty,     ///< α too small for the sampling: no triangle kept → convex hull
   Torn,      ///< too much had to be repaired → convex hull
-  Eroded,    ///< the α-shape missed dense samples of the surface → convex hull
+  Eroded,    ///< the α-shape still missed part of the surface after its repairs → convex hull
 };
 /// "ok" | "repaired" | "empty" | "torn" | "eroded".
 const char* projection_status_name(ProjectionStatus s);
