@@ -161,13 +161,13 @@ struct BucketGrid {
         for_cell(i, j, [&](std::uint32_t k) { out.push_back(k); });
     }
   }
-  /// Calls f(item, i, j) for the items listed in each cell (i, j) that the box lo..hi
-  /// meets (clamped to the grid): an item in several of those cells, once per cell.
+  /// Calls f(item) for the items listed in each cell that the box lo..hi meets (clamped
+  /// to the grid): an item in several of those cells, once per cell.
   template <class F>
   void for_box(const Vec2& lo, const Vec2& hi, F&& f) const {
     if (empty()) return;
     for (int j = cy(lo.y()), j1 = cy(hi.y()); j <= j1; ++j)
-      for (int i = cx(lo.x()), i1 = cx(hi.x()); i <= i1; ++i) for_cell(i, j, [&](std::uint32_t k) { f(k, i, j); });
+      for (int i = cx(lo.x()), i1 = cx(hi.x()); i <= i1; ++i) for_cell(i, j, f);
   }
   template <class F>
   void for_cell(int x, int y, F&& f) const {
@@ -229,29 +229,17 @@ void clip_polygon(ClipPolygon& poly, const Vec2& n, double c, ClipPolygon& scrat
   poly.swap(scratch);
 }
 
-/// Twice the signed area of a polygon (positive when counter-clockwise).
-double twice_area(const ClipPolygon& poly) {
-  double a = 0.0;
-  for (std::size_t i = 0; i < poly.size(); ++i) {
-    const Vec2& p = poly[i];
-    const Vec2& q = poly[(i + 1) % poly.size()];
-    a += p.x() * q.y() - p.y() * q.x();
-  }
-  return a;
-}
-
-
 /// The pieces (convex, CCW) of `poly` outside the convex polygon given by the half-planes
-/// n·x ≥ c (appended to `out`), those of twice their area above min_twice_area only:
+/// n·x ≥ c (appended to `out`), those of area above min_area only:
 /// the part beyond the first half-plane, then beyond the second of what is inside the
 /// first, and so on.
 void subtract_convex(const ClipPolygon& poly, const std::array<Vec2, 8>& n, const std::array<double, 8>& c, int count,
-                     double min_twice_area, std::vector<ClipPolygon>& out, ClipPolygon& scratch) {
+                     double min_area, std::vector<ClipPolygon>& out, ClipPolygon& scratch) {
   ClipPolygon rest = poly, outside;
   for (int i = 0; i < count && rest.size() >= 3; ++i) {
     outside = rest;
     clip_polygon(outside, -n[i], -c[i], scratch);
-    if (outside.size() >= 3 && twice_area(outside) > min_twice_area) out.push_back(outside);
+    if (outside.size() >= 3 && ring_signed_area(outside) > min_area) out.push_back(outside);
     clip_polygon(rest, n[i], c[i], scratch);
   }
 }
@@ -337,17 +325,19 @@ struct AlphaShape2D::Impl {
     build_flags(lo, hi);
   }
 
-  /// Appends the gap points of triangle t (plane coordinates, inside the hull; with area)
-  /// to `gaps` (see AlphaShape2D::triangle_gaps); `serial` is distinct per triangle of one
-  /// scratch (marks the removed faces already listed for it).
-  void triangle_gaps(std::array<Vec2, 3> t, std::uint32_t serial, const BucketGrid& removed_grid, double tol,
-                     double spacing, GapScratch& g, std::vector<Vec2>& gaps) const;
+  /// Appends the gap points of triangle t (plane coordinates, inside the hull; CCW, with
+  /// area; t_scale2 its longest edge squared) to `gaps` (see AlphaShape2D::triangle_gaps);
+  /// `serial` is distinct per triangle of one scratch (marks the removed faces already
+  /// listed for it).
+  void triangle_gaps(const std::array<Vec2, 3>& t, double t_scale2, std::uint32_t serial,
+                     const BucketGrid& removed_grid, double tol, double spacing, GapScratch& g,
+                     std::vector<Vec2>& gaps) const;
 
   /// Replaces `poly` by its pieces (in `pieces`) outside every tol-rectangle of a boundary
   /// edge (the points within tol of the edge's line whose foot lies on the edge) and every
-  /// tol-octagon inscribed in the disc around a boundary vertex, near it; pieces of twice
-  /// their area at most min_twice_area are dropped. What it removes lies within tol of ∂R.
-  void subtract_boundary_neighbourhood(const ClipPolygon& poly, double tol, double min_twice_area,
+  /// tol-octagon inscribed in the disc around a boundary vertex, near it; pieces of area
+  /// at most min_area are dropped. What it removes lies within tol of ∂R.
+  void subtract_boundary_neighbourhood(const ClipPolygon& poly, double tol, double min_area,
                                        std::vector<ClipPolygon>& pieces, ClipPolygon& scratch) const;
 
   /// Fills `flags` over lo..hi (the kept triangles' bounding box); see FlagGrid.
@@ -545,7 +535,11 @@ double AlphaShape2D::fill_pinches() {
       const Face f = m.faces[static_cast<std::size_t>(se[0])];
       candidates.push_back(f->vertex(DT::ccw(se[1])));
     }
-    std::sort(candidates.begin(), candidates.end());
+    // In the order of their points (not of their handles, which are heap addresses: the
+    // fills around one vertex change the next, so the order must not follow the heap).
+    std::sort(candidates.begin(), candidates.end(), [](const DT::Vertex_handle& a, const DT::Vertex_handle& b) {
+      return a->point().x() < b->point().x() || (a->point().x() == b->point().x() && a->point().y() < b->point().y());
+    });
     candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
     for (const auto& v : candidates) {
       ring.clear();
@@ -554,12 +548,8 @@ double AlphaShape2D::fill_pinches() {
       while (++fc != done);
       const std::size_t n = ring.size();
       auto kept_at = [&](std::size_t i) { return m.is_kept(ring[i % n]); };
-      std::size_t runs = 0, first_gap = n;
-      for (std::size_t i = 0; i < n; ++i)
-        if (kept_at(i) && !kept_at(i + n - 1)) {
-          ++runs;
-          if (first_gap == n) first_gap = i + 1;  // a gap starts after a kept run ends... found below
-        }
+      std::size_t runs = 0;
+      for (std::size_t i = 0; i < n; ++i) runs += kept_at(i) && !kept_at(i + n - 1) ? 1 : 0;
       if (runs < 2) continue;
       // The gaps (runs of faces not kept), each with its angle at v; the one the hull's
       // outside lies in (an infinite face) stays open, else the widest.
@@ -846,7 +836,7 @@ bool separated_by_edge_of(const std::array<Vec2, 3>& t, const std::array<Vec2, 3
 
 }  // namespace
 
-void AlphaShape2D::Impl::subtract_boundary_neighbourhood(const ClipPolygon& poly, double tol, double min_twice_area,
+void AlphaShape2D::Impl::subtract_boundary_neighbourhood(const ClipPolygon& poly, double tol, double min_area,
                                                          std::vector<ClipPolygon>& pieces, ClipPolygon& scratch) const {
   pieces.assign(1, poly);
   if (!(tol > 0.0) || seg_grid.empty()) return;
@@ -857,7 +847,7 @@ void AlphaShape2D::Impl::subtract_boundary_neighbourhood(const ClipPolygon& poly
   }
   const Vec2 pad = Vec2::Constant(tol);
   std::vector<std::uint32_t> near;
-  seg_grid.for_box(lo - pad, hi + pad, [&](std::uint32_t k, int, int) { near.push_back(k); });
+  seg_grid.for_box(lo - pad, hi + pad, [&](std::uint32_t k) { near.push_back(k); });
   std::sort(near.begin(), near.end());
   near.erase(std::unique(near.begin(), near.end()), near.end());
   std::array<Vec2, 8> n;
@@ -866,7 +856,7 @@ void AlphaShape2D::Impl::subtract_boundary_neighbourhood(const ClipPolygon& poly
   std::vector<ClipPolygon> next;
   auto subtract = [&](int count) {
     next.clear();
-    for (const ClipPolygon& piece : pieces) subtract_convex(piece, n, c, count, min_twice_area, next, scratch);
+    for (const ClipPolygon& piece : pieces) subtract_convex(piece, n, c, count, min_area, next, scratch);
     pieces.swap(next);
   };
   for (std::uint32_t k : near) {
@@ -911,12 +901,9 @@ struct GapScratch {
 
 }  // namespace
 
-void AlphaShape2D::Impl::triangle_gaps(std::array<Vec2, 3> t, std::uint32_t serial, const BucketGrid& removed_grid,
-                                       double tol, double spacing, GapScratch& g, std::vector<Vec2>& gaps) const {
-  const double t_area = tri_area(t);
-  const double t_scale2 =
-      std::max({(t[1] - t[0]).squaredNorm(), (t[2] - t[1]).squaredNorm(), (t[0] - t[2]).squaredNorm()});
-  if (t_area < 0.0) std::swap(t[1], t[2]);
+void AlphaShape2D::Impl::triangle_gaps(const std::array<Vec2, 3>& t, double t_scale2, std::uint32_t serial,
+                                       const BucketGrid& removed_grid, double tol, double spacing, GapScratch& g,
+                                       std::vector<Vec2>& gaps) const {
   const Vec2 lo = t[0].cwiseMin(t[1]).cwiseMin(t[2]), hi = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
   // The removed faces listed in the cells t meets (both listed along their area only),
   // each once.
@@ -954,26 +941,27 @@ void AlphaShape2D::Impl::triangle_gaps(std::array<Vec2, 3> t, std::uint32_t seri
     }
     // What is left lies in d, farther than the strips from d's edges on ∂R (a piece of no
     // area at the scale of the two triangles is rounding of the clipping).
-    const double min_twice_area = 2e-12 * std::max(t_scale2, d_scale2);
-    if (poly.size() < 3 || !(twice_area(poly) > min_twice_area)) continue;
+    const double min_area = 1e-12 * std::max(t_scale2, d_scale2);
+    if (poly.size() < 3 || !(ring_signed_area(poly) > min_area)) continue;
     // The strips are narrow where d is flat, and a piece near a corner of ∂R may be
     // covered by several edges: the piece less every boundary edge's tol-rectangle and
     // boundary vertex's inscribed tol-octagon nearby (all within R ⊕ tol) is what remains.
-    subtract_boundary_neighbourhood(poly, tol, min_twice_area, g.pieces, g.clip);
+    subtract_boundary_neighbourhood(poly, tol, min_area, g.pieces, g.clip);
     for (const ClipPolygon& piece : g.pieces) {
       Vec2 c = Vec2::Zero();
       for (const Vec2& v : piece) c += v;
       c /= static_cast<double>(piece.size());
       gaps.push_back(c);
-      // Points along the piece's sides (a quarter of the way in: inside the convex piece),
-      // at most `spacing` apart, so that one repair closes a long sliver.
+      // Points along the piece's sides longer than `spacing`, at most that apart and a
+      // quarter of the way in (inside the convex piece), so that one repair closes a long
+      // sliver.
       for (std::size_t i = 0; i < piece.size(); ++i) {
         const Vec2 p = piece[i], pq = piece[(i + 1) % piece.size()] - p;
-        const int n = static_cast<int>(std::ceil(pq.norm() / spacing));
-        for (int j = 0; j < n && n > 1; ++j) {
-          const Vec2 q = p + pq * ((j + 0.5) / n);
-          gaps.push_back(q + 0.25 * (c - q));
-        }
+        const double len = pq.norm();
+        if (!(len > spacing)) continue;
+        const std::size_t first = gaps.size();
+        stretch_points(p, pq, len, 0.0, 1.0, spacing, gaps);
+        for (std::size_t j = first; j < gaps.size(); ++j) gaps[j] += 0.25 * (c - gaps[j]);
       }
     }
   }
@@ -999,11 +987,12 @@ std::vector<Vec2> AlphaShape2D::triangles_gaps(const std::vector<std::array<Vec2
     auto& out = found.local();
     auto& g = scratch.local();
     for (std::size_t i = rg.begin(); i != rg.end(); ++i) {
-      const auto& t = triangles[i];
+      std::array<Vec2, 3> t = triangles[i];
       const double t_scale2 =
           std::max({(t[1] - t[0]).squaredNorm(), (t[2] - t[1]).squaredNorm(), (t[0] - t[2]).squaredNorm()});
+      const double t_area = tri_area(t);
       // A triangle without area (within rounding) is its longest edge: checked as a segment.
-      if (!(std::abs(tri_area(t)) > 1e-12 * t_scale2)) {
+      if (!(std::abs(t_area) > 1e-12 * t_scale2)) {
         int longest = 0;
         for (int e = 1; e < 3; ++e)
           if ((t[(e + 1) % 3] - t[e]).squaredNorm() > (t[(longest + 1) % 3] - t[longest]).squaredNorm()) longest = e;
@@ -1011,8 +1000,10 @@ std::vector<Vec2> AlphaShape2D::triangles_gaps(const std::vector<std::array<Vec2
         out.insert(out.end(), seg.begin(), seg.end());
         continue;
       }
+      if (t_area < 0.0) std::swap(t[1], t[2]);
       // Every finite face kept: the hull is the region.
-      if (!removed_grid.empty()) m.triangle_gaps(t, static_cast<std::uint32_t>(i), removed_grid, tol, spacing, g, out);
+      if (!removed_grid.empty())
+        m.triangle_gaps(t, t_scale2, static_cast<std::uint32_t>(i), removed_grid, tol, spacing, g, out);
     }
   });
   std::vector<Vec2> gaps;

@@ -879,7 +879,7 @@ void exact_projection(const Mesh& mesh, const AlphaSimPrism& pr, double snap, do
       return;
     }
     if (pass == kExactRepairs) break;
-    sort_unique(gaps);  // the same set whatever the thread schedule
+    // Both lists come in an order independent of the thread schedule (triangles_gaps sorts).
     rep.exact_gaps += gaps.size();
     if (pass < kRefinePasses) {
       exact.insert(exact.end(), gaps.begin(), gaps.end());

@@ -507,12 +507,10 @@ ExtrusionsMesh mesh_extrusions_in_order(const std::vector<Extrusion>& kept, doub
   if (pair) {
     acc = extrusion_pair_mesh(kept[0], kept[1]);
     if (boolean_follows) {
-      // Only fewer triangles for the Boolean to cut: a face merge_face_vertices refuses
-      // (its boundary loops cross in its plane) is left to the Boolean as sliced.
-      FacedMesh merged = acc;
+      // Only fewer triangles for the Boolean to cut: where merge_face_vertices refuses a
+      // face it throws and leaves the mesh as it was, sliced, for the Boolean.
       try {
-        merge_face_vertices(merged, kSliceMergeShare * tol);
-        static_cast<FacedMesh&>(acc) = std::move(merged);
+        merge_face_vertices(acc, kSliceMergeShare * tol);
       } catch (const std::runtime_error&) {
       }
     }

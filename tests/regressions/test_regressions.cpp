@@ -30,6 +30,14 @@ using loom::Vec3;
 
 double angle(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
 
+/// The mesh file `rel` of ../shared/data as a part named `name`.
+loom::Part shared_part(const char* name, const char* rel) {
+  loom::Part p;
+  p.name = name;
+  p.mesh = loom::read_mesh_file(std::filesystem::path(LOOM_SHARED_DATA) / rel);
+  return p;
+}
+
 // 2026-11-21, CI run after session 1: SweepProperty (RapidCheck, random seed) found a step
 // where the double-reflection normal turned 1e-7 rad more than the tangent (0.0217073 vs
 // 0.0217072). Not a sweep bug: double reflection approximates the rotation-minimising
@@ -247,9 +255,7 @@ TEST(Regression, AlphaSimMeshHoldsTheImplicitSolidOfTwoTurnedBoxes) {
 // (AlphaSimOptions::thin_edge_factor), and a plane becomes its hull only after three
 // repairs of its own (the rounds were counted for all planes together).
 TEST(Regression, AlphaSimBunnyIsNotThreeConvexHulls) {
-  loom::Part bunny;
-  bunny.name = "bunny";
-  bunny.mesh = loom::read_mesh_file(std::filesystem::path(LOOM_SHARED_DATA) / "trimesh/bunny.ply");
+  const loom::Part bunny = shared_part("bunny", "trimesh/bunny.ply");
   loom::AlphaSimOptions o;
   o.dim_pre = 0.02 * bunny.mesh.bounds().diagonal();
   const loom::AlphaSimPart sp = loom::simplify_part(bunny, o);
@@ -303,9 +309,7 @@ TEST(Regression, AlphaSimFacesTouchingThemselvesAreMerged) {
 // containment (AlphaSimOptions::exact_containment, now the default) tests every triangle
 // whole against every shape (AlphaShape2D::triangle_gaps) and repairs what it finds.
 TEST(Regression, AlphaSimRandomSamplesMissedSliversOfTheSurface) {
-  loom::Part bunny;
-  bunny.name = "bunny";
-  bunny.mesh = loom::read_mesh_file(std::filesystem::path(LOOM_SHARED_DATA) / "trimesh/bunny.ply");
+  const loom::Part bunny = shared_part("bunny", "trimesh/bunny.ply");
   auto outside = [&](bool exact) {
     loom::AlphaSimOptions o;
     o.dim_pre = 0.04 * bunny.mesh.bounds().diagonal();
@@ -327,4 +331,25 @@ TEST(Regression, AlphaSimRandomSamplesMissedSliversOfTheSurface) {
   };
   EXPECT_GT(outside(false), 0u);
   EXPECT_EQ(outside(true), 0u);
+}
+
+// Twenty-fifth session: fill_pinches visited the pinched vertices in the order of their
+// handles (heap addresses), and filling around one vertex changes its neighbours, so the
+// same part came out differently as the heap moved: the tube at 1% of its diagonal gave
+// 152 or 168 triangles, from run to run and within one process. The vertices are now
+// visited in the order of their points. Memory held between the runs moves the heap.
+TEST(Regression, AlphaSimPinchFillsDoNotFollowTheHeap) {
+  const loom::Part tube = shared_part("tube", "trimesh/tube.obj");
+  loom::AlphaSimOptions o;
+  o.dim_pre = 0.01 * tube.mesh.bounds().diagonal();
+  o.measure = false;
+  const loom::AlphaSimPart first = loom::simplify_part(tube, o);
+  std::vector<std::unique_ptr<char[]>> held;
+  for (int run = 1; run < 12; ++run) {
+    held.emplace_back(new char[static_cast<std::size_t>(run * 7919 % 200000 + 1000)]);
+    const loom::AlphaSimPart again = loom::simplify_part(tube, o);
+    EXPECT_EQ(again.result.triangles_after, first.result.triangles_after) << "run " << run;
+    EXPECT_TRUE(again.mesh.vertices == first.mesh.vertices && again.mesh.triangles == first.mesh.triangles)
+        << "run " << run;
+  }
 }
