@@ -1142,17 +1142,63 @@ std::size_t merge_collinear(std::vector<Vec2>& ring, double angle_tol_rad, doubl
   const double sin_tol = std::sin(angle_tol_rad);
   // Greedy: extend the segment anchor → r[j] while every skipped vertex lies within
   // max(dist_tol, sin_tol·|segment|) of it, strictly between its ends.
+  // The skipped vertices' offsets w from the anchor all pass when the extreme ones do:
+  // along = w·d and the deviation d × w are linear in w, so their extremes over the
+  // skipped vertices are reached at corners of their convex hull. The hull of a straight
+  // run has two corners, so a long run costs O(1) per step instead of O(run); a hull
+  // grown past kMaxHullCorners (a long gentle arc) falls back to testing every vertex.
+  constexpr std::size_t kMaxHullCorners = 16;
+  std::vector<Vec2> hull, grown;
+  bool use_hull = true;
+  // Adds w to the hull (CCW, no collinear corners), or gives up on it.
+  auto add_to_hull = [&](const Vec2& w) {
+    if (!use_hull) return;
+    auto left_of = [](const Vec2& o, const Vec2& p, const Vec2& q) {
+      return (p.x() - o.x()) * (q.y() - o.y()) - (p.y() - o.y()) * (q.x() - o.x());
+    };
+    if (hull.size() >= 3) {
+      bool inside = true;
+      for (std::size_t i = 0; i < hull.size() && inside; ++i)
+        inside = left_of(hull[i], hull[(i + 1) % hull.size()], w) >= 0.0;
+      if (inside) return;
+    }
+    // Andrew's monotone chain over the corners and w.
+    grown = hull;
+    grown.push_back(w);
+    std::sort(grown.begin(), grown.end(), [](const Vec2& p, const Vec2& q) { return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y()); });
+    grown.erase(std::unique(grown.begin(), grown.end()), grown.end());
+    hull.clear();
+    if (grown.size() < 3) {
+      hull = grown;
+      return;
+    }
+    std::vector<Vec2> h(2 * grown.size());
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < grown.size(); ++i) {
+      while (k >= 2 && left_of(h[k - 2], h[k - 1], grown[i]) <= 0.0) --k;
+      h[k++] = grown[i];
+    }
+    for (std::size_t i = grown.size() - 1, lower = k + 1; i-- > 0;) {
+      while (k >= lower && left_of(h[k - 2], h[k - 1], grown[i]) <= 0.0) --k;
+      h[k++] = grown[i];
+    }
+    h.resize(k - 1);
+    hull = std::move(h);
+    if (hull.size() > kMaxHullCorners) use_hull = false;
+  };
+  auto passes = [&](const Vec2& w, const Vec2& d, double len, double lim) {
+    const double along = w.dot(d) / len;
+    if (along <= 0.0 || along >= len) return false;
+    return std::abs(d.x() * w.y() - d.y() * w.x()) / len <= lim;
+  };
   auto fits = [&](std::size_t a, std::size_t j) {
     const Vec2 d = r[j] - r[a];
     const double len = d.norm();
     if (len == 0.0) return false;
     const double lim = std::max(dist_tol, sin_tol * len);
-    for (std::size_t k = a + 1; k < j; ++k) {
-      const Vec2 w = r[k] - r[a];
-      const double along = w.dot(d) / len;
-      if (along <= 0.0 || along >= len) return false;
-      if (std::abs(d.x() * w.y() - d.y() * w.x()) / len > lim) return false;
-    }
+    if (use_hull) return std::all_of(hull.begin(), hull.end(), [&](const Vec2& w) { return passes(w, d, len, lim); });
+    for (std::size_t k = a + 1; k < j; ++k)
+      if (!passes(r[k] - r[a], d, len, lim)) return false;
     return true;
   };
   std::vector<Vec2> out;
@@ -1162,7 +1208,13 @@ std::size_t merge_collinear(std::vector<Vec2>& ring, double angle_tol_rad, doubl
     std::size_t j = a + 1;
     // Runs are capped at kMaxRun vertices so that the check stays linear in the ring size.
     constexpr std::size_t kMaxRun = 256;
-    while (j + 1 < r.size() && j + 1 - a <= kMaxRun && fits(a, j + 1)) ++j;
+    hull.clear();
+    use_hull = true;
+    while (j + 1 < r.size() && j + 1 - a <= kMaxRun) {
+      add_to_hull(r[j] - r[a]);  // the vertices a + 1 … j are skipped if j + 1 fits
+      if (!fits(a, j + 1)) break;
+      ++j;
+    }
     if (j + 1 < r.size()) out.push_back(r[j]);
     a = j;
   }

@@ -540,6 +540,90 @@ TEST(AlphaShape2D, MergeCollinearKeepsCorners) {
 
 namespace {
 
+/// merge_collinear's contract checked vertex by vertex (the oracle for its hull shortcut):
+/// from the lowest vertex, greedily extend each chord while every skipped vertex lies
+/// strictly between its ends and within max(dist_tol, sin(angle)·chord) of it, runs of at
+/// most 256 vertices.
+std::vector<Vec2> merge_collinear_reference(std::vector<Vec2> ring, double angle_tol_rad, double dist_tol) {
+  std::vector<Vec2> r;
+  for (const auto& p : ring)
+    if (r.empty() || p != r.back()) r.push_back(p);
+  while (r.size() > 1 && r.front() == r.back()) r.pop_back();
+  if (r.size() < 3) return r;
+  std::size_t s0 = 0;
+  for (std::size_t i = 1; i < r.size(); ++i)
+    if (r[i].x() < r[s0].x() || (r[i].x() == r[s0].x() && r[i].y() < r[s0].y())) s0 = i;
+  std::rotate(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(s0), r.end());
+  r.push_back(r.front());
+  const double sin_tol = std::sin(angle_tol_rad);
+  auto fits = [&](std::size_t a, std::size_t j) {
+    const Vec2 d = r[j] - r[a];
+    const double len = d.norm();
+    if (len == 0.0) return false;
+    const double lim = std::max(dist_tol, sin_tol * len);
+    for (std::size_t k = a + 1; k < j; ++k) {
+      const Vec2 w = r[k] - r[a];
+      const double along = w.dot(d) / len;
+      if (along <= 0.0 || along >= len || std::abs(d.x() * w.y() - d.y() * w.x()) / len > lim) return false;
+    }
+    return true;
+  };
+  std::vector<Vec2> out{r[0]};
+  for (std::size_t a = 0; a + 1 < r.size();) {
+    std::size_t j = a + 1;
+    while (j + 1 < r.size() && j + 1 - a <= 256 && fits(a, j + 1)) ++j;
+    if (j + 1 < r.size()) out.push_back(r[j]);
+    a = j;
+  }
+  return out;
+}
+
+}  // namespace
+
+// Random rings (fixed seeds): squares with sides cut into up to 600 points, jittered by 0
+// to 1% of the side (straight runs, hulls of two corners, runs past the 256 cap); circles
+// of 8 to 4,000 vertices (gentle arcs, hulls past the corner cap); zigzags; repeated and
+// all-equal points. The result must equal the vertex-by-vertex check's exactly.
+TEST(AlphaShape2D, MergeCollinearMatchesTheVertexByVertexCheck) {
+  std::mt19937_64 rng(20261126);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  auto check = [](const std::vector<Vec2>& ring, double angle, double dist, const std::string& what) {
+    std::vector<Vec2> got = ring;
+    const std::size_t removed = merge_collinear(got, angle, dist);
+    const std::vector<Vec2> want = merge_collinear_reference(ring, angle, dist);
+    EXPECT_EQ(removed, ring.size() - want.size()) << what;
+    ASSERT_EQ(got.size(), want.size()) << what;
+    for (std::size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i], want[i]) << what << " vertex " << i;
+  };
+  for (int trial = 0; trial < 40; ++trial) {
+    const int per_side = 1 + static_cast<int>(rng() % 600);
+    const double jitter = std::array<double, 4>{0.0, 1e-9, 1e-4, 1e-2}[trial % 4];
+    std::vector<Vec2> ring;
+    const Vec2 corners[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    for (int side = 0; side < 4; ++side)
+      for (int k = 0; k < per_side; ++k) {
+        const double t = static_cast<double>(k) / per_side;
+        ring.push_back(corners[side] + t * (corners[(side + 1) % 4] - corners[side]) + jitter * Vec2(unit(rng), unit(rng)));
+      }
+    for (double angle : {1e-8, 1e-3, 0.05})
+      for (double dist : {0.0, 1e-5, 3e-3}) check(ring, angle, dist, "square " + std::to_string(trial));
+  }
+  for (int n : {8, 100, 1000, 4000}) {
+    std::vector<Vec2> circle;
+    for (int k = 0; k < n; ++k) circle.emplace_back(std::cos(2 * M_PI * k / n), std::sin(2 * M_PI * k / n));
+    for (double angle : {1e-3, 0.05, 0.3})
+      for (double dist : {0.0, 1e-6, 1e-3}) check(circle, angle, dist, "circle " + std::to_string(n));
+  }
+  std::vector<Vec2> zigzag;
+  for (int k = 0; k < 500; ++k) zigzag.emplace_back(k * 0.01, (k % 2) * 1e-4);
+  zigzag.emplace_back(5.0, 1.0);
+  for (double dist : {0.0, 5e-5, 2e-4}) check(zigzag, 1e-3, dist, "zigzag");
+  check(std::vector<Vec2>(7, Vec2(0.5, 0.5)), 1e-3, 0.0, "all equal");
+  check({{0, 0}, {0, 0}, {1, 0}, {1, 0}, {1, 1}, {0, 0}}, 1e-3, 0.0, "repeats");
+}
+
+namespace {
+
 double point_segment_distance(const Vec2& p, const Vec2& a, const Vec2& b) {
   const Vec2 ab = b - a;
   const double t = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
@@ -1052,6 +1136,30 @@ TEST(AlphaSim, LatticeBitmapGivesTheSortedSampleSets) {
                                        [&](const Vec2& a, const Vec2& b) { return !less(a, b); }) == fast.points.end());
         EXPECT_GT(fast.points.size(), m.vertices.size() / 8);
       }
+  }
+}
+
+TEST(AlphaSim, SampleSetsAreSortedOnEverySnapGrid) {
+  // Points and checks on the snap grid are sorted by packed 64-bit grid keys where the
+  // grid indices span less than 2^32, by their coordinates otherwise: both orders must be
+  // the lexicographic one, without repeats, and every coordinate a multiple of snap.
+  const Mesh m = read_mesh_file(std::filesystem::path(LOOM_SHARED_DATA) / "occt/motor.stl");
+  const double diag = m.bounds().diagonal();
+  AlphaSimPrism xy;
+  for (const double snap_share : {0.25e-6, 1e-3, std::exp2(-40.0)}) {  // the last spans > 2^32 cells
+    const double snap = std::exp2(std::floor(std::log2(snap_share * diag)));
+    const auto smp = alpha_sim_plane_samples(m, xy, 0.02 * diag, snap);
+    for (const auto* set : {&smp.points, &smp.checks}) {
+      std::vector<Vec2> ref = *set;
+      std::sort(ref.begin(), ref.end(), [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+      ref.erase(std::unique(ref.begin(), ref.end()), ref.end());
+      EXPECT_TRUE(ref == *set) << "snap " << snap;
+      for (const Vec2& q : *set) {
+        EXPECT_EQ(std::round(q.x() / snap) * snap, q.x());
+        EXPECT_EQ(std::round(q.y() / snap) * snap, q.y());
+      }
+    }
+    EXPECT_GT(smp.points.size(), 100u);
   }
 }
 
