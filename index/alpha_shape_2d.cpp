@@ -1041,6 +1041,22 @@ double AlphaShape2D::signed_distance(const Vec2& p) const {
   return impl_->in_kept_triangle(p) ? -d : d;
 }
 
+std::vector<std::pair<std::array<Vec2, 3>, char>> AlphaShape2D::snapshot() const {
+  const Impl& m = *impl_;
+  std::vector<std::pair<std::array<Vec2, 3>, char>> out(m.coords.size());
+  for (std::size_t i = 0; i < m.coords.size(); ++i) {
+    auto c = m.coords[i];
+    // From the lowest corner, so that a triangle compares equal whatever corner CGAL
+    // starts it at (rotation keeps the orientation).
+    const auto lowest = std::min_element(c.begin(), c.end(), [](const Vec2& p, const Vec2& q) {
+      return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y());
+    });
+    std::rotate(c.begin(), lowest, c.end());
+    out[i] = {c, m.kept[i] ? char(1) : char(0)};
+  }
+  return out;
+}
+
 std::vector<PolygonWithHoles2> AlphaShape2D::polygons() const {
   const Impl& m = *impl_;
   const std::size_t nseg = m.segments.size();

@@ -111,6 +111,10 @@ class AlphaShape2D {
                                    double spacing) const;
   /// Signed distance to the region's boundary: negative inside, +inf if the region is empty.
   double signed_distance(const Vec2& p) const;
+  /// Every finite Delaunay triangle (plane coordinates, CCW from its lowest corner in
+  /// (x, y) order) with 1 if it is kept, 0 if not, in no particular order: where two
+  /// snapshots differ, the triangulation or the region changed in between.
+  std::vector<std::pair<std::array<Vec2, 3>, char>> snapshot() const;
   /// Boundary loops grouped per connected piece (outer CCW, holes CW), in deterministic order.
   std::vector<PolygonWithHoles2> polygons() const;
 

@@ -937,6 +937,74 @@ void repair_projection(AlphaShape2D& shape, const std::vector<Vec2>& checks, con
   }
 }
 
+using ShapeSnapshot = std::vector<std::pair<std::array<Vec2, 3>, char>>;
+
+/// Boxes (min, max) of the triangles that are in one snapshot and not in the other
+/// (corners and kept flag compared exactly; a hash only groups the candidates).
+std::vector<std::array<Vec2, 2>> changed_boxes(const ShapeSnapshot& a, const ShapeSnapshot& b) {
+  // (hash, index << 1 | side): equal triangles share a run of equal hashes.
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> keys;
+  keys.reserve(a.size() + b.size());
+  auto hash = [](const std::pair<std::array<Vec2, 3>, char>& t) {
+    return hash_doubles(t.first[0].data(), 2) ^ hash_doubles(t.first[1].data(), 2) * 3 ^
+           hash_doubles(t.first[2].data(), 2) * 5 ^ std::uint64_t(t.second) * 0x9e3779b97f4a7c15ull;
+  };
+  for (std::size_t i = 0; i < a.size(); ++i) keys.emplace_back(hash(a[i]), std::uint64_t(i) << 1);
+  for (std::size_t i = 0; i < b.size(); ++i) keys.emplace_back(hash(b[i]), std::uint64_t(i) << 1 | 1u);
+  sort_pairs(keys);
+  auto item = [&](std::uint64_t k) -> const std::pair<std::array<Vec2, 3>, char>& { return (k & 1) ? b[k >> 1] : a[k >> 1]; };
+  std::vector<std::array<Vec2, 2>> out;
+  std::vector<char> matched;
+  for (std::size_t i = 0; i < keys.size();) {
+    std::size_t j = i;
+    while (j < keys.size() && keys[j].first == keys[i].first) ++j;
+    // Within the run, pair each entry of one side with an equal one of the other.
+    matched.assign(j - i, 0);
+    for (std::size_t p = i; p < j; ++p) {
+      if (matched[p - i]) continue;
+      for (std::size_t q = p + 1; q < j; ++q)
+        if (!matched[q - i] && (keys[q].second & 1) != (keys[p].second & 1) && item(keys[q].second) == item(keys[p].second)) {
+          matched[p - i] = matched[q - i] = 1;
+          break;
+        }
+      if (!matched[p - i]) {
+        const auto& c = item(keys[p].second).first;
+        out.push_back({c[0].cwiseMin(c[1]).cwiseMin(c[2]), c[0].cwiseMax(c[1]).cwiseMax(c[2])});
+      }
+    }
+    i = j;
+  }
+  return out;
+}
+
+/// For each of `boxes`, 1 if it comes within `pad` of one of `near` (boxes as (min, max),
+/// plane coordinates): `near` sorted by lower x is searched over the x-window that can
+/// reach the box. All 1 when that search would visit more than a few candidates per box
+/// (changes spread over the whole shape: testing everything is then as cheap).
+std::vector<char> near_any(const std::vector<std::array<Vec2, 2>>& boxes, std::vector<std::array<Vec2, 2>> near, double pad) {
+  std::vector<char> out(boxes.size(), 0);
+  if (near.empty()) return out;
+  std::sort(near.begin(), near.end(), [](const auto& x, const auto& y) { return x[0].x() < y[0].x(); });
+  double width = 0.0;
+  for (const auto& n : near) width = std::max(width, n[1].x() - n[0].x());
+  constexpr std::size_t kVisitsPerBox = 16;
+  std::size_t visits = 0;
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    const auto& bx = boxes[i];
+    auto it = std::lower_bound(near.begin(), near.end(), bx[0].x() - pad - width,
+                               [](const auto& n, double x) { return n[0].x() < x; });
+    for (; it != near.end() && (*it)[0].x() <= bx[1].x() + pad; ++it) {
+      if (++visits > kVisitsPerBox * boxes.size() + near.size()) return std::vector<char>(boxes.size(), 1);
+      const auto& n = *it;
+      if (n[1].x() >= bx[0].x() - pad && n[0].y() <= bx[1].y() + pad && n[1].y() >= bx[0].y() - pad) {
+        out[i] = 1;
+        break;
+      }
+    }
+  }
+  return out;
+}
+
 /// Makes `shape` hold every triangle of `mesh` projected by `pr` within tol, exactly (up
 /// to rounding), or replaces it by its convex hull (status Eroded, or Torn as
 /// repair_projection decides): the regular checks first (repair_projection), then up to
@@ -978,9 +1046,37 @@ void exact_projection(const Mesh& mesh, const AlphaSimPrism& pr, double snap, do
       tested, [](const auto& t) { return hash_doubles(t[0].data(), 2) ^ hash_doubles(t[1].data(), 2) * 3 ^ hash_doubles(t[2].data(), 2) * 5; },
       [](const auto& x, const auto& y) { return x == y; }, [](auto&, const auto&) {});
   repair_projection(shape, checks, exact, tol, torn_fraction, rep);
+  // After a repair only what lies near a change can have changed: a triangle or segment
+  // whose box, widened by tol, meets no Delaunay triangle that the repair added, removed
+  // or flipped (kept ↔ removed) and holds no gap point of the pass before sees the same
+  // faces within tol, so it has no gaps again (it had none). The others are tested again
+  // (`retest_*`; all of them in the first pass): the gaps found are the same as if all were.
+  auto box_of = [](const auto& corners) {
+    std::array<Vec2, 2> b{corners[0], corners[0]};
+    for (const Vec2& q : corners) {
+      b[0] = b[0].cwiseMin(q);
+      b[1] = b[1].cwiseMax(q);
+    }
+    return b;
+  };
+  std::vector<std::array<Vec2, 2>> tested_boxes, segment_boxes;
+  std::vector<char> retest_tested, retest_segments;
+  std::vector<std::array<Vec2, 3>> tested_now;
+  EdgeOnTriangles edge_on_now;
   for (int pass = 0; !is_hull(rep.status); ++pass) {
-    std::vector<Vec2> gaps = edge_on_gaps(shape, edge_on, edge_on_tol, triangle_tol, gap_spacing);
-    const std::vector<Vec2> inside = shape.triangles_gaps(tested, triangle_tol, gap_spacing);
+    const bool all = pass == 0;
+    if (!all) {
+      tested_now.clear();
+      for (std::size_t i = 0; i < tested.size(); ++i)
+        if (retest_tested[i]) tested_now.push_back(tested[i]);
+      edge_on_now.segments.clear();
+      edge_on_now.thin_edges = edge_on.thin_edges;  // (none in exact mode) all of them
+      edge_on_now.thin_active = edge_on.thin_active;
+      for (std::size_t i = 0; i < edge_on.segments.size(); ++i)
+        if (retest_segments[i]) edge_on_now.segments.push_back(edge_on.segments[i]);
+    }
+    std::vector<Vec2> gaps = edge_on_gaps(shape, all ? edge_on : edge_on_now, edge_on_tol, triangle_tol, gap_spacing);
+    const std::vector<Vec2> inside = shape.triangles_gaps(all ? tested : tested_now, triangle_tol, gap_spacing);
     gaps.insert(gaps.end(), inside.begin(), inside.end());
     if (gaps.empty()) {
       shape.fill_pinches();
@@ -989,23 +1085,33 @@ void exact_projection(const Mesh& mesh, const AlphaSimPrism& pr, double snap, do
     if (pass == kExactRepairs) break;
     // Both lists come in an order independent of the thread schedule (triangles_gaps sorts).
     rep.exact_gaps += gaps.size();
+    const ShapeSnapshot before = shape.snapshot();
     if (pass < kRefinePasses) {
       exact.insert(exact.end(), gaps.begin(), gaps.end());
       repair_projection(shape, checks, exact, tol, torn_fraction, rep);
-      continue;
+    } else {
+      // Then the removed faces that hold the gaps are kept: each gap point lies inside the
+      // face that holds its piece, which then covers all of it, so one such pass closes
+      // every gap (keeping faces only shrinks the others). Inserted points may not: around
+      // a silhouette sliver their new triangles are thin, above α, and only those holding
+      // a point are kept.
+      const double added = shape.cover(gaps, 0.0);
+      if (added > torn_fraction * shape.area()) {
+        rep.status = ProjectionStatus::Torn;
+        shape.keep_all();
+      } else if (added > 0.0) {
+        rep.status = ProjectionStatus::Repaired;
+      }
     }
-    // Then the removed faces that hold the gaps are kept: each gap point lies inside the
-    // face that holds its piece, which then covers all of it, so one such pass closes
-    // every gap (keeping faces only shrinks the others). Inserted points may not: around a
-    // silhouette sliver their new triangles are thin, above α, and only those holding a
-    // point are kept.
-    const double added = shape.cover(gaps, 0.0);
-    if (added > torn_fraction * shape.area()) {
-      rep.status = ProjectionStatus::Torn;
-      shape.keep_all();
-    } else if (added > 0.0) {
-      rep.status = ProjectionStatus::Repaired;
+    if (is_hull(rep.status)) break;
+    std::vector<std::array<Vec2, 2>> near = changed_boxes(before, shape.snapshot());
+    for (const Vec2& g : gaps) near.push_back({g, g});
+    if (tested_boxes.empty()) {
+      for (const auto& t : tested) tested_boxes.push_back(box_of(t));
+      for (const auto& sg : edge_on.segments) segment_boxes.push_back(box_of(sg));
     }
+    retest_tested = near_any(tested_boxes, near, tol);
+    retest_segments = near_any(segment_boxes, near, tol);
   }
   if (is_hull(rep.status)) return;
   rep.status = ProjectionStatus::Eroded;
