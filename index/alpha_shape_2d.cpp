@@ -1060,9 +1060,11 @@ std::vector<std::pair<std::array<Vec2, 3>, char>> AlphaShape2D::snapshot() const
 std::vector<PolygonWithHoles2> AlphaShape2D::polygons() const {
   const Impl& m = *impl_;
   const std::size_t nseg = m.segments.size();
-  // Boundary edge lookup: (face id, edge index) → segment index.
-  std::map<std::pair<int, int>, std::size_t> seg_of;
-  for (std::size_t s = 0; s < nseg; ++s) seg_of[{m.segment_edge[s][0], m.segment_edge[s][1]}] = s;
+  // Boundary edge lookup: 3·face id + edge index → segment index (kNone: not a boundary edge).
+  constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+  std::vector<std::size_t> seg_of(3 * m.faces.size(), kNone);
+  for (std::size_t s = 0; s < nseg; ++s)
+    seg_of[3 * static_cast<std::size_t>(m.segment_edge[s][0]) + static_cast<std::size_t>(m.segment_edge[s][1])] = s;
   std::vector<char> used(nseg, 0);
   struct Loop {
     std::vector<Vec2> ring;
@@ -1089,8 +1091,8 @@ std::vector<PolygonWithHoles2> AlphaShape2D::polygons() const {
         const int out = DT::cw(j);  // edge of g from v to g->vertex(ccw(j))
         const Face n = g->neighbor(out);
         if (!m.is_kept(n)) {
-          auto it = seg_of.find({g->info(), out});
-          s = it == seg_of.end() ? s0 : it->second;
+          const std::size_t next = seg_of[3 * static_cast<std::size_t>(g->info()) + static_cast<std::size_t>(out)];
+          s = next == kNone ? s0 : next;
           break;
         }
         g = n;
