@@ -697,11 +697,15 @@ namespace {
 
 /// Narrows [lo, hi] to the t where f0 + t·(f1 − f0) ≥ −slack (a half-plane along a line).
 void clip_half_plane(double f0, double f1, double slack, double& lo, double& hi) {
-  const double df = f1 - f0;
-  if (df == 0.0) {
-    if (f0 < -slack) hi = lo - 1.0;  // empty
+  // Both ends inside: nothing is cut (the crossing would lie at t ≤ 0 or ≥ 1); both
+  // outside: all is. Only a segment that crosses the line pays for the division.
+  const bool in0 = f0 >= -slack, in1 = f1 >= -slack;
+  if (in0 && in1) return;
+  if (!in0 && !in1) {
+    hi = lo - 1.0;  // empty
     return;
   }
+  const double df = f1 - f0;
   const double t = (-slack - f0) / df;
   if (df > 0.0)
     lo = std::max(lo, t);
