@@ -539,11 +539,14 @@ std::vector<Vec2> project_vertices(const Mesh& mesh, const AlphaSimPrism& pr) {
   return proj;
 }
 
-/// `proj`: the mesh's vertices projected (project_vertices).
+/// `proj`: the mesh's vertices projected (project_vertices). sort_checks = false leaves
+/// the checks as listed, with repeats (sort_unique_snapped() gives the sorted set): a
+/// plane without gaps never uses them (exact_projection), and their sort was most of
+/// their cost (a spar's face-on plane: 79k checks).
 AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
                                        const std::vector<MeshEdge>& edges,
                                        const std::vector<Vec2>& proj, double l_max, double snap, bool lattice_bitmap,
-                                       bool coarse_interior, bool all_checks) {
+                                       bool coarse_interior, bool all_checks, bool sort_checks = true) {
   AlphaSimPlaneSamples s;
   auto snapped = [snap](const Vec2& q) { return snap_to_grid(q, snap); };
   std::vector<char> used(mesh.vertices.size(), 0);
@@ -645,7 +648,7 @@ AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
       for (int k = 0; k < n; ++k) s.checks.push_back(snapped(pa + (pb - pa) * ((k + 0.5) / n)));
   }
   sort_unique_snapped(s.points, snap);
-  sort_unique_snapped(s.checks, snap);
+  if (sort_checks || centres.active()) sort_unique_snapped(s.checks, snap);  // (merged below)
   if (nodes.active())
     merge_unique(s.points, nodes.points([&](long i, long j) { return snapped(nodes.at(i, j)); }, keep_node));
   if (centres.active())
@@ -1042,12 +1045,18 @@ std::vector<char> near_any(const std::vector<std::array<Vec2, 2>>& boxes, std::v
 /// corners snapped (to `snap`, as the samples are, so that they lie in the hull of the
 /// samples) within tol − snap·√2/2: a point of the triangle lies within snap·√2/2 of the
 /// same combination of the snapped corners. `edge_on` and `exact` (the gap points, kept
-/// covered by later repairs) are filled for the caller.
+/// covered by later repairs) are filled for the caller. `checks` are sorted
+/// (sort_unique_snapped) when first used, unless `checks_sorted` says they are.
 void exact_projection(const Mesh& mesh, const std::vector<Vec2>& projected, double snap, double tol, AlphaShape2D& shape,
-                      const std::vector<Vec2>& checks, EdgeOnTriangles& edge_on, std::vector<Vec2>& exact,
+                      std::vector<Vec2>& checks, bool& checks_sorted, EdgeOnTriangles& edge_on, std::vector<Vec2>& exact,
                       double torn_fraction, double l_max, ProjectionReport& rep) {
   // Passes of gap finding and repair; a plane with gaps after the last is replaced by its hull.
   constexpr int kExactRepairs = 3;
+  auto sorted_checks = [&]() -> const std::vector<Vec2>& {
+    if (!checks_sorted) sort_unique_snapped(checks, snap);
+    checks_sorted = true;
+    return checks;
+  };
   // The first passes repair by inserting the gap points (a notch closes with small
   // triangles), the later ones by keeping the faces that hold them.
   constexpr int kRefinePasses = 1;
@@ -1128,7 +1137,7 @@ void exact_projection(const Mesh& mesh, const std::vector<Vec2>& projected, doub
   for (std::size_t i = 0; i < checks.size() && !misses; i += kPreCheckStride) misses = !shape.contains(checks[i], tol);
   std::vector<Vec2> gaps;
   if (misses) {
-    repair_projection(shape, checks, exact, tol, torn_fraction, rep);
+    repair_projection(shape, sorted_checks(), exact, tol, torn_fraction, rep);
     if (is_hull(rep.status)) return;
   } else {
     gaps = find_gaps();
@@ -1138,7 +1147,7 @@ void exact_projection(const Mesh& mesh, const std::vector<Vec2>& projected, doub
       return;
     }
     const ShapeSnapshot before = shape.snapshot();
-    repair_projection(shape, checks, exact, tol, torn_fraction, rep);
+    repair_projection(shape, sorted_checks(), exact, tol, torn_fraction, rep);
     if (is_hull(rep.status)) return;
     mark_changes(before, gaps);
   }
@@ -1153,7 +1162,7 @@ void exact_projection(const Mesh& mesh, const std::vector<Vec2>& projected, doub
     const ShapeSnapshot before = shape.snapshot();
     if (pass < kRefinePasses) {
       exact.insert(exact.end(), gaps.begin(), gaps.end());
-      repair_projection(shape, checks, exact, tol, torn_fraction, rep);
+      repair_projection(shape, sorted_checks(), exact, tol, torn_fraction, rep);
     } else {
       // Then the removed faces that hold the gaps are kept: each gap point lies inside the
       // face that holds its piece, which then covers all of it, so one such pass closes
@@ -1328,6 +1337,9 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   // their circumradius √2·L_max stays below α, with a margin for the snapping.
   const bool coarse_interior = opt.coarse_interior && M_SQRT2 * r.l_max < kCoarseCellAlphaMargin * r.alpha;
   std::vector<EdgeOnTriangles> edge_on(specs.size());
+  // 1 once a plane's checks are sorted and unique (sample_projection leaves them as
+  // listed in exact mode: exact_projection sorts them if it uses them).
+  std::vector<char> checks_sorted(specs.size(), 0);
   // 1 while a plane's shape is unchanged since its edge-on segments were found covered.
   std::vector<char> edge_on_clean(specs.size(), 0);
   // Gap points of the edge-on segments found so far, per plane: kept covered by every
@@ -1348,7 +1360,9 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       }
     AlphaSimPlaneSamples& smp = plane_samples[k];
     // The exact test finds what centroids and midpoints of interior edges would.
-    smp = sample_projection(part.mesh, edges, projected[k], r.l_max, snap, true, coarse_interior, !opt.exact_containment);
+    smp = sample_projection(part.mesh, edges, projected[k], r.l_max, snap, true, coarse_interior, !opt.exact_containment,
+                            !opt.exact_containment);
+    checks_sorted[k] = !opt.exact_containment;
     const std::vector<Vec2>& pts = smp.points;
     rep.points = pts.size();
     auto shape = std::make_shared<AlphaShape2D>(pts, r.alpha, std::min(opt.short_edge_factor * r.l_max, r.alpha));
@@ -1360,8 +1374,10 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       rep.status = ProjectionStatus::Empty;
       shape->keep_all();
     } else if (opt.exact_containment) {
-      exact_projection(part.mesh, projected[k], snap, tol, *shape, smp.checks, edge_on[k], exact_checks[k], opt.torn_fraction,
+      bool sorted = checks_sorted[k] != 0;
+      exact_projection(part.mesh, projected[k], snap, tol, *shape, smp.checks, sorted, edge_on[k], exact_checks[k], opt.torn_fraction,
                        r.l_max, rep);
+      checks_sorted[k] = sorted ? 1 : 0;
     } else {
       if (opt.edge_on_segments)
         edge_on[k] = edge_on_triangles(part.mesh, projected[k], edge_on_width, opt.thin_edge_factor * r.l_max, snap);
@@ -1453,6 +1469,8 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
         hull_missed = true;  // already the convex hull
       } else if (plane_repairs[k]++ < kRefineRounds) {
         auto& checks = plane_samples[k].checks;
+        if (!checks_sorted[k]) sort_unique_snapped(checks, snap);
+        checks_sorted[k] = 1;
         checks.insert(checks.end(), missed[k].begin(), missed[k].end());
         if (!missed[k].empty() && !edge_on[k].thin_active) {
           // Samples missed: the thin triangles' slivers are where (see edge_on_triangles);
