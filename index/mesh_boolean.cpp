@@ -1,6 +1,7 @@
 #include "index/mesh_boolean.hpp"
 
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
@@ -9,7 +10,6 @@
 
 #include <algorithm>
 #include <array>
-#include <map>
 #include <memory>
 #include <numeric>
 #include <stdexcept>
@@ -30,6 +30,18 @@ namespace PMP = CGAL::Polygon_mesh_processing;
 std::size_t root(std::vector<std::size_t>& parent, std::size_t i) {
   while (parent[i] != i) i = parent[i] = parent[parent[i]];
   return i;
+}
+
+/// True if the triangles `polygons` of `mesh` cross each other (PMP::does_self_intersect
+/// on a Surface_mesh of the Epick kernel).
+bool does_self_intersect_epick(const Mesh& mesh, const std::vector<std::array<std::size_t, 3>>& polygons) {
+  using EpickPoint = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
+  std::vector<EpickPoint> points;
+  points.reserve(mesh.vertices.size());
+  for (const Vec3& p : mesh.vertices) points.emplace_back(p.x(), p.y(), p.z());
+  CGAL::Surface_mesh<EpickPoint> sm;
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, sm);
+  return PMP::does_self_intersect(sm);
 }
 
 SurfaceMesh to_surface_mesh(const FacedMesh& m, int label_offset, const char* which) {
@@ -67,7 +79,9 @@ SurfaceMesh to_surface_mesh(const FacedMesh& m, int label_offset, const char* wh
   if (!CGAL::is_closed(sm)) throw std::runtime_error(name + " is not closed");
   // CGAL's precondition (crossing faces are undefined behaviour there, as the touching
   // pieces above were): checked, since the meshers' rounding is not proven never to fold.
-  if (PMP::does_self_intersect(sm)) throw std::runtime_error(name + " intersects itself");
+  // On a copy with the inexact-constructions kernel: the test takes only predicates on the
+  // input's doubles, exact there too, without the lazy exact kernel's overhead.
+  if (does_self_intersect_epick(m.mesh, polygons)) throw std::runtime_error(name + " intersects itself");
   // Faces were added in polygon order to an empty mesh: face t is triangle t.
   LabelMap label = sm.add_property_map<FaceIndex, int>("f:label", -1).first;
   for (std::size_t t = 0; t < polygons.size(); ++t) label[FaceIndex(static_cast<SurfaceMesh::size_type>(t))] = m.face[t] + label_offset;
@@ -92,17 +106,28 @@ struct LabelVisitor : PMP::Corefinement::Default_visitor<SurfaceMesh> {
 }  // namespace
 
 std::vector<std::size_t> labelled_face_ids(const Mesh& m, const std::vector<int>& face) {
-  std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> first_of_edge;
-  std::vector<std::size_t> parent(m.triangles.size());
-  std::iota(parent.begin(), parent.end(), std::size_t(0));
+  // Each triangle is joined to the first triangle (lowest index) of each of its edges
+  // when their labels agree: (edge, triangle) pairs sorted, a run per edge.
+  std::vector<std::pair<std::uint64_t, std::size_t>> uses;
+  uses.reserve(3 * m.triangles.size());
   for (std::size_t t = 0; t < m.triangles.size(); ++t)
     for (int e = 0; e < 3; ++e) {
       const std::uint32_t a = m.triangles[t][static_cast<std::size_t>(e)], b = m.triangles[t][static_cast<std::size_t>((e + 1) % 3)];
-      const auto [it, added] = first_of_edge.emplace(std::minmax(a, b), t);
-      if (added || face[it->second] != face[t]) continue;
-      const std::size_t ra = root(parent, it->second), rb = root(parent, t);
-      if (ra != rb) parent[ra] = rb;
+      uses.emplace_back(std::uint64_t(std::min(a, b)) << 32 | std::max(a, b), t);
     }
+  std::sort(uses.begin(), uses.end());
+  std::vector<std::size_t> parent(m.triangles.size());
+  std::iota(parent.begin(), parent.end(), std::size_t(0));
+  for (std::size_t i = 0, first = 0; i < uses.size(); ++i) {
+    if (i == 0 || uses[i].first != uses[i - 1].first) {
+      first = uses[i].second;
+      continue;
+    }
+    const std::size_t t = uses[i].second;
+    if (t == first || face[first] != face[t]) continue;  // (a triangle may repeat an edge)
+    const std::size_t ra = root(parent, first), rb = root(parent, t);
+    if (ra != rb) parent[ra] = rb;
+  }
   // Name each face by its first triangle, whatever root the union ended with.
   std::vector<std::size_t> first(m.triangles.size(), m.triangles.size()), id(m.triangles.size());
   for (std::size_t t = 0; t < m.triangles.size(); ++t) {
