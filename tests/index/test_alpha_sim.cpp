@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <map>
 #include <random>
 #include <set>
@@ -428,6 +429,66 @@ TEST(AlphaShape2D, TriangleGapsOfAnAnnulusMatchClosedForm) {
   EXPECT_TRUE(s.triangle_gaps({1, 1}, {19, 1}, {10, 1}, tol, spacing).empty());
   EXPECT_FALSE(s.triangle_gaps({1, 10}, {19, 10}, {10, 10}, tol, spacing).empty());
   EXPECT_THROW(s.triangle_gaps({0, 0}, {1, 0}, {0, 1}, tol, 0.0), std::invalid_argument);
+}
+
+TEST(AlphaShape2D, TrianglesAwayFromARepairKeepTheirGapFreedom) {
+  // exact_projection tests again, after a repair, only the triangles whose box (widened
+  // by tol) meets a Delaunay triangle that the repair added, removed or flipped between
+  // two snapshots. That relies on this: a triangle away from every change that had no
+  // gaps still has none. Ragged shapes, refined with random points, covered at random
+  // points, or both; random triangles of several sizes.
+  std::mt19937_64 rng(26);
+  std::uniform_real_distribution<double> u(-10.0, 10.0), size(0.05, 2.0);
+  int away = 0, near = 0;
+  for (int trial = 0; trial < 9; ++trial) {
+    AlphaShape2D shape(ragged_cloud(rng), 0.45);
+    const double tol = trial % 2 ? 1e-2 : 0.0;
+    std::vector<std::array<Vec2, 3>> tris;
+    for (int i = 0; i < 400; ++i) {
+      const Vec2 c(u(rng), u(rng));
+      const double s = size(rng);
+      tris.push_back({c, c + s * Vec2(1.0, 0.1), c + s * Vec2(0.3, 0.9)});
+    }
+    std::vector<char> clear(tris.size());
+    for (std::size_t i = 0; i < tris.size(); ++i)
+      clear[i] = shape.triangle_gaps(tris[i][0], tris[i][1], tris[i][2], tol, 0.1).empty();
+    const auto before = shape.snapshot();
+    std::vector<Vec2> points;
+    for (int i = 0; i < 12; ++i) points.emplace_back(u(rng), u(rng));
+    if (trial % 3 != 1) shape.refine(points, tol);
+    if (trial % 3 != 0) shape.cover(points, 0.0);
+    const auto after = shape.snapshot();
+    // The triangles in one snapshot only, by value.
+    using Key = std::array<double, 7>;
+    auto keys = [](const std::vector<std::pair<std::array<Vec2, 3>, char>>& snap) {
+      std::set<Key> out;
+      for (const auto& [c, kept] : snap) out.insert({c[0].x(), c[0].y(), c[1].x(), c[1].y(), c[2].x(), c[2].y(), double(kept)});
+      return out;
+    };
+    const std::set<Key> a = keys(before), b = keys(after);
+    std::vector<Key> changed;
+    std::set_symmetric_difference(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(changed));
+    ASSERT_FALSE(changed.empty()) << "trial " << trial;
+    for (std::size_t i = 0; i < tris.size(); ++i) {
+      const auto& t = tris[i];
+      const Vec2 lo = t[0].cwiseMin(t[1]).cwiseMin(t[2]) - Vec2::Constant(tol), hi = t[0].cwiseMax(t[1]).cwiseMax(t[2]) + Vec2::Constant(tol);
+      const bool touched = std::any_of(changed.begin(), changed.end(), [&](const Key& k) {
+        const double x0 = std::min({k[0], k[2], k[4]}), x1 = std::max({k[0], k[2], k[4]});
+        const double y0 = std::min({k[1], k[3], k[5]}), y1 = std::max({k[1], k[3], k[5]});
+        return x0 <= hi.x() && x1 >= lo.x() && y0 <= hi.y() && y1 >= lo.y();
+      });
+      if (touched || !clear[i]) {
+        near += touched;
+        continue;
+      }
+      ++away;
+      EXPECT_TRUE(shape.triangle_gaps(t[0], t[1], t[2], tol, 0.1).empty())
+          << std::setprecision(17) << "trial " << trial << " triangle " << t[0].transpose() << " / " << t[1].transpose()
+          << " / " << t[2].transpose();
+    }
+  }
+  EXPECT_GT(away, 500);  // the property was exercised, and the changes were local
+  EXPECT_GT(near, 50);
 }
 
 TEST(AlphaShape2D, TriangleGapsAgreeWithDenseSamplingOnRaggedShapes) {
