@@ -539,14 +539,56 @@ std::vector<Vec2> project_vertices(const Mesh& mesh, const AlphaSimPrism& pr) {
   return proj;
 }
 
-/// `proj`: the mesh's vertices projected (project_vertices). sort_checks = false leaves
-/// the checks as listed, with repeats (sort_unique_snapped() gives the sorted set): a
-/// plane without gaps never uses them (exact_projection), and their sort was most of
-/// their cost (a spar's face-on plane: 79k checks).
+/// The checks of an outline edge pa → pb (n pieces): its sub-edge midpoints, snapped.
+template <class F>
+void for_each_outline_check(const Vec2& pa, const Vec2& pb, int n, double snap, F&& f) {
+  for (int k = 0; k < n; ++k) f(snap_to_grid(pa + (pb - pa) * ((k + 0.5) / n), snap));
+}
+
+/// Pieces an edge of projected length `len` is cut into: each ≤ l_max.
+int outline_pieces(double len, double l_max) { return std::max(1, static_cast<int>(std::ceil(len / l_max))); }
+
+/// A plane's outline checks before they are listed (exact mode): most planes never use
+/// them (exact_projection), and listing and sorting them was most of their cost (a
+/// spar's face-on plane: 79k checks from its hole rims). `edges` as (pa.x, pa.y, pb.x,
+/// pb.y), in the order sample_projection met them.
+struct DeferredChecks {
+  std::vector<std::array<double, 4>> edges;
+  double l_max = 0.0, snap = 0.0;
+  bool listed = true;  ///< true once `checks` holds them all, sorted and unique
+  /// f(check) for every `stride`-th check in the order they would be listed, until f
+  /// returns true; true if it did.
+  template <class F>
+  bool any_of_every(std::size_t stride, F&& f) const {
+    std::size_t i = 0;
+    for (const auto& e : edges) {
+      const Vec2 pa(e[0], e[1]), pb(e[2], e[3]);
+      const int n = outline_pieces((pb - pa).norm(), l_max);
+      for (int k = 0; k < n; ++k, ++i)
+        if (i % stride == 0 && f(snap_to_grid(pa + (pb - pa) * ((k + 0.5) / n), snap))) return true;
+    }
+    return false;
+  }
+  /// Appends them to `checks`, sorts those (sort_unique_snapped) and marks them listed.
+  void list(std::vector<Vec2>& checks) {
+    if (listed) return;
+    for (const auto& e : edges) {
+      const Vec2 pa(e[0], e[1]), pb(e[2], e[3]);
+      for_each_outline_check(pa, pb, outline_pieces((pb - pa).norm(), l_max), snap, [&](const Vec2& q) { checks.push_back(q); });
+    }
+    sort_unique_snapped(checks, snap);
+    edges.clear();
+    listed = true;
+  }
+};
+
+/// `proj`: the mesh's vertices projected (project_vertices). With `deferred`, the
+/// outline's checks are left to it (DeferredChecks; only without all_checks, where they
+/// are all the checks) and `checks` is empty.
 AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
                                        const std::vector<MeshEdge>& edges,
                                        const std::vector<Vec2>& proj, double l_max, double snap, bool lattice_bitmap,
-                                       bool coarse_interior, bool all_checks, bool sort_checks = true) {
+                                       bool coarse_interior, bool all_checks, DeferredChecks* deferred = nullptr) {
   AlphaSimPlaneSamples s;
   auto snapped = [snap](const Vec2& q) { return snap_to_grid(q, snap); };
   std::vector<char> used(mesh.vertices.size(), 0);
@@ -636,19 +678,27 @@ AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
       ends, [](const auto& e) { return hash_doubles(e.data(), 4); },
       [](const auto& x, const auto& y) { return std::equal(x.begin(), x.begin() + 4, y.begin()); },
       [](auto& kept, const auto& repeat) { kept[4] = std::max(kept[4], repeat[4]); });
+  const bool defer = deferred != nullptr && !all_checks;
+  if (defer) {
+    deferred->edges.clear();
+    deferred->l_max = l_max;
+    deferred->snap = snap;
+    deferred->listed = false;
+  }
   for (const auto& e : ends) {
     const Vec2 pa(e[0], e[1]), pb(e[2], e[3]);
-    const int n = std::max(1, static_cast<int>(std::ceil((pb - pa).norm() / l_max)));
+    const int n = outline_pieces((pb - pa).norm(), l_max);
     if (e[4] != 0.0)
       for (int k = 1; k < n; ++k) {
         const Vec2 q = pa + (pb - pa) * (static_cast<double>(k) / n);
         if (!in_covered_cell(q)) s.points.push_back(snapped(q));
       }
-    if (e[4] != 0.0 || all_checks)
-      for (int k = 0; k < n; ++k) s.checks.push_back(snapped(pa + (pb - pa) * ((k + 0.5) / n)));
+    if (defer && e[4] != 0.0) deferred->edges.push_back({e[0], e[1], e[2], e[3]});
+    else if (e[4] != 0.0 || all_checks)
+      for_each_outline_check(pa, pb, n, snap, [&](const Vec2& q) { s.checks.push_back(q); });
   }
   sort_unique_snapped(s.points, snap);
-  if (sort_checks || centres.active()) sort_unique_snapped(s.checks, snap);  // (merged below)
+  sort_unique_snapped(s.checks, snap);
   if (nodes.active())
     merge_unique(s.points, nodes.points([&](long i, long j) { return snapped(nodes.at(i, j)); }, keep_node));
   if (centres.active())
@@ -1045,16 +1095,15 @@ std::vector<char> near_any(const std::vector<std::array<Vec2, 2>>& boxes, std::v
 /// corners snapped (to `snap`, as the samples are, so that they lie in the hull of the
 /// samples) within tol − snap·√2/2: a point of the triangle lies within snap·√2/2 of the
 /// same combination of the snapped corners. `edge_on` and `exact` (the gap points, kept
-/// covered by later repairs) are filled for the caller. `checks` are sorted
-/// (sort_unique_snapped) when first used, unless `checks_sorted` says they are.
+/// covered by later repairs) are filled for the caller. The outline checks are listed
+/// into `checks` only if a repair uses them (`deferred`).
 void exact_projection(const Mesh& mesh, const std::vector<Vec2>& projected, double snap, double tol, AlphaShape2D& shape,
-                      std::vector<Vec2>& checks, bool& checks_sorted, EdgeOnTriangles& edge_on, std::vector<Vec2>& exact,
+                      std::vector<Vec2>& checks, DeferredChecks& deferred, EdgeOnTriangles& edge_on, std::vector<Vec2>& exact,
                       double torn_fraction, double l_max, ProjectionReport& rep) {
   // Passes of gap finding and repair; a plane with gaps after the last is replaced by its hull.
   constexpr int kExactRepairs = 3;
   auto sorted_checks = [&]() -> const std::vector<Vec2>& {
-    if (!checks_sorted) sort_unique_snapped(checks, snap);
-    checks_sorted = true;
+    deferred.list(checks);
     return checks;
   };
   // The first passes repair by inserting the gap points (a notch closes with small
@@ -1133,8 +1182,7 @@ void exact_projection(const Mesh& mesh, const std::vector<Vec2>& projected, doub
   // bunny: 81 -> 94 ms without this guess, 90 with every 16th check and triangle tested).
   // Either way the same shape results.
   constexpr std::size_t kPreCheckStride = 4;
-  bool misses = false;
-  for (std::size_t i = 0; i < checks.size() && !misses; i += kPreCheckStride) misses = !shape.contains(checks[i], tol);
+  const bool misses = deferred.any_of_every(kPreCheckStride, [&](const Vec2& q) { return !shape.contains(q, tol); });
   std::vector<Vec2> gaps;
   if (misses) {
     repair_projection(shape, sorted_checks(), exact, tol, torn_fraction, rep);
@@ -1337,9 +1385,8 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   // their circumradius √2·L_max stays below α, with a margin for the snapping.
   const bool coarse_interior = opt.coarse_interior && M_SQRT2 * r.l_max < kCoarseCellAlphaMargin * r.alpha;
   std::vector<EdgeOnTriangles> edge_on(specs.size());
-  // 1 once a plane's checks are sorted and unique (sample_projection leaves them as
-  // listed in exact mode: exact_projection sorts them if it uses them).
-  std::vector<char> checks_sorted(specs.size(), 0);
+  // Exact mode: the planes' outline checks, listed only where a repair uses them.
+  std::vector<DeferredChecks> deferred(specs.size());
   // 1 while a plane's shape is unchanged since its edge-on segments were found covered.
   std::vector<char> edge_on_clean(specs.size(), 0);
   // Gap points of the edge-on segments found so far, per plane: kept covered by every
@@ -1361,8 +1408,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     AlphaSimPlaneSamples& smp = plane_samples[k];
     // The exact test finds what centroids and midpoints of interior edges would.
     smp = sample_projection(part.mesh, edges, projected[k], r.l_max, snap, true, coarse_interior, !opt.exact_containment,
-                            !opt.exact_containment);
-    checks_sorted[k] = !opt.exact_containment;
+                            &deferred[k]);
     const std::vector<Vec2>& pts = smp.points;
     rep.points = pts.size();
     auto shape = std::make_shared<AlphaShape2D>(pts, r.alpha, std::min(opt.short_edge_factor * r.l_max, r.alpha));
@@ -1374,10 +1420,8 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       rep.status = ProjectionStatus::Empty;
       shape->keep_all();
     } else if (opt.exact_containment) {
-      bool sorted = checks_sorted[k] != 0;
-      exact_projection(part.mesh, projected[k], snap, tol, *shape, smp.checks, sorted, edge_on[k], exact_checks[k], opt.torn_fraction,
-                       r.l_max, rep);
-      checks_sorted[k] = sorted ? 1 : 0;
+      exact_projection(part.mesh, projected[k], snap, tol, *shape, smp.checks, deferred[k], edge_on[k], exact_checks[k],
+                       opt.torn_fraction, r.l_max, rep);
     } else {
       if (opt.edge_on_segments)
         edge_on[k] = edge_on_triangles(part.mesh, projected[k], edge_on_width, opt.thin_edge_factor * r.l_max, snap);
@@ -1469,8 +1513,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
         hull_missed = true;  // already the convex hull
       } else if (plane_repairs[k]++ < kRefineRounds) {
         auto& checks = plane_samples[k].checks;
-        if (!checks_sorted[k]) sort_unique_snapped(checks, snap);
-        checks_sorted[k] = 1;
+        deferred[k].list(checks);
         checks.insert(checks.end(), missed[k].begin(), missed[k].end());
         if (!missed[k].empty() && !edge_on[k].thin_active) {
           // Samples missed: the thin triangles' slivers are where (see edge_on_triangles);
