@@ -538,7 +538,7 @@ double AlphaShape2D::fill_pinches() {
     // In the order of their points (not of their handles, which are heap addresses: the
     // fills around one vertex change the next, so the order must not follow the heap).
     std::sort(candidates.begin(), candidates.end(), [](const DT::Vertex_handle& a, const DT::Vertex_handle& b) {
-      return a->point().x() < b->point().x() || (a->point().x() == b->point().x() && a->point().y() < b->point().y());
+      return xy_less(to_vec(a->point()), to_vec(b->point()));
     });
     candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
     for (const auto& v : candidates) {
@@ -1013,7 +1013,7 @@ std::vector<Vec2> AlphaShape2D::triangles_gaps(const std::vector<std::array<Vec2
   std::vector<Vec2> gaps;
   for (const auto& f : found) gaps.insert(gaps.end(), f.begin(), f.end());
   // The same list whatever the thread schedule.
-  std::sort(gaps.begin(), gaps.end(), [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+  std::sort(gaps.begin(), gaps.end(), xy_less);
   gaps.erase(std::unique(gaps.begin(), gaps.end()), gaps.end());
   return gaps;
 }
@@ -1052,10 +1052,7 @@ std::vector<std::pair<std::array<Vec2, 3>, char>> AlphaShape2D::snapshot() const
     auto c = m.coords[i];
     // From the lowest corner, so that a triangle compares equal whatever corner CGAL
     // starts it at (rotation keeps the orientation).
-    const auto lowest = std::min_element(c.begin(), c.end(), [](const Vec2& p, const Vec2& q) {
-      return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y());
-    });
-    std::rotate(c.begin(), lowest, c.end());
+    std::rotate(c.begin(), std::min_element(c.begin(), c.end(), xy_less), c.end());
     out[i] = {c, m.kept[i] ? char(1) : char(0)};
   }
   return out;
@@ -1158,7 +1155,7 @@ std::size_t merge_collinear(std::vector<Vec2>& ring, double angle_tol_rad, doubl
   // Start at the lexicographically lowest vertex: an extreme point, hence a corner.
   std::size_t s0 = 0;
   for (std::size_t i = 1; i < r.size(); ++i)
-    if (r[i].x() < r[s0].x() || (r[i].x() == r[s0].x() && r[i].y() < r[s0].y())) s0 = i;
+    if (xy_less(r[i], r[s0])) s0 = i;
   std::rotate(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(s0), r.end());
   r.push_back(r.front());  // closed for the sweep
   const double sin_tol = std::sin(angle_tol_rad);
@@ -1187,7 +1184,7 @@ std::size_t merge_collinear(std::vector<Vec2>& ring, double angle_tol_rad, doubl
     // Andrew's monotone chain over the corners and w.
     grown = hull;
     grown.push_back(w);
-    std::sort(grown.begin(), grown.end(), [](const Vec2& p, const Vec2& q) { return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y()); });
+    std::sort(grown.begin(), grown.end(), xy_less);
     grown.erase(std::unique(grown.begin(), grown.end()), grown.end());
     hull.clear();
     if (grown.size() < 3) {

@@ -17,6 +17,10 @@ namespace loom {
 /// A point in a projection plane (scene units).
 using Vec2 = Eigen::Vector2d;
 
+/// True if p comes before q in (x, then y) order: the lexicographic order every sorted
+/// point list of α-SIM uses.
+inline bool xy_less(const Vec2& p, const Vec2& q) { return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y()); }
+
 /// One connected piece of an α-shape: outer boundary counter-clockwise, holes clockwise.
 struct PolygonWithHoles2 {
   std::vector<Vec2> outer;               ///< CCW, not repeated at the end

@@ -416,9 +416,9 @@ constexpr double kCoarseCellAlphaMargin = 0.9;
 /// (≤ tol/4, moving a point by ≤ 0.18·tol) that keeps every point of them within tol.
 constexpr double kEdgeOnWidthShare = 0.25, kEdgeOnTolShare = 0.5;
 
-/// Lexicographic order (x, then y) of plane points.
+/// Lexicographic order (x, then y) of plane points, as a function object.
 struct Vec2Less {
-  bool operator()(const Vec2& p, const Vec2& q) const { return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y()); }
+  bool operator()(const Vec2& p, const Vec2& q) const { return xy_less(p, q); }
 };
 
 void sort_unique(std::vector<Vec2>& v) {
@@ -472,6 +472,12 @@ std::uint64_t hash_doubles(const double* x, std::size_t n) {
     h ^= h >> 31;
   }
   return h;
+}
+
+/// hash_doubles of a triangle's six coordinates (corners in the order given).
+std::uint64_t hash_triangle(const std::array<Vec2, 3>& t) {
+  const double c[6] = {t[0].x(), t[0].y(), t[1].x(), t[1].y(), t[2].x(), t[2].y()};
+  return hash_doubles(c, 6);
 }
 
 /// Drops repeats from `items`: of the items that `same` says are equal (their `hash`
@@ -539,10 +545,13 @@ std::vector<Vec2> project_vertices(const Mesh& mesh, const AlphaSimPrism& pr) {
   return proj;
 }
 
-/// The checks of an outline edge pa → pb (n pieces): its sub-edge midpoints, snapped.
+/// The checks of an outline edge pa → pb (n pieces): its sub-edge midpoints, snapped,
+/// each passed to f until f returns true; true if it did.
 template <class F>
-void for_each_outline_check(const Vec2& pa, const Vec2& pb, int n, double snap, F&& f) {
-  for (int k = 0; k < n; ++k) f(snap_to_grid(pa + (pb - pa) * ((k + 0.5) / n), snap));
+bool outline_checks_until(const Vec2& pa, const Vec2& pb, int n, double snap, F&& f) {
+  for (int k = 0; k < n; ++k)
+    if (f(snap_to_grid(pa + (pb - pa) * ((k + 0.5) / n), snap))) return true;
+  return false;
 }
 
 /// Pieces an edge of projected length `len` is cut into: each ≤ l_max.
@@ -556,26 +565,30 @@ struct DeferredChecks {
   std::vector<std::array<double, 4>> edges;
   double l_max = 0.0, snap = 0.0;
   bool listed = true;  ///< true once `checks` holds them all, sorted and unique
+  /// f(check) for each check in the order they would be listed, until f returns true;
+  /// true if it did.
+  template <class F>
+  bool until(F&& f) const {
+    for (const auto& e : edges) {
+      const Vec2 pa(e[0], e[1]), pb(e[2], e[3]);
+      if (outline_checks_until(pa, pb, outline_pieces((pb - pa).norm(), l_max), snap, f)) return true;
+    }
+    return false;
+  }
   /// f(check) for every `stride`-th check in the order they would be listed, until f
   /// returns true; true if it did.
   template <class F>
   bool any_of_every(std::size_t stride, F&& f) const {
     std::size_t i = 0;
-    for (const auto& e : edges) {
-      const Vec2 pa(e[0], e[1]), pb(e[2], e[3]);
-      const int n = outline_pieces((pb - pa).norm(), l_max);
-      for (int k = 0; k < n; ++k, ++i)
-        if (i % stride == 0 && f(snap_to_grid(pa + (pb - pa) * ((k + 0.5) / n), snap))) return true;
-    }
-    return false;
+    return until([&](const Vec2& q) { return i++ % stride == 0 && f(q); });
   }
   /// Appends them to `checks`, sorts those (sort_unique_snapped) and marks them listed.
   void list(std::vector<Vec2>& checks) {
     if (listed) return;
-    for (const auto& e : edges) {
-      const Vec2 pa(e[0], e[1]), pb(e[2], e[3]);
-      for_each_outline_check(pa, pb, outline_pieces((pb - pa).norm(), l_max), snap, [&](const Vec2& q) { checks.push_back(q); });
-    }
+    until([&](const Vec2& q) {
+      checks.push_back(q);
+      return false;
+    });
     sort_unique_snapped(checks, snap);
     edges.clear();
     listed = true;
@@ -695,7 +708,10 @@ AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
       }
     if (defer && e[4] != 0.0) deferred->edges.push_back({e[0], e[1], e[2], e[3]});
     else if (e[4] != 0.0 || all_checks)
-      for_each_outline_check(pa, pb, n, snap, [&](const Vec2& q) { s.checks.push_back(q); });
+      outline_checks_until(pa, pb, n, snap, [&](const Vec2& q) {
+        s.checks.push_back(q);
+        return false;
+      });
   }
   sort_unique_snapped(s.points, snap);
   sort_unique_snapped(s.checks, snap);
@@ -739,7 +755,7 @@ EdgeOnTriangles edge_on_triangles(const Mesh& mesh, const std::vector<Vec2>& pro
   // The segment pq snapped, ends in lexicographic order (so that equal segments compare equal).
   auto snapped_segment = [snap](const Vec2& p, const Vec2& q) {
     Vec2 a = snap_to_grid(p, snap), b = snap_to_grid(q, snap);
-    if (b.x() < a.x() || (b.x() == a.x() && b.y() < a.y())) std::swap(a, b);
+    if (xy_less(b, a)) std::swap(a, b);
     return std::array<Vec2, 2>{a, b};
   };
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
@@ -1027,8 +1043,7 @@ std::vector<std::array<Vec2, 2>> changed_boxes(const ShapeSnapshot& a, const Sha
   std::vector<std::pair<std::uint64_t, std::uint64_t>> keys;
   keys.reserve(a.size() + b.size());
   auto hash = [](const std::pair<std::array<Vec2, 3>, char>& t) {
-    return hash_doubles(t.first[0].data(), 2) ^ hash_doubles(t.first[1].data(), 2) * 3 ^
-           hash_doubles(t.first[2].data(), 2) * 5 ^ std::uint64_t(t.second) * 0x9e3779b97f4a7c15ull;
+    return hash_triangle(t.first) ^ std::uint64_t(t.second) * 0x9e3779b97f4a7c15ull;
   };
   for (std::size_t i = 0; i < a.size(); ++i) keys.emplace_back(hash(a[i]), std::uint64_t(i) << 1);
   for (std::size_t i = 0; i < b.size(); ++i) keys.emplace_back(hash(b[i]), std::uint64_t(i) << 1 | 1u);
@@ -1102,13 +1117,13 @@ void exact_projection(const Mesh& mesh, const std::vector<Vec2>& projected, doub
                       double torn_fraction, double l_max, ProjectionReport& rep) {
   // Passes of gap finding and repair; a plane with gaps after the last is replaced by its hull.
   constexpr int kExactRepairs = 3;
+  // The first passes repair by inserting the gap points (a notch closes with small
+  // triangles), the later ones by keeping the faces that hold them.
+  constexpr int kRefinePasses = 1;
   auto sorted_checks = [&]() -> const std::vector<Vec2>& {
     deferred.list(checks);
     return checks;
   };
-  // The first passes repair by inserting the gap points (a notch closes with small
-  // triangles), the later ones by keeping the faces that hold them.
-  constexpr int kRefinePasses = 1;
   const double edge_on_width = kEdgeOnWidthShare * tol, edge_on_tol = kEdgeOnTolShare * tol;
   const double triangle_tol = tol - snap * M_SQRT1_2;
   const double gap_spacing = l_max / 4.0;
@@ -1129,7 +1144,7 @@ void exact_projection(const Mesh& mesh, const std::vector<Vec2>& projected, doub
   // (AlphaShape2D::triangles_gaps sorts its gap points: the order of `tested` is free.)
   for (auto& t : tested) std::sort(t.begin(), t.end(), Vec2Less());
   dedupe_by_hash(
-      tested, [](const auto& t) { return hash_doubles(t[0].data(), 2) ^ hash_doubles(t[1].data(), 2) * 3 ^ hash_doubles(t[2].data(), 2) * 5; },
+      tested, hash_triangle,
       [](const auto& x, const auto& y) { return x == y; }, [](auto&, const auto&) {});
   // After a repair only what lies near a change can have changed: a triangle or segment
   // whose box, widened by tol, meets no Delaunay triangle that the repair added, removed
@@ -1489,8 +1504,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       for (std::size_t k = 0; k < specs.size(); ++k) missed[k].insert(missed[k].end(), lm[k].begin(), lm[k].end());
     for (std::size_t k = 0; k < specs.size(); ++k) {
       // Deterministic order whatever the thread schedule.
-      std::sort(missed[k].begin(), missed[k].end(),
-                [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+      std::sort(missed[k].begin(), missed[k].end(), xy_less);
       miss[k] = missed[k].size() + gapped[k].size();
     }
     return miss;

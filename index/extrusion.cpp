@@ -516,7 +516,10 @@ ExtrusionsMesh first_operand(const std::vector<Extrusion>& kept) {
 }
 
 /// first_operand() ∩ the rest of `kept` (CGAL corefinement), faces merged within tol.
-ExtrusionsMesh intersect_rest(ExtrusionsMesh acc, const std::vector<Extrusion>& kept, double tol) {
+/// `meshes`, if given, holds labelled_extrusion_mesh() of kept[i] at i where the caller
+/// built it already (an empty mesh elsewhere).
+ExtrusionsMesh intersect_rest(ExtrusionsMesh acc, const std::vector<Extrusion>& kept, double tol,
+                              const std::vector<FacedMesh>* meshes = nullptr) {
   const bool pair = kept.size() >= 2 && sliceable(kept[0], kept[1]);
   if (pair && kept.size() > 2) {
     // Only fewer triangles for the Boolean to cut: where merge_face_vertices refuses a
@@ -527,7 +530,10 @@ ExtrusionsMesh intersect_rest(ExtrusionsMesh acc, const std::vector<Extrusion>& 
     }
   }
   for (std::size_t i = pair ? 2 : 1; i < kept.size(); ++i) {
-    static_cast<FacedMesh&>(acc) = mesh_intersection(acc, labelled_extrusion_mesh(kept[i]));
+    const bool built = meshes && i < meshes->size() && !(*meshes)[i].mesh.triangles.empty();
+    FacedMesh own;
+    const FacedMesh& operand = built ? (*meshes)[i] : (own = labelled_extrusion_mesh(kept[i]));
+    static_cast<FacedMesh&>(acc) = mesh_intersection(acc, operand);
     ++acc.booleans;
   }
   if (acc.booleans > 0) merge_face_vertices(acc, (pair ? 1.0 - kSliceMergeShare : 1.0) * tol);
@@ -573,6 +579,7 @@ ExtrusionsMesh mesh_extrusions(const std::vector<Extrusion>& kept, double tol) {
   struct Candidate {
     std::vector<Extrusion> kept;
     ExtrusionsMesh first;
+    std::vector<FacedMesh> meshes;  ///< at 2: the third prism's mesh, where counted
     std::size_t cost = 0;
     std::string error;  ///< why its operands could not be built
   };
@@ -583,7 +590,11 @@ ExtrusionsMesh mesh_extrusions(const std::vector<Extrusion>& kept, double tol) {
     c.kept = {kept[static_cast<std::size_t>(o[0])], kept[static_cast<std::size_t>(o[1])], kept[static_cast<std::size_t>(o[2])]};
     try {
       c.first = first_operand(c.kept);
-      if (sliceable(c.kept[0], c.kept[1])) c.cost = box_overlaps(c.first.mesh, labelled_extrusion_mesh(c.kept[2]).mesh);
+      if (sliceable(c.kept[0], c.kept[1])) {
+        c.meshes.resize(3);
+        c.meshes[2] = labelled_extrusion_mesh(c.kept[2]);
+        c.cost = box_overlaps(c.first.mesh, c.meshes[2].mesh);
+      }
     } catch (const std::runtime_error& e) {
       c.error = e.what();
     }
@@ -598,7 +609,7 @@ ExtrusionsMesh mesh_extrusions(const std::vector<Extrusion>& kept, double tol) {
     Candidate& c = candidates[k];
     try {
       if (!c.error.empty()) throw std::runtime_error(c.error);
-      return intersect_rest(std::move(c.first), c.kept, tol);
+      return intersect_rest(std::move(c.first), c.kept, tol, &c.meshes);
     } catch (const std::runtime_error& e) {
       why += std::string(why.empty() ? "" : "; ") + e.what();
     }
