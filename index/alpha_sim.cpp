@@ -878,12 +878,17 @@ std::vector<PlaneSpec> planes_for(const AlphaSimOptions& opt) {
 
 /// One closed or open mesh as a one-part EmbreeIndex: exact (double) distances and
 /// ray-parity inside tests (DESIGN §9: Embree for BVH queries).
-EmbreeIndex mesh_index(Mesh m, bool closed) {
+/// An EmbreeIndex over one mesh. `watertight`: checked closed and consistently oriented,
+/// so one ray that grazes nothing decides an inside test exactly (inside_rays = 1); the
+/// default majority of three guards real meshes with holes, at three times the rays.
+EmbreeIndex mesh_index(Mesh m, bool closed, bool watertight = false) {
   std::vector<Part> parts(1);
   parts[0].name = "alpha-sim";
   parts[0].mesh = std::move(m);
   parts[0].closed = closed;
-  return EmbreeIndex(parts);
+  EmbreeOptions eo;
+  if (watertight) eo.inside_rays = 1;
+  return EmbreeIndex(parts, eo);
 }
 
 /// Number of `samples` inside or within tol of the closed mesh indexed by q (parallel).
@@ -1740,7 +1745,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
           std::plus<std::size_t>());
       r.containment_implicit = samples.empty() ? 1.0 : static_cast<double>(in) / samples.size();
     }
-    const EmbreeIndex simplified = mesh_index(out.mesh, true);
+    const EmbreeIndex simplified = mesh_index(out.mesh, true, true);  // watertight: checked above
     const std::size_t in = count_contained_mesh(simplified, samples, tol);
     r.containment = samples.empty() ? 1.0 : static_cast<double>(in) / samples.size();
     if (in != samples.size()) {
@@ -1752,10 +1757,12 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     }
     // One-sided Hausdorff distance: output surface → original surface.
     const EmbreeIndex original = mesh_index(part.mesh, r.closed_before);
-    const auto surf = dense_surface_samples(out.mesh, r.l_max, 1.0, 200000, opt.seed + 1);
     r.hausdorff = 0.0;
-    for (const ClosestHit& h : original.closest_batch(surf, std::numeric_limits<double>::infinity()))
-      r.hausdorff = std::max(r.hausdorff, h.distance);
+    if (opt.hausdorff) {
+      const auto surf = dense_surface_samples(out.mesh, r.l_max, 1.0, 200000, opt.seed + 1);
+      for (const ClosestHit& h : original.closest_batch(surf, std::numeric_limits<double>::infinity()))
+        r.hausdorff = std::max(r.hausdorff, h.distance);
+    }
 
     // Lost space (blocked projections): largest ball inside the simplified solid and
     // outside the original, probed on a grid.

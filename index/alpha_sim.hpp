@@ -100,6 +100,9 @@ struct AlphaSimOptions {
   /// always uses OpenCASCADE (it needs the B-rep).
   bool occt_booleans = false;
   bool measure = true;          ///< containment of the mesh + Hausdorff distance
+  /// With measure: also the Hausdorff distance (a figure for the report: routing, which
+  /// needs the containment check and the lost-space probe only, skips it; then 0).
+  bool hausdorff = true;
   /// If set, writes <step_dir>/<stem>.step (OpenCASCADE); the stem is simplify_part's
   /// `step_stem`, in simplify_parts the part's output_file_stems entry.
   std::filesystem::path step_dir;
@@ -176,7 +179,7 @@ struct AlphaSimResult {
   std::size_t containment_samples = 0;
   /// Verification rounds that found random samples outside a shape and repaired it.
   int repair_rounds = 0;
-  double hausdorff = 0.0;             ///< max over the output surface of the distance to the original
+  double hausdorff = 0.0;             ///< max over the output surface of the distance to the original (0 unless measured)
   double lost_space_radius = 0.0;     ///< largest probed ball radius filled by the simplification
   double lost_space_resolution = 0.0; ///< grid spacing of that probe
   double time_ms = 0.0;

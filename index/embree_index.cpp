@@ -31,6 +31,9 @@ constexpr double kFloatPadRel = 16.0 / 16777216.0;
 /// Barycentric margin under which a ray is said to graze an edge or vertex of a triangle
 /// it crosses; such a ray is discarded from the inside vote.
 constexpr double kGrazeBary = 1e-6;
+/// Winding number above 0.5 by this much counts as inside when every ray grazed (a point on
+/// the surface has 0.5 up to the rounding of the solid angles).
+constexpr double kWindingMargin = 1e-6;
 /// Directions of the inside-test rays: fixed, irrational-looking, pairwise far apart, so
 /// that no axis-aligned CAD edge is parallel to any of them.
 const Vec3 kInsideDirs[] = {
@@ -199,10 +202,14 @@ struct LineCrossing {
   double t = 0.0;
 };
 
-/// Classifies the line's crossing of triangle abc: Through when the barycentrics are all
-/// at least kGrazeBary, Miss when one is below -kGrazeBary, Grazing otherwise (near an
-/// edge or vertex, or the line lies in the plane of a non-degenerate triangle).
-LineCrossing line_crossing(const Vec3& p, const Vec3& u, const Vec3& a, const Vec3& b, const Vec3& c) {
+/// Classifies the line's crossing of triangle abc: Grazing when the crossing point lies
+/// within `margin` (absolute, scene units) of an edge line of the triangle, or within
+/// kGrazeBary of one in barycentric terms, or the line lies in the triangle's plane;
+/// otherwise Through or Miss. `margin` bounds the float rounding of Embree's ray test
+/// across the ray: a crossing closer than that to an edge may be reported on the
+/// neighbouring triangle or on neither, so the ray cannot count it.
+LineCrossing line_crossing(const Vec3& p, const Vec3& u, const Vec3& a, const Vec3& b, const Vec3& c,
+                           double margin) {
   LineCrossing out;
   const Vec3 e1 = b - a, e2 = c - a;
   const Vec3 pv = u.cross(e2);
@@ -220,9 +227,24 @@ LineCrossing line_crossing(const Vec3& p, const Vec3& u, const Vec3& a, const Ve
   const double bu = tv.dot(pv) * inv;
   const Vec3 qv = tv.cross(e1);
   const double bv = u.dot(qv) * inv;
-  const double m = std::min({bu, bv, 1.0 - bu - bv});
+  const double bw = 1.0 - bu - bv;
   out.t = e2.dot(qv) * inv;
-  out.status = m >= kGrazeBary ? LineCrossing::Through : m < -kGrazeBary ? LineCrossing::Miss : LineCrossing::Grazing;
+  // Distance of the crossing point from each edge line: its barycentric coordinate times
+  // the altitude onto that edge, 2·area / edge length.
+  const double twice_area = e1.cross(e2).norm();
+  const double du = bu * twice_area / e2.norm();        // from edge ca (opposite b)
+  const double dv = bv * twice_area / e1.norm();        // from edge ab (opposite c)
+  const double dw = bw * twice_area / (c - b).norm();   // from edge bc (opposite a)
+  const double m = std::min({bu, bv, bw}), d = std::min({du, dv, dw});
+  // A rounding of `margin` across the ray moves the crossing by margin / |cos| within the
+  // plane, |cos| = |u · n| = |det| / (2·area): a ray at a glancing angle grazes sooner.
+  margin *= twice_area / std::abs(det);
+  if (m >= kGrazeBary && d > margin)
+    out.status = LineCrossing::Through;
+  else if (m < -kGrazeBary && d < -margin)
+    out.status = LineCrossing::Miss;
+  else
+    out.status = LineCrossing::Grazing;
   return out;
 }
 
@@ -643,6 +665,9 @@ bool EmbreeIndex::inside(const Vec3& p, int* part) const {
     // can stop where it leaves the last of them instead of crossing the whole scene.
     double exit = 0.0;
     for (const std::uint32_t c : cand) exit = std::max(exit, box_exit_distance(parts_[c].bounds, p, u));
+    // Float rounding of the ray test, across the ray, anywhere along it (the bound that
+    // pads every culling radius).
+    const double margin = float_pad(p, exit);
     hits.clear();
     CollectContext cc;
     rtcInitIntersectContext(&cc.ctx);
@@ -672,7 +697,7 @@ bool EmbreeIndex::inside(const Vec3& p, int* part) const {
       const auto it = std::find(cand.begin(), cand.end(), h.first);
       if (it == cand.end()) continue;
       const auto c = parts_[h.first].corners(h.second);
-      const LineCrossing x = line_crossing(p, u, c[0], c[1], c[2]);
+      const LineCrossing x = line_crossing(p, u, c[0], c[1], c[2], margin);
       if (x.status == LineCrossing::Grazing) {
         grazing = true;  // the ray passes by an edge or vertex, or lies in the plane
         break;
@@ -687,7 +712,24 @@ bool EmbreeIndex::inside(const Vec3& p, int* part) const {
     ++valid_rays;
     for (std::size_t i = 0; i < cand.size(); ++i) votes_in[i] += crossings[i] % 2;
   }
-  if (valid_rays == 0) valid_rays = 1;  // every ray grazed: treat as outside (on the surface)
+  if (valid_rays == 0) {
+    // Every ray grazed: p lies on a surface, or among triangles too small for the float
+    // rays at this distance from the centre. The generalized winding number decides, in
+    // double (O(triangles) of the candidates; 0.5 on the surface, which is not inside).
+    for (const std::uint32_t c : cand) {
+      const PartData& pd = parts_[c];
+      double w = 0.0;
+      for (std::size_t t = 0; t < pd.triangles.size(); ++t) {
+        const auto tc = pd.corners(t);
+        w += triangle_solid_angle(p, tc[0], tc[1], tc[2]);
+      }
+      if (w > 0.5 + kWindingMargin) {
+        if (part) *part = static_cast<int>(c);
+        return true;
+      }
+    }
+    return false;
+  }
   for (std::size_t i = 0; i < cand.size(); ++i)
     if (2 * votes_in[i] > valid_rays) {
       if (part) *part = static_cast<int>(cand[i]);

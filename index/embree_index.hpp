@@ -8,7 +8,10 @@
 /// distances are exact up to double rounding. Inside the callback a triangle is first
 /// rejected by its box (a lower bound, so still exact), and its zero-area flag, stored at
 /// build, spares the exact kernel its degeneracy test. Inside tests cast several rays (majority
-/// vote, rays grazing an edge or vertex are discarded) and count crossings of closed parts.
+/// vote) and count crossings of closed parts, each decided in double; a ray whose crossing
+/// lies within the float rounding of Embree's ray test of an edge or vertex (where Embree
+/// may report it on the neighbouring triangle, or on neither) is discarded, and if every
+/// ray is, the generalized winding number decides.
 
 #include "core/part.hpp"
 #include "index/obstacle_index.hpp"
@@ -29,7 +32,8 @@ struct EmbreeOptions {
   /// closest queries: the right trade when one build serves one audit).
   int build_quality = -1;
   /// Rays cast for an inside test; the answer is the majority of the rays that do not
-  /// graze an edge or vertex (odd, ≥ 1).
+  /// graze an edge or vertex (odd, ≥ 1). One is exact on a watertight mesh; the majority
+  /// guards real meshes with holes.
   int inside_rays = 3;
 };
 

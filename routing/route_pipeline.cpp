@@ -125,6 +125,7 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
     AlphaSimOptions ao;
     ao.dim_pre = scene.simplify.dim_pre.value;
     ao.detect_lost_space = true;
+    ao.hausdorff = false;  // not reported by routing; the containment check and lost-space probe stay
     ao.progress = opt.progress;
     std::vector<AlphaSimResult> results;
     planning_parts = simplify_parts(scene.parts, ao, &results);

@@ -23,6 +23,8 @@
 #include "index/extrusion.hpp"
 #include "routing/sweep.hpp"
 
+#include "../index/index_test_meshes.hpp"
+
 namespace {
 
 using loom::Centerline;
@@ -352,4 +354,37 @@ TEST(Regression, AlphaSimPinchFillsDoNotFollowTheHeap) {
     EXPECT_TRUE(again.mesh.vertices == first.mesh.vertices && again.mesh.triangles == first.mesh.triangles)
         << "run " << run;
   }
+}
+
+// 2026-11-26, session 27: with one ray per inside test (what α-SIM wanted for its
+// watertight output, 3× fewer rays), α-SIM's containment check found 0.9999931 of the
+// motor's samples inside (CgalBooleansGiveTheSolidOfOpenCascade). Embree's float ray test
+// put crossings that lie 1e-5..6e-3 of a triangle's width from a shared edge (more than the
+// barycentric grazing margin, 1e-6) on the neighbouring triangle, whose exact test then
+// missed, or on neither: the crossing was lost and the parity flipped. The majority of
+// three rays had hidden it. A crossing within the float rounding of the ray test (the
+// culling pad, over the cosine of the incidence) of an edge now grazes, and when every ray
+// grazes the winding number decides. Four points that one ray classified wrongly: a fine
+// sphere (96 × 48) with a box 4000 units away, so the index centre is 2000 away from it.
+TEST(Regression, EmbreeOneRayInsideKeepsCrossingsNearSharedEdges) {
+  using loom::testmesh::box;
+  using loom::testmesh::uv_sphere;
+  std::vector<loom::Part> parts(2);
+  parts[0].name = "fine";
+  parts[0].mesh = uv_sphere(Vec3::Zero(), 1.0, 96, 48);
+  parts[0].closed = true;
+  parts[1].name = "far";
+  parts[1].mesh = box(Vec3::Constant(4000), Vec3::Constant(4001));
+  parts[1].closed = true;
+  loom::EmbreeOptions one;
+  one.inside_rays = 1;
+  const loom::EmbreeIndex e(parts, one);
+  const struct {
+    Vec3 p;
+    bool inside;
+  } cases[] = {{Vec3(0.43480167302257899, -0.96345855721236473, -0.41832604705775012), false},
+               {Vec3(-0.17824256649075543, -0.55859443028242328, 0.067049945044918235), true},
+               {Vec3(0.18683456229730644, -0.76237505427020036, -0.64231826484776589), false},
+               {Vec3(0.52977313759478561, 0.08655659338384547, 0.4868321903933317), true}};
+  for (const auto& c : cases) EXPECT_EQ(e.inside(c.p), c.inside) << c.p.transpose();
 }
