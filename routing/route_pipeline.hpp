@@ -24,10 +24,11 @@ struct RouteOptions {
   long seed = -1;            ///< < 0: scene.routing.seed
   int threads = 0;           ///< audit threads (≤ 0: all cores)
   /// Plan among α-simplified obstacles (false: the exact parts). Off by default: on the
-  /// bundled wing section α-SIM costs ~1.1 s and brings no reliable gain on a ~0.3 s planning
-  /// time (−28% to +25%, bench/results/route.csv): Embree on the exact 147k triangles is
-  /// already fast. Turn it on for scenes whose detail (threads, rivets) slows the planner
-  /// more than simplifying costs.
+  /// bundled wing section α-SIM costs ~0.25 s (with its containment check and lost-space
+  /// probe) and takes planning from ~0.46 to ~0.36 s (`loom route`; from −28% to +25% in
+  /// bench/results/route.csv): Embree on the exact 147k triangles is already fast. Turn
+  /// it on for scenes whose detail (threads, rivets) slows the planner more than
+  /// simplifying costs.
   bool simplify = false;
   /// Planning obstacles computed by the caller (e.g. α-simplified once and reused across
   /// runs, as bench_route does); when set, `simplify` is ignored. They must contain the
