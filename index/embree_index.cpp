@@ -34,6 +34,9 @@ constexpr double kGrazeBary = 1e-6;
 /// Winding number above 0.5 by this much counts as inside when every ray grazed (a point on
 /// the surface has 0.5 up to the rounding of the solid angles).
 constexpr double kWindingMargin = 1e-6;
+/// A closed part whose box diagonal is below this many times the float rounding of a ray
+/// at its distance from the centre is decided by the winding number, not by rays.
+constexpr double kRayResolvedParts = 1000.0;
 /// Directions of the inside-test rays: fixed, irrational-looking, pairwise far apart, so
 /// that no axis-aligned CAD edge is parallel to any of them.
 const Vec3 kInsideDirs[] = {
@@ -648,6 +651,36 @@ bool EmbreeIndex::inside(const Vec3& p, int* part) const {
   at.extend(p);
   impl_->closed_boxes->overlapping(at, cand);
   if (cand.empty()) return false;
+  // A part not much larger than the float rounding of a ray at this distance from the
+  // centre cannot be crossed reliably (Embree may report none of its triangles, which no
+  // test here could notice): the winding number decides it, in double, O(its triangles).
+  // So does every candidate when every ray grazed (p on a surface: ±0.5, not inside; −1
+  // inside a part oriented inwards, which the rays' parity also counts as inside).
+  auto winding_inside = [&](std::uint32_t c) {
+    const PartData& pd = parts_[c];
+    double w = 0.0;
+    for (std::size_t t = 0; t < pd.triangles.size(); ++t) {
+      const auto tc = pd.corners(t);
+      w += triangle_solid_angle(p, tc[0], tc[1], tc[2]);
+    }
+    return std::abs(w) > 0.5 + kWindingMargin;
+  };
+  std::vector<char> by_winding(cand.size(), 0);
+  bool any_by_rays = false;
+  for (std::size_t i = 0; i < cand.size(); ++i) {
+    const double size = parts_[cand[i]].bounds.diagonal();
+    by_winding[i] = size < kRayResolvedParts * float_pad(p, size) ? 1 : 0;
+    any_by_rays = any_by_rays || !by_winding[i];
+  }
+  auto answer = [&](std::size_t i) {
+    if (part) *part = static_cast<int>(cand[i]);
+    return true;
+  };
+  if (!any_by_rays) {
+    for (std::size_t i = 0; i < cand.size(); ++i)
+      if (winding_inside(cand[i])) return answer(i);
+    return false;
+  }
   FlushDenormals ftz;
   const Vec3 pc = p - centre_;
   const double back = 4.0 * float_pad(p, 0.0);
@@ -664,7 +697,8 @@ bool EmbreeIndex::inside(const Vec3& p, int* part) const {
     // Only crossings of the candidates count, and p lies in each candidate's box: the ray
     // can stop where it leaves the last of them instead of crossing the whole scene.
     double exit = 0.0;
-    for (const std::uint32_t c : cand) exit = std::max(exit, box_exit_distance(parts_[c].bounds, p, u));
+    for (std::size_t i = 0; i < cand.size(); ++i)
+      if (!by_winding[i]) exit = std::max(exit, box_exit_distance(parts_[cand[i]].bounds, p, u));
     // Float rounding of the ray test, across the ray, anywhere along it (the bound that
     // pads every culling radius).
     const double margin = float_pad(p, exit);
@@ -695,7 +729,7 @@ bool EmbreeIndex::inside(const Vec3& p, int* part) const {
     bool grazing = false;
     for (const auto& h : hits) {
       const auto it = std::find(cand.begin(), cand.end(), h.first);
-      if (it == cand.end()) continue;
+      if (it == cand.end() || by_winding[it - cand.begin()]) continue;
       const auto c = parts_[h.first].corners(h.second);
       const LineCrossing x = line_crossing(p, u, c[0], c[1], c[2], margin);
       if (x.status == LineCrossing::Grazing) {
@@ -712,29 +746,11 @@ bool EmbreeIndex::inside(const Vec3& p, int* part) const {
     ++valid_rays;
     for (std::size_t i = 0; i < cand.size(); ++i) votes_in[i] += crossings[i] % 2;
   }
-  if (valid_rays == 0) {
-    // Every ray grazed: p lies on a surface, or among triangles too small for the float
-    // rays at this distance from the centre. The generalized winding number decides, in
-    // double (O(triangles) of the candidates; 0.5 on the surface, which is not inside).
-    for (const std::uint32_t c : cand) {
-      const PartData& pd = parts_[c];
-      double w = 0.0;
-      for (std::size_t t = 0; t < pd.triangles.size(); ++t) {
-        const auto tc = pd.corners(t);
-        w += triangle_solid_angle(p, tc[0], tc[1], tc[2]);
-      }
-      if (w > 0.5 + kWindingMargin) {
-        if (part) *part = static_cast<int>(c);
-        return true;
-      }
-    }
-    return false;
+  // In candidate order, as every answer here: the first part that holds p.
+  for (std::size_t i = 0; i < cand.size(); ++i) {
+    const bool in = by_winding[i] || valid_rays == 0 ? winding_inside(cand[i]) : 2 * votes_in[i] > valid_rays;
+    if (in) return answer(i);
   }
-  for (std::size_t i = 0; i < cand.size(); ++i)
-    if (2 * votes_in[i] > valid_rays) {
-      if (part) *part = static_cast<int>(cand[i]);
-      return true;
-    }
   return false;
 }
 

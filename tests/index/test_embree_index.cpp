@@ -236,6 +236,37 @@ TEST(EmbreeIndex, OneRayInsideIsExactOnSmallTrianglesFarFromTheCentre) {
   EXPECT_GT(inside, 2000);
 }
 
+// A part barely larger than the float rounding at its distance from the index centre (a
+// unit sphere a million units from it, rounding ~2 units): rays cannot resolve it (Embree
+// may report none of its triangles), so the winding number in double decides — also for
+// the same sphere oriented inwards (winding −1 inside), which rays' parity counts as
+// inside too.
+TEST(EmbreeIndex, InsideUsesTheWindingNumberWhereRaysCannotResolveThePart) {
+  Mesh inward = uv_sphere(Vec3::Zero(), 1.0, 48, 24);
+  for (auto& t : inward.triangles) std::swap(t[1], t[2]);
+  for (const Mesh& sphere : {uv_sphere(Vec3::Zero(), 1.0, 48, 24), inward}) {
+    const std::vector<Part> parts = {make_part("tiny", sphere, true),
+                                     make_part("far", box(Vec3::Constant(2e6), Vec3::Constant(2e6 + 1)), true)};
+    const EmbreeIndex e(parts);
+    std::mt19937_64 rng(41);
+    std::uniform_real_distribution<double> u(-1.5, 1.5);
+    int inside = 0;
+    for (int i = 0; i < 300; ++i) {
+      const Vec3 p(u(rng), u(rng), u(rng));
+      const double r = p.norm();
+      if (r > 0.98 && r < 1.02) continue;  // between the inscribed polyhedron and the sphere
+      int part = -1;
+      const bool in = e.inside(p, &part);
+      EXPECT_EQ(in, r < 0.98) << p.transpose();
+      if (in) {
+        EXPECT_EQ(part, 0);
+        ++inside;
+      }
+    }
+    EXPECT_GT(inside, 20);
+  }
+}
+
 TEST(EmbreeIndex, RaysThroughVerticesAndEdgesOfABox) {
   // Axis-aligned box: points on the grid of its vertex coordinates make axis rays hit
   // edges exactly; the fixed non-axis inside rays and the majority must still be right.
