@@ -12,8 +12,6 @@ namespace loom {
 
 namespace {
 
-constexpr double kFourPi = 4.0 * 3.14159265358979323846;
-
 void check_part(int part, std::size_t n) {
   if (part < 0 || static_cast<std::size_t>(part) >= n)
     throw std::out_of_range("obstacle index: part id " + std::to_string(part) + " out of range [0, " +
@@ -45,9 +43,7 @@ std::vector<PartTriangles> extract_part_triangles(const std::vector<Part>& parts
 }
 
 double winding_number(const PartTriangles& part, const Vec3& p) {
-  double sum = 0.0;
-  for (const auto& t : part.triangles) sum += triangle_solid_angle(p, t[0], t[1], t[2]);
-  return sum / kFourPi;
+  return triangles_winding_number(p, part.triangles.size(), [&](std::size_t t) { return part.triangles[t]; });
 }
 
 BruteForceIndex::BruteForceIndex(const std::vector<Part>& parts) : parts_(extract_part_triangles(parts)) {}

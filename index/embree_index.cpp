@@ -31,8 +31,8 @@ constexpr double kFloatPadRel = 16.0 / 16777216.0;
 /// Barycentric margin under which a ray is said to graze an edge or vertex of a triangle
 /// it crosses; such a ray is discarded from the inside vote.
 constexpr double kGrazeBary = 1e-6;
-/// Winding number above 0.5 by this much counts as inside when every ray grazed (a point on
-/// the surface has 0.5 up to the rounding of the solid angles).
+/// A winding number above 0.5 by this much counts as inside where the winding number
+/// decides (it passes 0.5 only within rounding of the surface, where p counts as on it).
 constexpr double kWindingMargin = 1e-6;
 /// A closed part whose box diagonal is below this many times the float rounding of a ray
 /// at its distance from the centre is decided by the winding number, not by rays.
@@ -435,11 +435,14 @@ double EmbreeIndex::float_pad(const Vec3& p, double radius) const {
   return kFloatPadRel * (half_extent_ + far + r) + std::numeric_limits<float>::min();
 }
 
+double EmbreeIndex::distance_rounding() const {
+  return 16.0 * std::numeric_limits<double>::epsilon() * (centre_.cwiseAbs().maxCoeff() + half_extent_);
+}
+
 IndexAccuracy EmbreeIndex::accuracy() const {
   IndexAccuracy a;
   a.exact = true;
-  const double extent = centre_.cwiseAbs().maxCoeff() + half_extent_;
-  a.abs_error = 16.0 * std::numeric_limits<double>::epsilon() * extent;
+  a.abs_error = distance_rounding();
   a.description = "embree float BVH re-centred on (" + full_precision(centre_.x()) + ", " +
                   full_precision(centre_.y()) + ", " + full_precision(centre_.z()) +
                   "), culling radius padded by " + full_precision(kFloatPadRel * half_extent_) +
@@ -654,15 +657,15 @@ bool EmbreeIndex::inside(const Vec3& p, int* part) const {
   // A part not much larger than the float rounding of a ray at this distance from the
   // centre cannot be crossed reliably (Embree may report none of its triangles, which no
   // test here could notice): the winding number decides it, in double, O(its triangles).
-  // So does every candidate when every ray grazed (p on a surface: ±0.5, not inside; −1
-  // inside a part oriented inwards, which the rays' parity also counts as inside).
+  // So does every candidate when every ray grazed (p on a surface, which is not inside; a
+  // winding number of −1 is inside a part oriented inwards, as the rays' parity counts it).
+  const double on_surface = distance_rounding();
   auto winding_inside = [&](std::uint32_t c) {
+    // On the surface (within the rounding of the exact distance) p is not strictly inside;
+    // there the solid angle of the face under p is ±2π by the rounding of a zero.
+    if (closest_on_part(p, static_cast<int>(c), on_surface).found()) return false;
     const PartData& pd = parts_[c];
-    double w = 0.0;
-    for (std::size_t t = 0; t < pd.triangles.size(); ++t) {
-      const auto tc = pd.corners(t);
-      w += triangle_solid_angle(p, tc[0], tc[1], tc[2]);
-    }
+    const double w = triangles_winding_number(p, pd.triangles.size(), [&](std::size_t t) { return pd.corners(t); });
     return std::abs(w) > 0.5 + kWindingMargin;
   };
   std::vector<char> by_winding(cand.size(), 0);

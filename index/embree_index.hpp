@@ -11,7 +11,8 @@
 /// vote) and count crossings of closed parts, each decided in double; a ray whose crossing
 /// lies within the float rounding of Embree's ray test of an edge or vertex (where Embree
 /// may report it on the neighbouring triangle, or on neither) is discarded, and if every
-/// ray is, the generalized winding number decides.
+/// ray is — or the part is too small for float rays at its distance from the centre — the
+/// generalized winding number decides, in double (a point on the surface is not inside).
 
 #include "core/part.hpp"
 #include "index/obstacle_index.hpp"
@@ -91,6 +92,8 @@ class EmbreeIndex : public ObstacleIndex {
  private:
   /// Search-radius pad (scene units) that covers float rounding for a query at p.
   double float_pad(const Vec3& p, double radius) const;
+  /// Bound on the rounding of an exact distance (scene units; IndexAccuracy::abs_error).
+  double distance_rounding() const;
   /// Closest point in `scene`: the whole index (only_part = -1; filter_part ≥ 0 keeps that
   /// part's triangles only), or a one-part scene with only_part = its id.
   /// `shrink` = 1 / (1 + rel_error) scales the search radius at each hit (1: exact).

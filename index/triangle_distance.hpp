@@ -7,6 +7,8 @@
 
 #include "core/geometry.hpp"
 
+#include <cstddef>
+
 namespace loom {
 
 /// Closest point on a triangle to a point.
@@ -71,6 +73,21 @@ RayTriangleResult intersect_ray_triangle(const Vec3& origin, const Vec3& dir, co
 /// (Van Oosterom–Strackee). Summed over a closed outward mesh and divided by 4π it gives
 /// the winding number: 1 inside, 0 outside.
 double triangle_solid_angle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
+/// Generalized winding number at p of the triangles t = 0 .. n−1, whose corners
+/// `corners(t)` returns (an indexable of three Vec3): the sum of their solid angles over
+/// 4π — 1 inside a closed outward mesh, 0 outside, 1/2 on its surface, −1 inside one
+/// oriented inwards.
+template <class Corners>
+double triangles_winding_number(const Vec3& p, std::size_t n, Corners&& corners) {
+  constexpr double kFourPi = 4.0 * 3.14159265358979323846;
+  double sum = 0.0;
+  for (std::size_t t = 0; t < n; ++t) {
+    const auto c = corners(t);
+    sum += triangle_solid_angle(p, c[0], c[1], c[2]);
+  }
+  return sum / kFourPi;
+}
 
 /// True if triangle abc has (numerically) zero area: |(b−a)×(c−a)|² ≤ 1e-24·(longest edge)⁴.
 /// Such triangles are treated as the segments they collapse to.
