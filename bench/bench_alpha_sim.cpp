@@ -58,6 +58,34 @@ double cpu_seconds() {
   return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
+/// Throughput measurements are the fastest of this many runs (the median beside it): this
+/// machine's neighbours slow single runs by 10–25% at times.
+constexpr int kThroughputRuns = 3;
+
+/// The fastest of `runs` calls of f: its wall and CPU seconds, and the median wall time.
+struct Fastest {
+  double sec = std::numeric_limits<double>::infinity(), cpu = 0.0, median = 0.0;
+};
+template <class F>
+Fastest fastest_of(int runs, F&& f) {
+  Fastest out;
+  std::vector<double> walls;
+  for (int run = 0; run < runs; ++run) {
+    const auto t0 = Clock::now();
+    const double cpu0 = cpu_seconds();
+    f();
+    const double wall = seconds_since(t0), cpu = cpu_seconds() - cpu0;
+    walls.push_back(wall);
+    if (wall < out.sec) {
+      out.sec = wall;
+      out.cpu = cpu;
+    }
+  }
+  std::sort(walls.begin(), walls.end());
+  out.median = walls[walls.size() / 2];
+  return out;
+}
+
 /// `n` random points in `box` (fixed seed).
 std::vector<Vec3> box_points(const AABB& box, int n, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
@@ -369,20 +397,13 @@ void throughput(const fs::path& out_dir, const std::vector<Set>& sets) {
        "edge-on triangles sampled"},
       {true, true, false, true, true, true, "with verification"}};
   const std::size_t n_configs = std::getenv("LOOM_TP_ONE") ? 1 : std::size(configs);
-  // Each measurement is the fastest of kRuns (its CPU time with it), the median beside it:
-  // this machine's neighbours slow single runs by 10–25% at times.
-  constexpr int kRuns = 3;
   for (std::size_t c = 0; c < n_configs; ++c)
     for (int threads : {1, 2}) {
       const Config& cf = configs[c];
       tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
-      std::vector<double> runs;
-      double sec = std::numeric_limits<double>::infinity(), cpu = 0.0;
-      for (int run = 0; run < kRuns; ++run) {
-        const auto t0 = Clock::now();
-        const double cpu0 = cpu_seconds();
-        // The sets run concurrently, as the parts of one scene would (each set has its own
-        // dim_pre, so they cannot be one simplify_parts call).
+      // The sets run concurrently, as the parts of one scene would (each set has its own
+      // dim_pre, so they cannot be one simplify_parts call).
+      const Fastest f = fastest_of(kThroughputRuns, [&] {
         tbb::parallel_for(std::size_t(0), sets.size(), [&](std::size_t s) {
           AlphaSimOptions o;
           o.dim_pre = sets[s].dim_pre;
@@ -395,20 +416,13 @@ void throughput(const fs::path& out_dir, const std::vector<Set>& sets) {
           std::vector<AlphaSimResult> res;
           simplify_parts(sets[s].parts, o, &res);
         });
-        const double run_sec = seconds_since(t0), run_cpu = cpu_seconds() - cpu0;
-        runs.push_back(run_sec);
-        if (run_sec < sec) {
-          sec = run_sec;
-          cpu = run_cpu;
-        }
-      }
-      std::sort(runs.begin(), runs.end());
-      const double median = runs[runs.size() / 2];
+      });
+      const double sec = f.sec, cpu = f.cpu, median = f.median;
       tp_csv << threads << "," << all_tris << "," << sec << "," << all_tris / sec << "," << int(cf.measure) << ","
-             << cpu << "," << all_tris / cpu << "," << int(cf.absorb) << "," << int(cf.occt) << "," << int(cf.edge_on) << "," << int(cf.exact) << "," << int(cf.coarse) << "," << kRuns << "," << median << "\n";
+             << cpu << "," << all_tris / cpu << "," << int(cf.absorb) << "," << int(cf.occt) << "," << int(cf.edge_on) << "," << int(cf.exact) << "," << int(cf.coarse) << "," << kThroughputRuns << "," << median << "\n";
       std::printf("throughput (%s): %d thread(s): %zu triangles in %.3f s = %.3g triangles/s (CPU %.2f s = %.3g "
                   "triangles per CPU second; fastest of %d, median %.3f s = %.3g/s)\n",
-                  cf.what, threads, all_tris, sec, all_tris / sec, cpu, all_tris / cpu, kRuns, median, all_tris / median);
+                  cf.what, threads, all_tris, sec, all_tris / sec, cpu, all_tris / cpu, kThroughputRuns, median, all_tris / median);
     }
 }
 
@@ -433,20 +447,15 @@ void tessellation_sweep(const fs::path& out_dir, const Scene& wing_settings, int
     o.measure = false;
     std::vector<AlphaSimResult> res;
     std::vector<Part> simple;
-    double sec = std::numeric_limits<double>::infinity(), cpu = 0.0;
+    double sec = 0.0, cpu = 0.0;
     {
       tbb::global_control gc(tbb::global_control::max_allowed_parallelism, 2);
-      for (int run = 0; run < 3; ++run) {  // the fastest of three, as in part 3
+      const Fastest f = fastest_of(kThroughputRuns, [&] {  // as in part 3
         res.clear();
-        const double cpu0 = cpu_seconds();
-        const auto t0 = Clock::now();
         simple = simplify_parts(parts, o, &res);
-        const double run_sec = seconds_since(t0), run_cpu = cpu_seconds() - cpu0;
-        if (run_sec < sec) {
-          sec = run_sec;
-          cpu = run_cpu;
-        }
-      }
+      });
+      sec = f.sec;
+      cpu = f.cpu;
     }
     for (const auto& r : res) after += r.triangles_after;
     AABB box;

@@ -416,13 +416,8 @@ constexpr double kCoarseCellAlphaMargin = 0.9;
 /// (≤ tol/4, moving a point by ≤ 0.18·tol) that keeps every point of them within tol.
 constexpr double kEdgeOnWidthShare = 0.25, kEdgeOnTolShare = 0.5;
 
-/// Lexicographic order (x, then y) of plane points, as a function object.
-struct Vec2Less {
-  bool operator()(const Vec2& p, const Vec2& q) const { return xy_less(p, q); }
-};
-
 void sort_unique(std::vector<Vec2>& v) {
-  std::sort(v.begin(), v.end(), Vec2Less());
+  std::sort(v.begin(), v.end(), xy_less);
   v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 
@@ -514,7 +509,7 @@ void dedupe_by_hash(std::vector<T>& items, Hash hash, Same same, Merge merge) {
 void merge_unique(std::vector<Vec2>& sorted, const std::vector<Vec2>& more) {
   std::vector<Vec2> out;
   out.reserve(sorted.size() + more.size());
-  std::merge(sorted.begin(), sorted.end(), more.begin(), more.end(), std::back_inserter(out), Vec2Less());
+  std::merge(sorted.begin(), sorted.end(), more.begin(), more.end(), std::back_inserter(out), xy_less);
   out.erase(std::unique(out.begin(), out.end()), out.end());
   sorted = std::move(out);
 }
@@ -877,10 +872,10 @@ std::vector<PlaneSpec> planes_for(const AlphaSimOptions& opt) {
 // --- Mesh queries for the measures (Embree) ---------------------------------------------
 
 /// One closed or open mesh as a one-part EmbreeIndex: exact (double) distances and
-/// ray-parity inside tests (DESIGN §9: Embree for BVH queries).
-/// An EmbreeIndex over one mesh. `watertight`: checked closed and consistently oriented,
-/// so one ray that grazes nothing decides an inside test exactly (inside_rays = 1); the
-/// default majority of three guards real meshes with holes, at three times the rays.
+/// ray-parity inside tests (DESIGN §9: Embree for BVH queries). `watertight`: checked to
+/// have no boundary and no misoriented edge, so one ray that grazes nothing decides an
+/// inside test exactly (inside_rays = 1); the default majority of three guards real
+/// meshes with holes, at three times the rays.
 EmbreeIndex mesh_index(Mesh m, bool closed, bool watertight = false) {
   std::vector<Part> parts(1);
   parts[0].name = "alpha-sim";
@@ -1147,7 +1142,7 @@ void exact_projection(const Mesh& mesh, const std::vector<Vec2>& projected, doub
   // Front and back faces of a plate, and the walls of a hole seen along its axis, project
   // onto the same triangles: each is tested once (the spar's end view: 12,252 -> 632).
   // (AlphaShape2D::triangles_gaps sorts its gap points: the order of `tested` is free.)
-  for (auto& t : tested) std::sort(t.begin(), t.end(), Vec2Less());
+  for (auto& t : tested) std::sort(t.begin(), t.end(), xy_less);
   dedupe_by_hash(
       tested, hash_triangle,
       [](const auto& x, const auto& y) { return x == y; }, [](auto&, const auto&) {});
