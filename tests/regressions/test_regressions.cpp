@@ -21,6 +21,7 @@
 #include "index/box_pairs.hpp"
 #include "index/embree_index.hpp"
 #include "index/extrusion.hpp"
+#include "routing/chord_plan.hpp"
 #include "routing/sweep.hpp"
 
 #include "../index/index_test_meshes.hpp"
@@ -387,4 +388,20 @@ TEST(Regression, EmbreeOneRayInsideKeepsCrossingsNearSharedEdges) {
                {Vec3(0.18683456229730644, -0.76237505427020036, -0.64231826484776589), false},
                {Vec3(0.52977313759478561, 0.08655659338384547, 0.4868321903933317), true}};
   for (const auto& c : cases) EXPECT_EQ(e.inside(c.p), c.inside) << c.p.transpose();
+}
+
+// 2026-11-26, session 28: a direct test of chord flattening (tests/routing/test_chord_plan)
+// found chords up to 2.9× longer than the longest allowed (kMaxChordRadii · r, which keeps
+// the self rule |s − t| ≥ πr sharp): a span was cut into its arc length / hmax chords
+// uniformly in u, so where the speed varies along the span the fast end's chords were
+// longer. Now the count comes from a bound on |C'| over the span (length_chords). One
+// span whose speed grows from 3 to 294: 50 chords before, the last ~5.9 long.
+TEST(Regression, ChordsStayWithinTheLongestAllowedWhereTheSpeedVaries) {
+  const Centerline c(3, {0, 0, 0, 0, 1, 1, 1, 1}, {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0), Vec3(100, 0, 0)});
+  const double hmax = 2.0, eps = 1.0;
+  loom::Chords ch;
+  loom::flatten(c, c.u_min(), c.u_max(), eps, hmax, 0.0, ch);
+  ASSERT_GE(ch.size(), 50u);
+  for (std::size_t k = 0; k < ch.size(); ++k) EXPECT_LE((ch.p[k + 1] - ch.p[k]).norm(), hmax) << "chord " << k;
+  EXPECT_EQ(static_cast<double>(ch.size()), loom::planned_chords(c, eps, hmax, 0.0));
 }
