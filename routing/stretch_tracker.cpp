@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <stdexcept>
 
-namespace loom {
+namespace loom::audit {
 
 bool is_attached(const std::vector<PartAttachment>& attachments, int part, double s) {
   return std::any_of(attachments.begin(), attachments.end(),
@@ -116,4 +116,4 @@ void StretchTracker::close(Open& st) {
   }
 }
 
-}  // namespace loom
+}  // namespace loom::audit

@@ -2,7 +2,8 @@
 /// The certified audit's bookkeeping along one cable (clash_check): observations of parts
 /// within their clearance band, in arc-length order, grouped into one clash per contiguous
 /// contact stretch (at its deepest point) and one clearance violation per band stretch
-/// without contact. Internal to the audit (routing/clash_check.cpp); world frame, scene units.
+/// without contact. Internal to the audit (namespace loom::audit; used by the certified and the
+/// discrete cable–structure passes); world frame, scene units.
 
 #include "routing/clash_check.hpp"
 
@@ -12,7 +13,7 @@
 #include <optional>
 #include <vector>
 
-namespace loom {
+namespace loom::audit {
 
 /// What the checker needs to know about one part.
 struct PartInfo {
@@ -116,4 +117,4 @@ class StretchTracker {
   std::map<int, Open> open_;
 };
 
-}  // namespace loom
+}  // namespace loom::audit

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 using namespace loom;
+using namespace loom::audit;
 
 namespace {
 
