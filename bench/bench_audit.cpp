@@ -257,6 +257,12 @@ class SplitIndex : public ForwardingIndex {
   bool inside(const Vec3& p, int* part) const override {
     return timed(kInside, [&] { return inner_.inside(p, part); });
   }
+  void inside_parts(const Vec3& p, std::vector<int>& out) const override {
+    timed(kInside, [&] {
+      inner_.inside_parts(p, out);
+      return out.size();
+    });
+  }
   RayHit ray(const Vec3& o, const Vec3& d, double t) const override {
     return timed(kOther, [&] { return inner_.ray(o, d, t); });
   }

@@ -22,6 +22,7 @@ class ForwardingIndex : public ObstacleIndex {
     return inner_.closest_on_part(p, part, r);
   }
   bool inside(const Vec3& p, int* part) const override { return inner_.inside(p, part); }
+  void inside_parts(const Vec3& p, std::vector<int>& out) const override { inner_.inside_parts(p, out); }
   RayHit ray(const Vec3& o, const Vec3& d, double t) const override { return inner_.ray(o, d, t); }
   bool any_within(const Vec3& p, double r) const override { return inner_.any_within(p, r); }
   bool segment_within(const Vec3& a, const Vec3& b, double r) const override { return inner_.segment_within(a, b, r); }

@@ -101,17 +101,27 @@ double BruteForceIndex::part_winding_number(int part, const Vec3& p) const {
   return winding_number(parts_[part], p);
 }
 
-bool BruteForceIndex::inside(const Vec3& p, int* part) const {
-  for (int i = 0; i < part_count(); ++i) {
-    const PartTriangles& pt = parts_[i];
+void parts_holding(const std::vector<PartTriangles>& parts, const Vec3& p, bool first_only, std::vector<int>& out) {
+  out.clear();
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const PartTriangles& pt = parts[i];
     if (!pt.closed || pt.triangles.empty() || !pt.bounds.contains(p)) continue;
     if (winding_number(pt, p) > 0.5) {
-      if (part) *part = i;
-      return true;
+      out.push_back(static_cast<int>(i));
+      if (first_only) return;
     }
   }
-  return false;
 }
+
+bool BruteForceIndex::inside(const Vec3& p, int* part) const {
+  std::vector<int> held;
+  parts_holding(parts_, p, true, held);
+  if (held.empty()) return false;
+  if (part) *part = held.front();
+  return true;
+}
+
+void BruteForceIndex::inside_parts(const Vec3& p, std::vector<int>& out) const { parts_holding(parts_, p, false, out); }
 
 RayHit BruteForceIndex::ray(const Vec3& origin, const Vec3& dir, double t_max) const {
   const Vec3 u = unit_direction(dir);

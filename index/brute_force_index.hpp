@@ -27,6 +27,11 @@ std::vector<PartTriangles> extract_part_triangles(const std::vector<Part>& parts
 /// orientation); sum of signed solid angles / 4π.
 double winding_number(const PartTriangles& part, const Vec3& p);
 
+/// The closed parts holding p (winding number > 1/2), as ascending indices into `parts`, in
+/// *out (cleared first); with first_only, at most the first of them. O(all triangles of the
+/// parts whose boxes contain p): the oracle's inside test, shared by the exact indices.
+void parts_holding(const std::vector<PartTriangles>& parts, const Vec3& p, bool first_only, std::vector<int>& out);
+
 /// Exact O(n) obstacle queries; see ObstacleIndex for the contract of each method.
 class BruteForceIndex : public ObstacleIndex {
  public:
@@ -41,6 +46,7 @@ class BruteForceIndex : public ObstacleIndex {
   ClosestHit closest_on_part(const Vec3& p, int part,
                              double max_radius = std::numeric_limits<double>::infinity()) const override;
   bool inside(const Vec3& p, int* part = nullptr) const override;
+  void inside_parts(const Vec3& p, std::vector<int>& out) const override;
   RayHit ray(const Vec3& origin, const Vec3& dir,
              double t_max = std::numeric_limits<double>::infinity()) const override;
   bool any_within(const Vec3& p, double r) const override;

@@ -647,13 +647,27 @@ RayHit EmbreeIndex::ray(const Vec3& origin, const Vec3& dir, double t_max) const
 }
 
 bool EmbreeIndex::inside(const Vec3& p, int* part) const {
+  std::vector<int> held;
+  inside_scan(p, true, held);
+  if (held.empty()) return false;
+  if (part) *part = held.front();
+  return true;
+}
+
+void EmbreeIndex::inside_parts(const Vec3& p, std::vector<int>& out) const {
+  inside_scan(p, false, out);
+  std::sort(out.begin(), out.end());
+}
+
+void EmbreeIndex::inside_scan(const Vec3& p, bool first_only, std::vector<int>& out) const {
+  out.clear();
   // Candidate closed parts whose box contains p.
-  if (!p.allFinite()) return false;
+  if (!p.allFinite()) return;
   std::vector<std::uint32_t> cand;
   AABB at;
   at.extend(p);
   impl_->closed_boxes->overlapping(at, cand);
-  if (cand.empty()) return false;
+  if (cand.empty()) return;
   // A part not much larger than the float rounding of a ray at this distance from the
   // centre cannot be crossed reliably (Embree may report none of its triangles, which no
   // test here could notice): the winding number decides it, in double, O(its triangles).
@@ -675,14 +689,15 @@ bool EmbreeIndex::inside(const Vec3& p, int* part) const {
     by_winding[i] = size < kRayResolvedParts * float_pad(p, size) ? 1 : 0;
     any_by_rays = any_by_rays || !by_winding[i];
   }
-  auto answer = [&](std::size_t i) {
-    if (part) *part = static_cast<int>(cand[i]);
-    return true;
+  // Adds candidate i; true when the scan can stop there.
+  auto holds = [&](std::size_t i) {
+    out.push_back(static_cast<int>(cand[i]));
+    return first_only;
   };
   if (!any_by_rays) {
     for (std::size_t i = 0; i < cand.size(); ++i)
-      if (winding_inside(cand[i])) return answer(i);
-    return false;
+      if (winding_inside(cand[i]) && holds(i)) return;
+    return;
   }
   FlushDenormals ftz;
   const Vec3 pc = p - centre_;
@@ -749,12 +764,11 @@ bool EmbreeIndex::inside(const Vec3& p, int* part) const {
     ++valid_rays;
     for (std::size_t i = 0; i < cand.size(); ++i) votes_in[i] += crossings[i] % 2;
   }
-  // In candidate order, as every answer here: the first part that holds p.
+  // In candidate order, as every answer here: first_only stops at the first part that holds p.
   for (std::size_t i = 0; i < cand.size(); ++i) {
     const bool in = by_winding[i] || valid_rays == 0 ? winding_inside(cand[i]) : 2 * votes_in[i] > valid_rays;
-    if (in) return answer(i);
+    if (in && holds(i)) return;
   }
-  return false;
 }
 
 }  // namespace loom

@@ -60,6 +60,7 @@ class EmbreeIndex : public ObstacleIndex {
   ClosestHit closest_on_part(const Vec3& p, int part,
                              double max_radius = std::numeric_limits<double>::infinity()) const override;
   bool inside(const Vec3& p, int* part = nullptr) const override;
+  void inside_parts(const Vec3& p, std::vector<int>& out) const override;
   std::optional<AABB> part_bounds(int part) const override;
   RayHit ray(const Vec3& origin, const Vec3& dir,
              double t_max = std::numeric_limits<double>::infinity()) const override;
@@ -94,6 +95,9 @@ class EmbreeIndex : public ObstacleIndex {
   double float_pad(const Vec3& p, double radius) const;
   /// Bound on the rounding of an exact distance (scene units; IndexAccuracy::abs_error).
   double distance_rounding() const;
+  /// The closed parts holding p strictly inside, into *out (cleared first) in candidate
+  /// order; with first_only the scan stops at the first. inside() and inside_parts().
+  void inside_scan(const Vec3& p, bool first_only, std::vector<int>& out) const;
   /// Closest point in `scene`: the whole index (only_part = -1; filter_part ≥ 0 keeps that
   /// part's triangles only), or a one-part scene with only_part = its id.
   /// `shrink` = 1 / (1 + rel_error) scales the search radius at each hit (1: exact).

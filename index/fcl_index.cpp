@@ -229,16 +229,14 @@ bool FclIndex::segment_within(const Vec3& a, const Vec3& b, double r) const {
 }
 
 bool FclIndex::inside(const Vec3& p, int* part) const {
-  for (int i = 0; i < part_count(); ++i) {
-    const PartTriangles& pt = impl_->parts[i];
-    if (!pt.closed || pt.triangles.empty() || !pt.bounds.contains(p)) continue;
-    if (winding_number(pt, p) > 0.5) {
-      if (part) *part = i;
-      return true;
-    }
-  }
-  return false;
+  std::vector<int> held;
+  parts_holding(impl_->parts, p, true, held);
+  if (held.empty()) return false;
+  if (part) *part = held.front();
+  return true;
 }
+
+void FclIndex::inside_parts(const Vec3& p, std::vector<int>& out) const { parts_holding(impl_->parts, p, false, out); }
 
 RayHit FclIndex::ray(const Vec3& origin, const Vec3& dir, double t_max) const {
   const Vec3 u = unit_dir(dir);

@@ -39,6 +39,7 @@ class FclIndex : public ObstacleIndex {
   ClosestHit closest_on_part(const Vec3& p, int part,
                              double max_radius = std::numeric_limits<double>::infinity()) const override;
   bool inside(const Vec3& p, int* part = nullptr) const override;
+  void inside_parts(const Vec3& p, std::vector<int>& out) const override;
   RayHit ray(const Vec3& origin, const Vec3& dir,
              double t_max = std::numeric_limits<double>::infinity()) const override;
   bool any_within(const Vec3& p, double r) const override;

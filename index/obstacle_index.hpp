@@ -84,6 +84,11 @@ class ObstacleIndex {
   /// True if p is strictly inside a closed part (open parts have no inside); the part id
   /// is written to *part when given. Correct for points near edges and vertices.
   virtual bool inside(const Vec3& p, int* part = nullptr) const = 0;
+  /// Every closed part holding p strictly inside, as ascending part ids in *out (cleared
+  /// first; empty if none). Closed parts may overlap — a keep-out zone drawn around a box,
+  /// two solids modelled through each other — and a point inside both is inside each; inside()
+  /// names only one of them.
+  virtual void inside_parts(const Vec3& p, std::vector<int>& out) const = 0;
   /// First hit along origin + t·dir, 0 ≤ t ≤ t_max (dir need not be unit).
   virtual RayHit ray(const Vec3& origin, const Vec3& dir,
                      double t_max = std::numeric_limits<double>::infinity()) const = 0;

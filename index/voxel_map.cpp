@@ -498,6 +498,16 @@ bool VoxelMap::inside(const Vec3& p, int* part) const {
   return true;  // loaded map: occupied voxels are solid
 }
 
+void VoxelMap::inside_parts(const Vec3& p, std::vector<int>& out) const {
+  if (exact_) {
+    exact_->inside_parts(p, out);
+    return;
+  }
+  out.clear();
+  int part = -1;
+  if (inside(p, &part)) out.push_back(part);
+}
+
 RayHit VoxelMap::ray(const Vec3& origin, const Vec3& dir, double t_max) const {
   const double n = dir.norm();
   if (!(n > 0.0) || !std::isfinite(n)) throw std::invalid_argument("voxel map: ray direction is zero or not finite");

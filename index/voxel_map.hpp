@@ -85,6 +85,9 @@ class VoxelMap : public ObstacleIndex {
   ClosestHit closest_on_part(const Vec3& p, int part,
                              double max_radius = std::numeric_limits<double>::infinity()) const override;
   bool inside(const Vec3& p, int* part = nullptr) const override;
+  /// With the exact index it was built from: its answer. A loaded map knows one part per
+  /// solid voxel (part 0 when loaded from a file): that part, or none.
+  void inside_parts(const Vec3& p, std::vector<int>& out) const override;
   RayHit ray(const Vec3& origin, const Vec3& dir,
              double t_max = std::numeric_limits<double>::infinity()) const override;
   bool any_within(const Vec3& p, double r) const override;

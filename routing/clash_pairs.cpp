@@ -2,6 +2,7 @@
 // phase over the blocks, exact segment–segment distances, contacts grouped into stretches
 // (clash_context.hpp, clash_check.hpp for the contract).
 #include "routing/clash_context.hpp"
+#include "routing/chord_pair_excuse.hpp"
 #include "routing/pair_contacts.hpp"
 
 #include "core/error.hpp"
@@ -80,12 +81,29 @@ std::int64_t narrow_phase(const Context& ctx, const CableChords& A, std::size_t 
       const double reach = r_sum + 0.5 * ((A.ch.p[ka + 1] - A.ch.p[ka]).norm() + (B.ch.p[kb + 1] - B.ch.p[kb]).norm());
       if ((ma - mb).squaredNorm() >= reach * reach) continue;
       ++tests;
-      const SegmentSegmentResult r = closest_segment_segment(A.ch.p[ka], A.ch.p[ka + 1], B.ch.p[kb], B.ch.p[kb + 1]);
+      SegmentSegmentResult r = closest_segment_segment(A.ch.p[ka], A.ch.p[ka + 1], B.ch.p[kb], B.ch.p[kb + 1]);
+      if (!(std::sqrt(r.dist2) < r_sum)) continue;
+      double s = sa0 + r.s * (sa1 - sa0), t = tb0 + r.t * (tb1 - tb0);
+      if (self && std::abs(s - t) < self_gap) {
+        // Excused there: the closest points of the two chords at least π r apart instead.
+        const auto apart = closest_apart(A.ch.p[ka], A.ch.p[ka + 1], sa0, sa1, B.ch.p[kb], B.ch.p[kb + 1], tb0, tb1,
+                                         self_gap);
+        if (!apart) continue;
+        r = *apart;
+        s = sa0 + r.s * (sa1 - sa0);
+        t = tb0 + r.t * (tb1 - tb0);
+      } else if (!self && excused(ca, s, r.p, cb, t, r.q)) {
+        // Excused there: the closest points of the two chords outside the excused region instead.
+        const auto boxes =
+            excused_boxes(ca, A.ch.p[ka], A.ch.p[ka + 1], sa0, sa1, cb, B.ch.p[kb], B.ch.p[kb + 1], tb0, tb1);
+        const auto outside = closest_unexcused(boxes, A.ch.p[ka], A.ch.p[ka + 1], B.ch.p[kb], B.ch.p[kb + 1]);
+        if (!outside) continue;
+        r = *outside;
+        s = sa0 + r.s * (sa1 - sa0);
+        t = tb0 + r.t * (tb1 - tb0);
+      }
       const double d = std::sqrt(r.dist2);
       if (!(d < r_sum)) continue;
-      double s = sa0 + r.s * (sa1 - sa0), t = tb0 + r.t * (tb1 - tb0);
-      if (self && std::abs(s - t) < self_gap) continue;
-      if (!self && excused(ca, s, r.p, cb, t, r.q)) continue;
       out.push_back(PairContact::ordered(A.cable, s, sa0, sa1, r.p, B.cable, t, tb0, tb1, r.q, d));
     }
   }

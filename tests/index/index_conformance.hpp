@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <iomanip>
 #include <random>
 #include <vector>
 
@@ -23,6 +25,26 @@ inline std::vector<Vec3> random_points(std::mt19937_64& rng, const AABB& box, do
 
 /// Tolerance for comparing a distance d: rel·max(d, scale) (scale = scene size).
 inline double tol(double d, double rel, double scale) { return rel * std::max(d, scale); }
+
+/// inside_parts() against brute force, and inside() consistent with it (true exactly when
+/// some part holds p, naming one of them). Returns how many points lie in two parts or more.
+inline int expect_inside_parts_match(const ObstacleIndex& idx, const BruteForceIndex& brute,
+                                     const std::vector<Vec3>& pts) {
+  int overlapped = 0;
+  std::vector<int> got, want;
+  for (const Vec3& p : pts) {
+    idx.inside_parts(p, got);
+    brute.inside_parts(p, want);
+    EXPECT_EQ(got, want) << std::setprecision(17) << "at (" << p.x() << ", " << p.y() << ", " << p.z() << ")";
+    int part = -1;
+    EXPECT_EQ(idx.inside(p, &part), !got.empty());
+    if (!got.empty()) {
+      EXPECT_NE(std::find(got.begin(), got.end(), part), got.end()) << "inside() named " << part;
+    }
+    overlapped += want.size() >= 2 ? 1 : 0;
+  }
+  return overlapped;
+}
 
 /// closest / closest_on_part / any_within / segment queries against brute force.
 inline void expect_distances_match(const ObstacleIndex& idx, const BruteForceIndex& brute,

@@ -118,6 +118,21 @@ inline std::vector<Part> mixed_scene(const Vec3& offset, const MixedSceneDetail&
   return parts;
 }
 
+/// Closed parts modelled through each other, as real assemblies have them: a box with a
+/// keep-out box drawn around it, a sphere overlapping both, a torus through the sphere, a
+/// box nested in the inner box, and an open soup (no inside) across them all.
+inline std::vector<Part> overlapping_scene() {
+  std::mt19937_64 rng(5);
+  std::vector<Part> parts;
+  parts.push_back(make_part("box", box(Vec3(-10, -10, -10), Vec3(10, 10, 10)), true));
+  parts.push_back(make_part("keep-out", box(Vec3(-13, -13, -13), Vec3(13, 13, 13)), true));
+  parts.push_back(make_part("sphere", uv_sphere(Vec3(12, 0, 0), 8, 24, 12), true));
+  parts.push_back(make_part("torus", torus(Vec3(16, 0, 0), 6, 2, 32, 12), true));
+  parts.push_back(make_part("nested", box(Vec3(-4, -4, -4), Vec3(4, 4, 4)), true));
+  parts.push_back(make_part("soup", random_soup(rng, 100, Vec3(-15, -15, -15), Vec3(25, 15, 15), 4), false));
+  return parts;
+}
+
 /// Bounding box of all the parts' meshes.
 inline AABB bounds_of(const std::vector<Part>& parts) {
   AABB b;

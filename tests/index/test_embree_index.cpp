@@ -214,6 +214,31 @@ TEST(EmbreeIndex, InsideAgreesWithWindingNumberNearEdgesAndVertices) {
 // A crossing must then count as grazing, not vanish: with one ray per test (no majority
 // to outvote a lost crossing), every point of a fine closed sphere far from the centre is
 // classified exactly. Regression: one ray lost crossings on α-SIM's output for the motor.
+// Closed parts modelled through each other: inside_parts() names every one holding the
+// point (the audit clashes a cable with each), against closed forms and brute force.
+TEST(EmbreeIndex, InsidePartsNamesEveryOverlappingClosedPart) {
+  const auto parts = overlapping_scene();
+  const EmbreeIndex e(parts);
+  const BruteForceIndex b(parts);
+  // Closed forms (ids: 0 box, 1 keep-out, 2 sphere, 3 torus, 4 nested, 5 open soup).
+  const std::vector<std::pair<Vec3, std::vector<int>>> known = {
+      {Vec3(0, 0, 0), {0, 1, 4}},  {Vec3(7, 7, 7), {0, 1}},   {Vec3(11, 0, 0), {1, 2, 3}},
+      {Vec3(21, 0, 0), {3}},       {Vec3(0, 0, 12), {1}},     {Vec3(30, 30, 30), {}}};
+  std::vector<int> got;
+  for (const auto& [p, want] : known) {
+    e.inside_parts(p, got);
+    EXPECT_EQ(got, want) << p.transpose();
+    b.inside_parts(p, got);
+    EXPECT_EQ(got, want) << p.transpose();
+  }
+  std::mt19937_64 rng(29);
+  const auto pts = random_points(rng, bounds_of(parts), 2, 3000);
+  EXPECT_GT(expect_inside_parts_match(e, b, pts), 300);
+  // Not finite: inside nothing.
+  e.inside_parts(Vec3(std::numeric_limits<double>::quiet_NaN(), 0, 0), got);
+  EXPECT_TRUE(got.empty());
+}
+
 TEST(EmbreeIndex, OneRayInsideIsExactOnSmallTrianglesFarFromTheCentre) {
   const std::vector<Part> parts = {make_part("fine", uv_sphere(Vec3::Zero(), 1.0, 96, 48), true),
                                    make_part("far", box(Vec3::Constant(4000), Vec3::Constant(4001)), true)};

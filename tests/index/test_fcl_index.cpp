@@ -49,6 +49,14 @@ TEST(FclIndex, MatchesBruteForce) {
   EXPECT_TRUE(f.accuracy().exact);
 }
 
+TEST(FclIndex, InsidePartsNamesEveryOverlappingClosedPart) {
+  const auto parts = overlapping_scene();
+  const FclIndex f(parts);
+  const BruteForceIndex b(parts);
+  std::mt19937_64 rng(29);
+  EXPECT_GT(expect_inside_parts_match(f, b, random_points(rng, bounds_of(parts), 2, 1000)), 100);
+}
+
 TEST(FclIndex, FarFromOriginMatchesBruteForce) {
   const auto parts = scene(Vec3(-35000, 52000, 8000));
   const FclIndex f(parts);

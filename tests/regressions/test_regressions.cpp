@@ -9,12 +9,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "core/centerline.hpp"
+#include "core/mesh.hpp"
 #include "core/io/mesh_read.hpp"
 #include "core/part.hpp"
 #include "index/alpha_sim.hpp"
@@ -22,6 +25,7 @@
 #include "index/embree_index.hpp"
 #include "index/extrusion.hpp"
 #include "routing/chord_plan.hpp"
+#include "routing/clash_check.hpp"
 #include "routing/sweep.hpp"
 
 #include "../index/index_test_meshes.hpp"
@@ -404,4 +408,142 @@ TEST(Regression, ChordsStayWithinTheLongestAllowedWhereTheSpeedVaries) {
   ASSERT_GE(ch.size(), 50u);
   for (std::size_t k = 0; k < ch.size(); ++k) EXPECT_LE((ch.p[k + 1] - ch.p[k]).norm(), hmax) << "chord " << k;
   EXPECT_EQ(static_cast<double>(ch.size()), loom::planned_chords(c, eps, hmax, 0.0));
+}
+
+// --- 2026-11-27, adversarial review of the certified audit (tests/routing/test_clash_adversarial.cpp).
+
+namespace {
+
+std::string regression_g17(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+loom::Part regression_box(const char* name, const Vec3& lo, const Vec3& hi) {
+  loom::Part p;
+  p.name = name;
+  p.mesh = loom::testmesh::box(lo, hi);
+  p.closed = loom::analyse_topology(p.mesh).closed;
+  return p;
+}
+
+loom::CableInput regression_cable(const char* id, const std::vector<Vec3>& polyline, double r) {
+  loom::CableInput c;
+  c.id = id;
+  c.curve = Centerline::polyline(polyline);
+  c.radius = r;
+  return c;
+}
+
+loom::ClashResult regression_audit(const std::vector<loom::CableInput>& cables, const std::vector<loom::Part>& parts,
+                                   double tol) {
+  const loom::EmbreeIndex index(parts);
+  loom::ClashRequest req;
+  req.tolerance = tol;
+  req.threads = 2;
+  return loom::check_clashes(cables, parts, &index, req);
+}
+
+}  // namespace
+
+// The certified self pass dropped a chord pair whenever its closest points were less than
+// π r apart along the cable, although other points of the same two chords, π r or more
+// apart, were in contact. Beside a fold that is where the contact is deepest: a V of 60°
+// (legs of 10 r, chords ending at the corner) touches itself at clearance
+// π r sin 30° − 2 r = −0.429 r exactly π r from the corner along both legs, and the audit
+// reported −2e-16 (the 45° V: −0.586 for −0.798). Now such a pair is measured at its
+// closest points at least π r apart (on the band's edge |s − t| = π r).
+TEST(Regression, SelfContactBesideAFoldWasExcusedWithTheFold) {
+  const double r = 1.0, tol = 0.01, theta = M_PI / 3.0;
+  const std::vector<Vec3> v{Vec3(10, 0, 0), Vec3::Zero(), 10.0 * Vec3(std::cos(theta), std::sin(theta), 0)};
+  const std::vector<loom::Part> far{regression_box("far", Vec3::Constant(1000), Vec3::Constant(1001))};
+  const loom::ClashResult res = regression_audit({regression_cable("V", v, r)}, far, tol);
+  const double truth = M_PI * r * std::sin(0.5 * theta) - 2.0 * r;
+  const std::string in = "V (10,0,0) (0,0,0) (" + regression_g17(v[2].x()) + ", " + regression_g17(v[2].y()) +
+                         ", 0) r " + regression_g17(r) + " tol " + regression_g17(tol);
+  ASSERT_EQ(res.clashes.size(), 1u) << in;
+  EXPECT_EQ(res.clashes[0].kind, loom::ClashKind::Self) << in;
+  EXPECT_NEAR(res.clashes[0].clearance, truth, tol) << in << " reported " << regression_g17(res.clashes[0].clearance);
+}
+
+// The certified structure pass kept one inside part, the first the index named: a cable
+// whose axis lay inside two overlapping closed parts (a keep-out zone drawn around a box)
+// clashed with one of them only — or, crossing into the inner one, had the outer one's
+// stretch cut in two. Now every closed part holding the axis is tracked.
+TEST(Regression, CableInsideTwoOverlappingClosedPartsClashedWithOneOnly) {
+  const std::vector<loom::Part> parts{regression_box("a", Vec3(-100, -100, -100), Vec3(60, 100, 100)),
+                                      regression_box("b", Vec3(-60, -100, -100), Vec3(100, 100, 100))};
+  const loom::ClashResult res = regression_audit({regression_cable("C", {Vec3(-20, 0, 0), Vec3(20, 0, 0)}, 1.0)}, parts, 0.01);
+  ASSERT_EQ(res.clashes.size(), 2u) << "cable (-20,0,0)-(20,0,0) r 1 in boxes a [-100,60]x[-100,100]^2 and b [-60,100]x[-100,100]^2";
+  EXPECT_EQ(res.clashes[0].part + res.clashes[1].part, 1);
+  for (const auto& e : res.clashes) EXPECT_TRUE(e.inside);
+}
+
+// A proven-clear stretch inside a closed part was recorded at its first sample only, so a
+// clash stretch running to the cable's end inside a part ended at the last sample of the
+// sphere trace, up to its longest step (50 r) short: s_end 270.85 for 310.
+TEST(Regression, InsideStretchEndedAtTheLastProvenClearSample) {
+  const std::vector<loom::Part> parts{regression_box("hull", Vec3(0, -200, -200), Vec3(400, 200, 200))};
+  const loom::ClashResult res =
+      regression_audit({regression_cable("C", {Vec3(-10, 0, 0), Vec3(300, 0, 0)}, 1.0)}, parts, 0.01);
+  ASSERT_EQ(res.clashes.size(), 1u);
+  EXPECT_NEAR(res.clashes[0].s_end, 310.0, 2.0) << "cable (-10,0,0)-(300,0,0) r 1 in [0,400]x[-200,200]^2, s_end "
+                                                << regression_g17(res.clashes[0].s_end);
+}
+
+// The certified cable–cable pass dropped a chord pair whenever its closest points were
+// excused (both in one bundle segment, or both within a shared junction's radius),
+// although other points of the same two chords, outside the excused region, were in
+// contact. Where two cables part at a junction still touching, the clash is deepest just
+// outside the junction's ball: B leaving A at 5° from a branch point J of radius 3 touches
+// it at clearance −0.252 r on the ball's edge, and the audit reported −0.167 r (leaving a
+// bundle segment without a junction, −0.5 r: missed). Now such a pair is measured at its
+// closest points outside the excused region.
+TEST(Regression, ContactLeavingAJunctionWasExcusedWithItsClosestPoints) {
+  const double r = 1.0, tol = 0.01, slope = std::tan(5.0 * M_PI / 180.0), jr = 3.0;
+  loom::CableInput a = regression_cable("A", {Vec3(-0.37, 0, 0), Vec3(40, 0, 0), Vec3(80, 0, 0)}, r);
+  loom::CableInput b = regression_cable("B", {Vec3(0, 1.5, 0), Vec3(40, 1.5, 0), Vec3(80, 1.5 + 40 * slope, 0)}, r);
+  a.segments = {{3, 0.0, 40.37}, {4, 40.37, 80.37}};
+  b.segments = {{3, 0.0, 40.0}, {5, 40.0, b.curve.length()}};
+  a.junctions = {{"J", Vec3(40, 0.75, 0), jr}};
+  b.junctions = a.junctions;
+  // Closed form: B's point (x, 1.5 + (x − 40)·slope) where it leaves J's ball, against A's
+  // axis y = 0 — the deepest contact outside the excused region to within 1e-4 r (pairs
+  // with A's point just outside the ball instead come within 3e-5 of it).
+  const double x = 40.0 + (-(0.75 * slope) + std::sqrt(0.75 * 0.75 * slope * slope + (1 + slope * slope) * (jr * jr - 0.5625))) /
+                              (1 + slope * slope);
+  const double truth = 1.5 + (x - 40.0) * slope - 2.0 * r;
+  const std::vector<loom::Part> far{regression_box("far", Vec3::Constant(1000), Vec3::Constant(1001))};
+  const loom::ClashResult res = regression_audit({a, b}, far, tol);
+  const std::string in = "A (-0.37,0,0) (40,0,0) (80,0,0); B (0,1.5,0) (40,1.5,0) (80, " +
+                         regression_g17(1.5 + 40 * slope) + ", 0); r 1; junction (40,0.75,0) radius 3; truth " +
+                         regression_g17(truth);
+  ASSERT_EQ(res.clashes.size(), 1u) << in;
+  EXPECT_NEAR(res.clashes[0].clearance, truth, tol) << in << " reported " << regression_g17(res.clashes[0].clearance);
+}
+
+// The certified structure pass excused an observation of a part the cable is attached to
+// (its connector) when the observation's point lay within the port's exit range, and the
+// closest point of the first chord past the exit is often the exit's end itself: the rest
+// of that chord, not excused, went unmeasured. A cable leaving a box face along its normal,
+// attached over s ∈ [0, 3], is 2.0 from the box just past the exit with 3.0 required; the
+// violation was not reported at all. Chords now end where attachments do, and a chord is
+// excused only if it lies within the range.
+TEST(Regression, ClearanceJustPastAPortExitWasExcusedWithTheExit) {
+  const std::vector<loom::Part> parts{regression_box("box", Vec3(0, 0, 0), Vec3(10, 10, 10))};
+  loom::CableInput c = regression_cable("C", {Vec3(10, 5, 5), Vec3(40, 5, 5)}, 1.0);
+  const double s_end = 3.0;
+  c.attachments = {{0, 0.0, s_end, "J1"}};
+  const loom::EmbreeIndex index(parts);
+  loom::ClashRequest req;
+  req.tolerance = 0.01;
+  req.routing_clearance = 3.0;
+  req.threads = 2;
+  const loom::ClashResult res = loom::check_clashes({c}, parts, &index, req);
+  const std::string in = "cable (10,5,5)-(40,5,5) r 1, attached to box [0,10]^3 over s in [0, " + regression_g17(s_end) +
+                         "], clearance 3";
+  EXPECT_TRUE(res.clashes.empty()) << in;
+  ASSERT_EQ(res.violations.size(), 1u) << in;
+  EXPECT_NEAR(res.violations[0].value, s_end - 1.0, 0.01) << in << " value " << regression_g17(res.violations[0].value);
 }

@@ -780,9 +780,9 @@ std::string random_scene_check(std::uint32_t seed) {
                                        cables[c].radius + cables[d].radius + 1.0);
       const ClashKind k = self ? ClashKind::Self : ClashKind::CableCable;
       const bool cert_hit = find_clash(cert, k, static_cast<int>(c), static_cast<int>(d)) != nullptr;
-      // Self: the chord-level |s − t| rule blurs by one chord (≤ r); only judge clear cases.
-      const double margin = self ? cables[c].radius : 0.0;
-      if ((truth < -tol - oracle_err - margin && !cert_hit) || (truth > tol + oracle_err + margin && cert_hit))
+      // Self contacts too are judged at the tolerance: the |s − t| ≥ π r rule is applied on
+      // each chord pair exactly (closest points outside the excused band).
+      if ((truth < -tol - oracle_err && !cert_hit) || (truth > tol + oracle_err && cert_hit))
         fail += "seed " + std::to_string(seed) + (self ? ": self " : ": pair ") + std::to_string(c) + "/" +
                 std::to_string(d) + " truth " + std::to_string(truth) + " reported " + (cert_hit ? "yes" : "no") + "\n";
       if (!self && truth < -tol - oracle_err) {
