@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -117,7 +118,7 @@ int run_audit_command(const AuditFlags& f) {
   write_view_outputs(f.out, scene, scene.harness, report, render);  // view.html, render.png (issue 9)
   write_audit_report(rep, report_path);
   if (f.json)
-    std::cout << report.dump(2) << "\n";
+    std::cout << json_text(report, 2) << "\n";
   else if (!f.quiet)
     print_summary(rep, report_path);
   return rep.exit_code();
@@ -138,7 +139,8 @@ void add_audit_command(CLI::App& app, int& exit_code) {
       ->check(finite_number(0.0, false));
   cmd->add_option("--tolerance", f->tolerance, "Certified accuracy (default: smallest cable radius / 100)")
       ->check(finite_number(0.0, false));
-  cmd->add_option("--threads", f->threads, "Worker threads (default: all cores)");
+  cmd->add_option("--threads", f->threads, "Worker threads (default: all cores)")
+      ->check(whole_number(1, std::numeric_limits<int>::max()));
   cmd->add_option("--out", f->out, "Output directory for report.json")->capture_default_str();
   cmd->add_option("--render-size", f->render_size, "Size of render.png, WIDTHxHEIGHT")->capture_default_str();
   cmd->add_flag("--json", f->json, "Print the report as JSON instead of the summary");

@@ -4,6 +4,7 @@
 #include "core/harness_topology.hpp"
 #include "core/io/scene_load.hpp"
 #include "core/progress.hpp"
+#include "routing/report_json.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -172,7 +173,7 @@ int run_info(const std::string& scene_path, bool json, bool quiet) {
   lo.progress = bar.fn();
   Scene scene = load_scene(scene_path, lo, &rep);
   if (quiet) return 0;
-  if (json) std::cout << info_json(scene, rep).dump(2) << "\n";
+  if (json) std::cout << json_text(info_json(scene, rep), 2) << "\n";
   else print_text(scene, rep);
   return 0;
 }

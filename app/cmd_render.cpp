@@ -11,6 +11,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <memory>
@@ -28,6 +29,30 @@ struct RenderFlags {
   std::string size = default_render_size();
   bool quiet = false;
 };
+
+/// The parts of a --report that the picture uses, checked as it is read: an object whose
+/// "clashes" and "violations" (each optional) are arrays of objects, each with an optional
+/// "kind" string and "point" of three finite numbers. Anything else is an input error
+/// naming the file and the entry, not a picture silently without its markers.
+void check_report_markers(const nlohmann::json& report, const std::string& file) {
+  if (!report.is_object()) throw InputError({file, 0, ""}, "expected a JSON object (a loom report.json)");
+  for (const char* key : {"clashes", "violations"}) {
+    if (!report.contains(key)) continue;
+    const nlohmann::json& list = report[key];
+    if (!list.is_array()) throw InputError({file, 0, key}, "expected an array");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const nlohmann::json& e = list[i];
+      const std::string where = std::string(key) + "[" + std::to_string(i) + "]";
+      if (!e.is_object()) throw InputError({file, 0, where}, "expected an object");
+      if (e.contains("kind") && !e["kind"].is_string()) throw InputError({file, 0, where + ".kind"}, "expected a string");
+      if (!e.contains("point")) continue;
+      const nlohmann::json& p = e["point"];
+      bool ok = p.is_array() && p.size() == 3;
+      for (std::size_t k = 0; ok && k < 3; ++k) ok = p[k].is_number() && std::isfinite(p[k].get<double>());
+      if (!ok) throw InputError({file, 0, where + ".point"}, "expected an array of 3 finite numbers");
+    }
+  }
+}
 
 int run_render(const RenderFlags& f) {
   RenderOptions opt;
@@ -47,6 +72,7 @@ int run_render(const RenderFlags& f) {
     } catch (const nlohmann::json::parse_error& e) {
       throw InputError({f.report, 0, ""}, std::string("not JSON: ") + e.what());
     }
+    check_report_markers(report, f.report);
   }
   RenderStats st;
   const Image img = render_scene(scene, scene.harness, report, opt, &st);

@@ -8,13 +8,16 @@
 #include "core/io/scene_load.hpp"
 #include "core/progress.hpp"
 #include "routing/render.hpp"
+#include "routing/report_json.hpp"
 #include "routing/route_report.hpp"
 #include "routing/view_html.hpp"
 
 #include <CLI/CLI.hpp>
 
+#include <cstdint>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <set>
 
@@ -83,7 +86,7 @@ int run_route(const std::string& scene_path, const RouteCommandOptions& o) {
   const double chord = 0.1 * 0.5 * scene.harness.smallest_diameter();
   write_route_outputs(rep, o.out, chord > 0 ? chord : 0.01);
   write_view_outputs(o.out, scene, rep.routed, route_report_json(rep), render);  // view.html, render.png (issue 9)
-  if (o.json) std::cout << route_report_json(rep).dump(2) << "\n";
+  if (o.json) std::cout << json_text(route_report_json(rep), 2) << "\n";
   else if (!o.quiet) print_summary(rep, o.out);
   return rep.exit_code();
 }
@@ -99,8 +102,10 @@ void add_route_command(CLI::App& app, int& exit_code) {
   // Checked here: the options' "use the scene's" values (< 0) must not swallow a bad one.
   cmd->add_option("--time-limit", o->time_limit, "Planning seconds per segment (default: scene [routing])")
       ->check(finite_number(0.0, true));
-  cmd->add_option("--seed", o->seed, "Random seed (default: scene [routing])")->check(finite_number(0.0, true));
-  cmd->add_option("--threads", o->threads, "Audit threads (default: all cores)");
+  cmd->add_option("--seed", o->seed, "Random seed (default: scene [routing])")
+      ->check(whole_number(0, std::numeric_limits<std::uint32_t>::max()));
+  cmd->add_option("--threads", o->threads, "Audit threads (default: all cores)")
+      ->check(whole_number(1, std::numeric_limits<int>::max()));
   cmd->add_option("--render-size", o->render_size, "Size of render.png, WIDTHxHEIGHT")->capture_default_str();
   cmd->add_flag("--simplify", o->simplify, "Plan among α-simplified parts instead of the exact ones (α-SIM, DESIGN §6)");
   cmd->add_flag("--json", o->json, "Print the report as JSON");

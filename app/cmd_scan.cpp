@@ -11,6 +11,7 @@
 #include "core/io/mesh_write.hpp"
 #include "routing/cable_geometry.hpp"
 #include "routing/point_cloud_io.hpp"
+#include "routing/report_json.hpp"
 #include "routing/scan_centerline.hpp"
 #include "routing/sweep.hpp"
 
@@ -195,10 +196,13 @@ int run_scan(const ScanCommandOptions& o) {
                     {"extract", r.timing.total_ms},
                     {"total", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count()}};
 
+  // Every output's text is made before the first file is written (a failure writes nothing).
+  const std::string report_text = json_text(j, 2) + "\n";
+  const std::string centerline_text = harness_to_xml(h);
   const std::filesystem::path out(o.out);
-  write_harness_xml(h, out / "centerline.xml");
+  write_file_atomic(out / "centerline.xml", centerline_text);
   write_mesh(out / "tube.ply", tube.mesh);
-  write_file_atomic(out / "report.json", j.dump(2) + "\n");
+  write_file_atomic(out / "report.json", report_text);
 
   if (!o.quiet) {
     std::printf("scan %s: %zu points (%s), method %s\n", o.cloud.c_str(), pc.points.size(), to_string(pc.format),

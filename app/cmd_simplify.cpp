@@ -9,6 +9,7 @@
 #include "core/io/scene_load.hpp"
 #include "core/progress.hpp"
 #include "index/alpha_sim.hpp"
+#include "routing/report_json.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -135,7 +136,7 @@ int run_simplify(const SimplifyCommandOptions& o) {
             {"triangles_before", before},
             {"triangles_after", after},
             {"parts", parts}};
-  write_file_atomic(out_dir / "simplify.json", j.dump(2) + "\n");
+  write_file_atomic(out_dir / "simplify.json", json_text(j, 2) + "\n");
   if (!o.quiet)
     std::fprintf(stderr, "loom simplify: %zu -> %zu triangles (%.1f%%) in %.2f s; wrote %s\n", before, after,
                  before > 0 ? 100.0 * after / before : 0.0,

@@ -1,5 +1,6 @@
 #include "app/option_checks.hpp"
 
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -19,6 +20,21 @@ CLI::Validator finite_number(double min, bool min_allowed) {
         return {};
       },
       "FINITE " + limit);
+}
+
+CLI::Validator whole_number(long long min, long long max) {
+  const std::string range = std::to_string(min) + ".." + std::to_string(max);
+  return CLI::Validator(
+      [min, max, range](std::string& text) -> std::string {
+        const char* begin = text.c_str();
+        char* end = nullptr;
+        errno = 0;
+        const long long v = std::strtoll(begin, &end, 10);
+        const bool whole = end != begin && *end == '\0' && errno == 0;
+        if (!whole || v < min || v > max) return "must be a whole number in " + range + ", got " + text;
+        return {};
+      },
+      "INT in " + range);
 }
 
 }  // namespace loom::app

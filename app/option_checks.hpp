@@ -11,4 +11,10 @@ namespace loom::app {
 /// ±inf and text that is not a whole number. The message names the limit and the value.
 CLI::Validator finite_number(double min, bool min_allowed);
 
+/// Accepts a whole number in [min, max] written in decimal digits (an optional sign); rejects
+/// fractions, exponents, text and values out of range (e.g. `--threads 0`, `--threads -1`,
+/// or a `--seed` beyond the 32-bit seed the planner takes, which would be cut to another).
+/// The message names the range and the value.
+CLI::Validator whole_number(long long min, long long max);
+
 }  // namespace loom::app

@@ -113,13 +113,8 @@ std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCa
   for (std::size_t c = 0; c < h.cables.size(); ++c) {
     AuditCable ac;
     ac.id = h.cables[c].id;
-    std::optional<Centerline> curve;
-    try {
-      curve = curves.cable(static_cast<int>(c));
-    } catch (const std::invalid_argument& e) {
-      throw InputError({h.source_file, h.cables[c].line, "cable " + h.cables[c].id},
-                       std::string("its route does not make a curve: ") + e.what());
-    }
+    // A route that does not make a curve throws InputError naming the file and cable.
+    std::optional<Centerline> curve = curves.cable(static_cast<int>(c));
     if (!curve) {
       ac.routed = false;
       ac.reason = "a segment of its route has an unplaced end (branch point without position)";

@@ -1,5 +1,7 @@
 #include "routing/cable_geometry.hpp"
 
+#include "core/error.hpp"
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -55,6 +57,15 @@ Centerline join(const Centerline& a, const Centerline& b) {
   return Centerline(3, std::move(knots), std::move(cps));
 }
 
+/// A cable whose segments do not make a curve (coincident key points, an empty knot
+/// domain, a degree that cannot be joined, ...) is a fault of the harness file: every user
+/// of the curves (audit, render, view, scan --compare) reports it naming the file, the
+/// cable's line and the reason.
+[[noreturn]] void not_a_curve(const Harness& h, int cable, const std::invalid_argument& e) {
+  const Cable& c = h.cables.at(static_cast<std::size_t>(cable));
+  throw InputError({h.source_file, c.line, "cable " + c.id}, std::string("its route does not make a curve: ") + e.what());
+}
+
 }  // namespace
 
 std::optional<Centerline> segment_centerline(const Harness& h, int segment) {
@@ -107,9 +118,14 @@ std::vector<CablePiece> SegmentCurves::pieces(int cable) {
   std::vector<CablePiece> out;
   double s0 = 0.0;
   for (const SegmentUse& u : topo_.cable_chain(cable)) {
-    const std::optional<Centerline>& c = segment(u.segment, u.reversed);
-    if (!c) return {};
-    out.push_back(CablePiece{u.segment, s0, *c});
+    const std::optional<Centerline>* c = nullptr;
+    try {
+      c = &segment(u.segment, u.reversed);
+    } catch (const std::invalid_argument& e) {
+      not_a_curve(topo_.harness(), cable, e);
+    }
+    if (!*c) return {};
+    out.push_back(CablePiece{u.segment, s0, **c});
     s0 += out.back().curve.length();
   }
   return out;
@@ -119,9 +135,13 @@ std::optional<Centerline> SegmentCurves::cable(int cable) {
   std::optional<Centerline> out;
   const auto pieces = this->pieces(cable);
   if (pieces.empty()) return std::nullopt;
-  for (const CablePiece& p : pieces) {
-    Centerline cubic = as_cubic(p.curve);
-    out = out ? join(*out, cubic) : cubic;
+  try {
+    for (const CablePiece& p : pieces) {
+      Centerline cubic = as_cubic(p.curve);
+      out = out ? join(*out, cubic) : cubic;
+    }
+  } catch (const std::invalid_argument& e) {
+    not_a_curve(topo_.harness(), cable, e);
   }
   return out;
 }

@@ -37,9 +37,10 @@ class SegmentCurves {
   /// segment_centerline(harness, s), traversed to → from if `backwards`; throws what it
   /// throws (and builds it again on the next call).
   const std::optional<Centerline>& segment(int s, bool backwards);
-  /// cable_pieces(topo, cable) from the cached curves.
+  /// cable_pieces(topo, cable) from the cached curves. A chain that does not make a curve
+  /// throws InputError naming the harness file, the cable's line and the reason.
   std::vector<CablePiece> pieces(int cable);
-  /// cable_centerline(topo, cable) from the cached curves.
+  /// cable_centerline(topo, cable) from the cached curves; throws as pieces() does.
   std::optional<Centerline> cable(int cable);
 
  private:

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -275,6 +276,27 @@ PointCloud parse_ply(const std::string& bytes, const std::string& file) {
     *slot = static_cast<int>(k);
   }
   if (ix < 0 || iy < 0 || iz < 0) fail(file, ve.line, "element vertex", "vertex element lacks x, y or z");
+  // Every element's count against the bytes after the header, before anything is reserved
+  // or looped over: an instance takes at least a line (ASCII) or its fixed properties' bytes
+  // (binary; a list at least its length field). A binary element without properties takes
+  // none, yet skipping a huge count of them would loop without end: its count must fit too.
+  {
+    const std::size_t bytes_after = bytes.size() - std::min(lr.pos, bytes.size());
+    std::size_t needed = 0;
+    for (const PlyElement& e : elems) {
+      std::size_t per = 1;
+      if (pc.format != PointCloudFormat::PlyAscii) {
+        per = 0;
+        for (const auto& p : e.props) per += static_cast<std::size_t>(scalar_size(p.is_list ? p.count_type : p.type));
+      }
+      const std::size_t room = bytes_after - std::min(needed, bytes_after);
+      if (e.count > bytes_after || (per > 0 && e.count > room / per))
+        fail(file, e.line, "element " + e.name,
+             "declares " + std::to_string(e.count) + " instances, more than the " + std::to_string(bytes_after) +
+                 " bytes after the header can hold (truncated data?)");
+      needed += e.count * per;
+    }
+  }
   pc.declared = ve.count;
   pc.points.reserve(ve.count);
 
@@ -297,6 +319,8 @@ PointCloud parse_ply(const std::string& bytes, const std::string& file) {
         if (p.is_list) {
           std::size_t n = 0;
           if (!parse_count(tk[t], n)) fail(file, lr.line, "vertex", "bad list length '" + std::string(tk[t]) + "'");
+          if (n > tk.size() - t - 1)
+            fail(file, lr.line, "vertex", "list length " + std::to_string(n) + " is more than the values on the line");
           t += 1 + n;
           continue;
         }
@@ -403,6 +427,9 @@ Scalar pcd_scalar(char type, int size, const std::string& file, int line) {
   fail(file, line, "TYPE", std::string("unsupported field type ") + type + " of size " + std::to_string(size));
 }
 
+/// Largest ratio of LZF output to input: a back reference of 264 bytes costs 3 bytes.
+constexpr std::uint64_t kLzfMaxExpansion = 88;
+
 PointCloud parse_pcd(const std::string& bytes, const std::string& file) {
   LineReader lr{bytes};
   std::string_view ln;
@@ -462,6 +489,12 @@ PointCloud parse_pcd(const std::string& bytes, const std::string& file) {
   if (types.size() != fields.size()) fail(file, hdr_line, "TYPE", "TYPE does not list one type per field");
   if (counts.empty()) counts.assign(fields.size(), 1);
   if (counts.size() != fields.size()) fail(file, hdr_line, "COUNT", "COUNT does not list one count per field");
+  // Header numbers come from the file: every product below is checked against overflow
+  // (a wrapped WIDTH*HEIGHT or record size would pass the size checks and read out of bounds).
+  const std::size_t data_bytes = bytes.size() - std::min(lr.pos, bytes.size());
+  if (height != 0 && width > SIZE_MAX / height)
+    fail(file, hdr_line, "WIDTH", "WIDTH " + std::to_string(width) + " x HEIGHT " + std::to_string(height) +
+                                      " overflows");
   if (!have_points) {
     if (!have_width) fail(file, hdr_line, "POINTS", "PCD header has neither POINTS nor WIDTH");
     points = width * height;
@@ -481,18 +514,35 @@ PointCloud parse_pcd(const std::string& bytes, const std::string& file) {
   }
   if (ix < 0 || iy < 0 || iz < 0) fail(file, fields_line, "FIELDS", "PCD fields lack x, y or z");
 
-  PointCloud pc;
-  pc.declared = points;
-  pc.points.reserve(points);
   // Value index (ascii) and byte offset (binary) of each field within one point.
   std::vector<std::size_t> vidx(fields.size()), boff(fields.size());
   std::size_t nvals = 0, rec = 0;
   for (std::size_t i = 0; i < fields.size(); ++i) {
     vidx[i] = nvals;
     boff[i] = rec;
+    const auto size = static_cast<std::size_t>(fields[i].size);  // 1..8, checked above
+    // A wrapped value count or record size would pass the checks below and index past the
+    // values of a line or the bytes of the file.
+    if (fields[i].count > (SIZE_MAX - rec) / size)
+      fail(file, hdr_line, "COUNT", "field '" + fields[i].name + "' has COUNT " + std::to_string(fields[i].count) +
+                                        ": the size of one point overflows");
     nvals += fields[i].count;
-    rec += fields[i].count * static_cast<std::size_t>(fields[i].size);
+    rec += fields[i].count * size;
   }
+  // Points against the data, before anything is reserved: a point takes at least a line
+  // (ascii), its record (binary), or its share of the uncompressed size (checked below).
+  if ((data == "ascii" && points > data_bytes) || (data == "binary" && rec > 0 && points > data_bytes / rec))
+    fail(file, hdr_line, "POINTS", "declares " + std::to_string(points) + " points, more than the " +
+                                       std::to_string(data_bytes) + " bytes of data can hold (truncated data?)");
+  if (data == "binary_compressed" && rec > 0 &&
+      (points > UINT32_MAX / rec || points > kLzfMaxExpansion * data_bytes / rec))
+    fail(file, hdr_line, "POINTS", "declares " + std::to_string(points) + " points of " + std::to_string(rec) +
+                                       " bytes: more than the " + std::to_string(data_bytes) +
+                                       " bytes of compressed data can expand to (LZF, at most " +
+                                       std::to_string(kLzfMaxExpansion) + "x, 32-bit sizes)");
+  PointCloud pc;
+  pc.declared = points;
+  pc.points.reserve(points);
   const auto fx = static_cast<std::size_t>(ix), fy = static_cast<std::size_t>(iy), fz = static_cast<std::size_t>(iz);
 
   if (data == "ascii") {
@@ -539,6 +589,10 @@ PointCloud parse_pcd(const std::string& bytes, const std::string& file) {
     if (usize != points * rec)
       fail_at_byte(file, start + 4, "DATA", "uncompressed size " + std::to_string(usize) + " != " +
                                                 std::to_string(points) + " points x " + std::to_string(rec) + " bytes");
+    if (static_cast<std::uint64_t>(usize) > kLzfMaxExpansion * static_cast<std::uint64_t>(csize))
+      fail_at_byte(file, start + 4, "DATA", "uncompressed size " + std::to_string(usize) + " is more than LZF can " +
+                                                "expand the " + std::to_string(csize) + " compressed bytes to (at most " +
+                                                std::to_string(kLzfMaxExpansion) + "x)");
     std::vector<std::uint8_t> buf(usize);
     if (usize > 0 && lzf_decompress(d + start + 8, csize, buf.data(), buf.size()) != usize)
       fail_at_byte(file, start + 8, "DATA", "corrupt LZF compressed data");
@@ -600,6 +654,10 @@ PointCloud parse_point_cloud(const std::string& bytes, const std::string& name) 
 }
 
 PointCloud read_point_cloud(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) fail(path.string(), 0, "", "point cloud file not found");
+  // A directory, a device (/dev/zero) or a pipe would never end or not read at all.
+  if (!std::filesystem::is_regular_file(path, ec)) fail(path.string(), 0, "", "not a regular file");
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path.string(), 0, "", "cannot open point cloud file");
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -115,8 +115,12 @@ json audit_report_json(const AuditReport& rep) {
   return j;
 }
 
+std::string json_text(const nlohmann::json& j, int indent) {
+  return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 void write_audit_report(const AuditReport& report, const std::filesystem::path& path) {
-  write_file_atomic(path, audit_report_json(report).dump(2) + "\n");
+  write_file_atomic(path, json_text(audit_report_json(report), 2) + "\n");
 }
 
 }  // namespace loom

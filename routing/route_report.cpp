@@ -121,7 +121,7 @@ void write_route_outputs(const RouteReport& rep, const std::filesystem::path& di
     colors.insert(colors.end(), tube.mesh.vertices.size(), cable_color(c));
   }
   write_harness_xml(rep.routed, dir / "routed.xml");
-  write_file_atomic(dir / "report.json", route_report_json(rep).dump(2) + "\n");
+  write_file_atomic(dir / "report.json", json_text(route_report_json(rep), 2) + "\n");
   write_mesh(dir / "cables.ply", all, colors);
 }
 

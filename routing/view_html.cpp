@@ -6,6 +6,7 @@
 #include "core/units.hpp"
 #include "routing/cable_geometry.hpp"
 #include "routing/render.hpp"
+#include "routing/report_json.hpp"
 #include "routing/view_assets.hpp"
 
 #include <algorithm>
@@ -116,7 +117,7 @@ void append_points(std::string& s, const std::vector<Vec3>& pts, double q) {
   s += ']';
 }
 
-std::string js(const std::string& text) { return nlohmann::json(text).dump(); }
+std::string js(const std::string& text) { return json_text(nlohmann::json(text)); }
 
 /// A report value as a finite number for the page (the reports never hold NaN; be safe).
 double finite_or(const nlohmann::json& j, const char* key, double fallback) {
@@ -141,7 +142,7 @@ bool marker_json(const nlohmann::json& e, double q, std::string& s) {
   nlohmann::json p = nlohmann::json::array();
   for (const auto& c : e["point"]) p.push_back(c.is_number() ? quantize(c.get<double>(), q) : 0);
   o["p"] = p;
-  s += o.dump();
+  s += json_text(o);
   return true;
 }
 

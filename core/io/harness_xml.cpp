@@ -17,6 +17,38 @@ namespace loom {
 
 namespace {
 
+/// Narrowest knot domain accepted for a <bspline>, relative to max(1, |knot|): the curve's
+/// k-th derivative scales as 1/width^k and overflows long before 1e-100 (measured: a
+/// domain of 1e-100 already broke the tube sweep, 1e-300 gave infinite positions).
+constexpr double kMinKnotDomain = 1e-12;
+constexpr const char* kMinKnotDomainText = "1e-12";
+
+/// Index of the first byte of `s` that does not belong to a valid UTF-8 sequence (overlong
+/// forms, surrogates and code points beyond U+10FFFF included), or npos.
+std::size_t first_invalid_utf8(const std::string& s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    std::size_t n = 0;
+    unsigned long cp = 0;
+    if (c < 0x80) { ++i; continue; }
+    if (c >= 0xC2 && c <= 0xDF) { n = 1; cp = c & 0x1Fu; }
+    else if (c >= 0xE0 && c <= 0xEF) { n = 2; cp = c & 0x0Fu; }
+    else if (c >= 0xF0 && c <= 0xF4) { n = 3; cp = c & 0x07u; }
+    else return i;
+    for (std::size_t k = 1; k <= n; ++k) {
+      if (i + k >= s.size()) return i;
+      const auto d = static_cast<unsigned char>(s[i + k]);
+      if ((d & 0xC0u) != 0x80u) return i;
+      cp = (cp << 6) | (d & 0x3Fu);
+    }
+    if ((n == 2 && cp < 0x800) || (n == 3 && cp < 0x10000) || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF))
+      return i;
+    i += n + 1;
+  }
+  return std::string::npos;
+}
+
 /// Maps pugixml byte offsets to 1-based line numbers.
 class LineMap {
  public:
@@ -85,11 +117,19 @@ class Reader {
 
   Vec3 point(const pugi::xml_node& n) const { return {number(n, "x"), number(n, "y"), number(n, "z")}; }
 
+  /// Every element the reader accepts passes here: its attributes must be known ones, and
+  /// their values valid UTF-8 (ids, types and colours travel into report.json and view.html,
+  /// which are UTF-8; pugixml has already converted a declared or BOM-marked encoding).
   void only_attributes(const pugi::xml_node& n, std::initializer_list<const char*> allowed) const {
     for (auto a : n.attributes()) {
       bool ok = false;
       for (const char* k : allowed) ok = ok || std::string(a.name()) == k;
       if (!ok) fail(n, std::string("unknown attribute '") + a.name() + "'");
+      const std::string v = a.value();
+      const std::size_t bad = first_invalid_utf8(v);
+      if (bad != std::string::npos)
+        fail(n, std::string("attribute '") + a.name() + "' is not valid UTF-8 (byte " + std::to_string(bad) +
+                    " of its value; declare the file's encoding in <?xml ... encoding=\"...\"?>)");
     }
   }
 
@@ -241,6 +281,16 @@ class Reader {
         if (b.knots.size() != b.control_points.size() + b.degree + 1)
           fail(c, "expected " + std::to_string(b.control_points.size() + b.degree + 1) +
                       " knots (control points + degree + 1), found " + std::to_string(b.knots.size()));
+        {
+          // The curve lives on [knots[degree], knots[count - 1 - degree]]; its derivatives scale
+          // as 1/width^k, so a domain narrower than kMinKnotDomain (relative) overflows them.
+          const double lo = b.knots[static_cast<std::size_t>(b.degree)];
+          const double hi = b.knots[b.knots.size() - 1 - static_cast<std::size_t>(b.degree)];
+          const double scale = std::max({1.0, std::abs(lo), std::abs(hi)});
+          if (!(hi - lo >= kMinKnotDomain * scale))
+            fail(c, "the knots span the domain [" + full_precision(lo) + ", " + full_precision(hi) +
+                        "], narrower than " + kMinKnotDomainText + " x max(1, |knot|): not a curve");
+        }
         seg.bspline = std::move(b);
       } else {
         unknown_child(s, c);
@@ -340,11 +390,12 @@ Harness parse_harness_xml(const std::string& text, const std::string& name_for_e
 }
 
 Harness read_harness_xml(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw InputError({path.string(), 0, ""}, "harness file not found");
+  // A directory reads as nothing, a device (/dev/zero) or pipe without end.
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError({path.string(), 0, ""}, "not a regular file");
   std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw InputError({path.string(), 0, ""},
-                     std::filesystem::exists(path) ? "cannot read harness file" : "harness file not found");
-  }
+  if (!in) throw InputError({path.string(), 0, ""}, "cannot read harness file");
   std::stringstream ss;
   ss << in.rdbuf();
   return parse_harness_xml(ss.str(), path.string());

@@ -1,6 +1,7 @@
 #include "core/io/mesh_read.hpp"
 
 #include "core/error.hpp"
+#include "core/io/mesh_file_checks.hpp"
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
@@ -78,10 +79,14 @@ Mesh read_mesh_file(const std::filesystem::path& path) {
   if (!is_mesh_file(path))
     throw InputError({path.string(), 0, ""}, "unknown mesh extension '" + path.extension().string() +
                                                  "' (meshes: .stl .obj .ply .off .gltf .glb .dae; CAD: .step .stp .iges .igs)");
+  check_mesh_file_structure(path);  // declared counts and nesting Assimp would trust
   Assimp::Importer importer;
   // Points and lines are dropped; node transforms are baked in so one mesh results.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* sc = importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+  // ValidateDataStructure runs before the other steps: a face index beyond the vertices (which
+  // Assimp's PLY reader passes on) is refused there instead of read out of bounds by them.
+  const aiScene* sc = importer.ReadFile(path.string(), aiProcess_ValidateDataStructure | aiProcess_Triangulate |
+                                                           aiProcess_JoinIdenticalVertices |
                                                            aiProcess_PreTransformVertices | aiProcess_SortByPType);
   if (!sc) throw InputError({path.string(), 0, ""}, std::string("cannot read mesh: ") + importer.GetErrorString());
   Mesh m;
@@ -94,6 +99,11 @@ Mesh read_mesh_file(const std::filesystem::path& path) {
     for (unsigned f = 0; f < am->mNumFaces; ++f) {
       const aiFace& face = am->mFaces[f];
       if (face.mNumIndices != 3) continue;
+      for (unsigned k = 0; k < 3; ++k)
+        if (face.mIndices[k] >= am->mNumVertices)
+          throw InputError({path.string(), 0, "face " + std::to_string(f)},
+                           "vertex index " + std::to_string(face.mIndices[k]) + " is beyond the mesh's " +
+                               std::to_string(am->mNumVertices) + " vertices");
       m.triangles.push_back({base + face.mIndices[0], base + face.mIndices[1], base + face.mIndices[2]});
     }
   }

@@ -10,7 +10,9 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -78,6 +80,16 @@ class TomlReader {
     return v;
   }
 
+  /// The table `key` of the document, nullptr if absent; present as anything but a table
+  /// (`harness = "h.xml"` for `[harness] file = "h.xml"`) it is an error, not ignored.
+  const toml::table* section(const toml::table& doc, const char* key) const {
+    const toml::node* n = doc.get(key);
+    if (!n) return nullptr;
+    const toml::table* t = n->as_table();
+    if (!t) fail(n, key, std::string("expected a table [") + key + "]");
+    return t;
+  }
+
   const std::string& file() const { return file_; }
 
  private:
@@ -131,6 +143,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
   {
     std::error_code ec;
     if (!std::filesystem::exists(toml_path, ec)) throw InputError({file, 0, ""}, "scene file not found");
+    if (!std::filesystem::is_regular_file(toml_path, ec)) throw InputError({file, 0, ""}, "not a regular file");
     std::ifstream probe(toml_path);
     if (!probe) throw InputError({file, 0, ""}, "cannot read scene file");
   }
@@ -147,7 +160,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
   Scene scene;
   scene.source_file = file;
 
-  const toml::table* sc = doc["scene"].as_table();
+  const toml::table* sc = r.section(doc, "scene");
   if (!sc) r.fail(nullptr, "[scene]", "missing [scene] table (name, units)");
   r.only_keys(*sc, "scene", {"name", "units"});
   scene.name = r.string(*sc, "scene", "name").value_or(toml_path.stem().string());
@@ -157,10 +170,11 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
   scene.units = *unit;
 
   // Harness first: cable sizes drive the derived tessellation deflection.
-  if (const toml::table* ht = doc["harness"].as_table()) {
+  if (const toml::table* ht = r.section(doc, "harness")) {
     r.only_keys(*ht, "harness", {"file"});
     auto hf = r.string(*ht, "harness", "file");
     if (!hf) r.fail(ht->get("file") ? ht->get("file") : nullptr, "harness.file", "missing harness file name");
+    if (hf->empty()) r.fail(ht->get("file"), "harness.file", "empty file name");
     try {
       scene.harness = read_harness_xml(resolve(base, *hf));
     } catch (const InputError& e) {
@@ -184,7 +198,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
   scene.routing.clearance = {dmin > 0 ? dmin : 1.0 * mm,
                              dmin > 0 ? "default: smallest cable diameter" : "default: 1 mm (no cables)"};
   scene.routing.time_limit = {1.0, "default: 1 s per cable or bundle"};
-  if (const toml::table* rt = doc["routing"].as_table()) {
+  if (const toml::table* rt = r.section(doc, "routing")) {
     r.only_keys(*rt, "routing", {"clearance", "planner", "time_limit", "seed"});
     if (auto v = r.number(*rt, "routing", "clearance")) {
       if (*v < 0) r.fail(rt->get("clearance"), "routing.clearance", "must not be negative");
@@ -196,14 +210,18 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
     }
     if (auto v = r.string(*rt, "routing", "planner")) scene.routing.planner = *v;
     if (auto v = r.number(*rt, "routing", "seed")) {
-      if (*v < 0 || *v != std::floor(*v)) r.fail(rt->get("seed"), "routing.seed", "must be a non-negative integer");
+      // The seed is an unsigned 32-bit value: a larger one would be cut, silently another seed.
+      if (*v < 0 || *v != std::floor(*v) || *v > static_cast<double>(std::numeric_limits<std::uint32_t>::max()))
+        r.fail(rt->get("seed"), "routing.seed",
+               "must be an integer in 0.." + std::to_string(std::numeric_limits<std::uint32_t>::max()) + ", got " +
+                   full_precision(*v));
       scene.routing.seed = static_cast<unsigned>(*v);
     }
   }
   // [simplify]
   scene.simplify.dim_pre = {dmin > 0 ? dmin : 1.0 * mm,
                             dmin > 0 ? "default: smallest cable diameter" : "default: 1 mm (no cables)"};
-  if (const toml::table* st = doc["simplify"].as_table()) {
+  if (const toml::table* st = r.section(doc, "simplify")) {
     r.only_keys(*st, "simplify", {"dim_pre"});
     if (auto v = r.number(*st, "simplify", "dim_pre")) {
       if (!(*v > 0)) r.fail(st->get("dim_pre"), "simplify.dim_pre", "must be positive");
@@ -214,7 +232,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
   scene.tessellation.linear_deflection = {dmin > 0 ? dmin / 20.0 : 0.1 * mm,
                                           dmin > 0 ? "default: smallest cable radius / 10" : "default: 0.1 mm (no cables)"};
   scene.tessellation.angular_deflection_deg = {20.0, "default: 20 degrees"};
-  if (const toml::table* tt = doc["tessellation"].as_table()) {
+  if (const toml::table* tt = r.section(doc, "tessellation")) {
     r.only_keys(*tt, "tessellation", {"linear_deflection", "angular_deflection_deg"});
     if (auto v = r.number(*tt, "tessellation", "linear_deflection")) {
       if (!(*v > 0)) r.fail(tt->get("linear_deflection"), "tessellation.linear_deflection", "must be positive");

@@ -2,6 +2,7 @@
 
 #include "core/io/atomic_file.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -28,6 +29,9 @@ bool get(std::istream& is, T& v) {
 }
 
 bool load(const std::filesystem::path& f, std::vector<NamedMesh>& out) {
+  std::error_code ec;
+  const std::uint64_t size = std::filesystem::file_size(f, ec);
+  if (ec) return false;
   std::ifstream in(f, std::ios::binary);
   if (!in) return false;
   char magic[8];
@@ -43,6 +47,13 @@ bool load(const std::filesystem::path& f, std::vector<NamedMesh>& out) {
     nm.name.resize(len);
     if (!in.read(nm.name.data(), static_cast<std::streamsize>(len))) return false;
     if (!get(in, faces) || !get(in, nv) || !get(in, nt) || nv > (1ull << 32) || nt > (1ull << 32)) return false;
+    // A corrupt or truncated entry must not size the arrays (2^32 vertices: 96 GB, then
+    // std::bad_alloc on every run until the cache was deleted): the rest of the file bounds them.
+    const auto at = in.tellg();
+    if (at < 0) return false;
+    const std::uint64_t left = size - std::min<std::uint64_t>(size, static_cast<std::uint64_t>(at));
+    const std::uint64_t tri_bytes = sizeof(nm.mesh.triangles[0]);
+    if (nv > left / sizeof(Vec3) || nt > (left - nv * sizeof(Vec3)) / tri_bytes) return false;
     nm.brep_faces = faces;
     nm.mesh.vertices.resize(nv);
     nm.mesh.triangles.resize(nt);

@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -420,6 +421,103 @@ TEST(CliRegression, LongPartNamesGiveValidFilesAndQuietStaysQuiet) {
   }
   EXPECT_EQ(stl, 2);
   EXPECT_EQ(step, 2);
+}
+
+// --- hostile inputs (session of 2026-11-27, a sweep of bad inputs of every kind) ---------
+
+// `--threads 0` and `--threads -1` ran with all cores, and `route --seed 5000000000` ran
+// with another seed (cut to 32 bits): each is now exit 2 naming the option and its range,
+// before any work.
+TEST(CliOptions, ThreadsAndSeedOutOfRangeAreUsageErrors) {
+  const auto out = fresh_dir("threads_seed");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"audit " + kAuditData + "/clean.toml --threads 0", "--threads: must be a whole number in 1.."},
+      {"audit " + kAuditData + "/clean.toml --threads -1", "--threads: must be a whole number in 1.."},
+      {"audit " + kAuditData + "/clean.toml --threads 1.5", "--threads"},
+      {"route " + kRouteData + "/around.toml --threads 0", "--threads"},
+      {"route " + kRouteData + "/around.toml --seed 5000000000", "--seed: must be a whole number in 0..4294967295"},
+      {"route " + kRouteData + "/around.toml --seed 1e3", "--seed"}};
+  for (const auto& [cmd, message] : cases) {
+    const auto r = loom(cmd + " --out " + out.string());
+    EXPECT_EQ(r.status, 2) << cmd << "\n" << r.out;
+    EXPECT_NE(r.out.find(message), std::string::npos) << cmd << "\n" << r.out;
+    EXPECT_FALSE(std::filesystem::exists(out)) << cmd;
+  }
+  EXPECT_EQ(loom("audit " + kAuditData + "/clean.toml --threads 1 --quiet --out " + out.string()).status, 0);
+}
+
+// `render --report` took a report of the wrong shape silently (`"clashes": 5`: no markers)
+// or failed naming nothing (`"kind": 5`: nlohmann's type_error 302).
+TEST(CliRender, ReportOfTheWrongShapeIsExitTwoNamingTheEntry) {
+  const auto dir = fresh_dir("render_report");
+  std::filesystem::create_directories(dir);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {R"({"clashes": 5})", "r.json: clashes: expected an array"},
+      {R"({"clashes": [{"kind": 5, "point": [0, 0, 0]}]})", "r.json: clashes[0].kind: expected a string"},
+      {R"({"violations": [{"point": [0, "a", 0]}]})", "r.json: violations[0].point: expected an array of 3 finite"},
+      {R"({"violations": [7]})", "r.json: violations[0]: expected an object"},
+      {"[1, 2]", "r.json: expected a JSON object"}};
+  for (const auto& [json, message] : cases) {
+    std::ofstream(dir / "r.json") << json;
+    const auto r = loom("render " + kAuditData + "/clash.toml --report " + (dir / "r.json").string() + " --out " +
+                        (dir / "x.png").string());
+    EXPECT_EQ(r.status, 2) << json << "\n" << r.out;
+    EXPECT_NE(r.out.find(message), std::string::npos) << json << "\n" << r.out;
+    EXPECT_FALSE(std::filesystem::exists(dir / "x.png")) << json;
+  }
+}
+
+/// Points on a tube of radius 1 around the x axis from x = 0 to 60, as XYZ text.
+std::string tube_cloud() {
+  std::string s;
+  for (int i = 0; i < 600; ++i)
+    for (int k = 0; k < 12; ++k) {
+      const double a = 2.0 * M_PI * k / 12.0 + 0.37 * i;
+      s += std::to_string(0.1 * i) + " " + std::to_string(std::cos(a)) + " " + std::to_string(std::sin(a)) + "\n";
+    }
+  return s;
+}
+
+// A route that does not make a curve (two ports at one place) named its harness file and
+// cable in `audit`, but `render --routes` and `scan --compare` said only
+// "Centerline::interpolate: need at least 2 distinct key points".
+TEST(CliRoutes, RouteThatIsNoCurveNamesFileAndCableInEveryCommand) {
+  const auto dir = fresh_dir("no_curve");
+  std::filesystem::create_directories(dir);
+  std::string h = slurp(kAuditData + "/harness_clear.xml");
+  h.replace(h.find(R"(x="30" y="5" z="30")"), 19, R"(x="-20" y="5" z="30")");
+  h.replace(h.find(R"(<pt x="5" y="5" z="30"/>)"), 24, "");
+  std::ofstream(dir / "r.xml") << h;
+  std::ofstream(dir / "c.xyz") << tube_cloud();
+  const std::string routes = (dir / "r.xml").string();
+  for (const std::string& cmd :
+       {"audit " + kAuditData + "/clean.toml --routes " + routes + " --out " + (dir / "a").string(),
+        "render " + kAuditData + "/clean.toml --routes " + routes + " --out " + (dir / "x.png").string(),
+        "scan " + (dir / "c.xyz").string() + " --compare " + routes + " --cable C1 --out " + (dir / "s").string()}) {
+    const auto r = loom(cmd);
+    EXPECT_EQ(r.status, 2) << cmd << "\n" << r.out;
+    EXPECT_NE(r.out.find("r.xml:5: cable C1: its route does not make a curve"), std::string::npos) << cmd << "\n" << r.out;
+  }
+}
+
+// File names are bytes: one that is not UTF-8 (a Latin-1 name) made nlohmann's dump()
+// throw type_error 316 — `scan` had then written centerline.xml and tube.ply but no
+// report, `audit` nothing, both exit 2 naming nothing. Reports now carry U+FFFD for the
+// bad bytes.
+TEST(CliNames, NonUtf8FileNamesGiveCompleteReports) {
+  const auto dir = fresh_dir("latin1");
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "c\xff.xyz") << tube_cloud();
+  const auto scan = loom("scan '" + (dir / "c\xff.xyz").string() + "' --quiet --out " + (dir / "s").string());
+  EXPECT_EQ(scan.status, 0) << scan.out;
+  EXPECT_NE(slurp(dir / "s" / "report.json").find("c\xef\xbf\xbd.xyz"), std::string::npos);
+  for (const char* f : {"box.obj", "harness_clash.xml"}) std::filesystem::copy_file(kAuditData + "/" + f, dir / f);
+  std::ofstream(dir / "sc\xe9ne.toml") << "[scene]\nunits = 'mm'\n[[part]]\nname = 'box'\nfile = 'box.obj'\n"
+                                          "[harness]\nfile = 'harness_clash.xml'\n";
+  const auto audit = loom("audit '" + (dir / "sc\xe9ne.toml").string() + "' --quiet --out " + (dir / "a").string());
+  EXPECT_EQ(audit.status, 1) << audit.out;
+  EXPECT_NE(slurp(dir / "a" / "report.json").find("\"scene\": \"sc\xef\xbf\xbdne\""), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(dir / "a" / "view.html"));
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 
 namespace loom {
@@ -232,6 +233,54 @@ TEST(HarnessXml, BadSplines) {
   expect_bad(R"(knots="0 0 0 0 1 1 1 1")", R"(knots="0 0 0 1 1 1 1")", {"expected 8 knots"});
   expect_bad(R"(knots="0 0 0 0 1 1 1 1")", R"(knots="0 0 0 0 1 0.5 1 1")", {"must not decrease"});
   expect_bad(R"(interp="polyline")", R"(interp="spline")", {"interp must be"});
+}
+
+// Attribute values travel into report.json and view.html, which are UTF-8: a byte that is
+// not valid UTF-8 is refused where it is read, naming the line, element and attribute.
+TEST(HarnessXml, AttributeValuesMustBeUtf8) {
+  expect_bad(R"(color="red")", "color=\"r\xff\xfe" "d\"", {"bad.xml:6:", "<physical>", "'color'", "not valid UTF-8"});
+  expect_bad(R"(<cable id="C2">)", "<cable id=\"C\xc3\x28" "2\">", {"bad.xml:8:", "'id'", "not valid UTF-8"});
+  expect_bad(R"(color="red")", "color=\"\xed\xa0\x80\"", {"not valid UTF-8"});  // a UTF-16 surrogate
+  expect_bad(R"(color="red")", "color=\"\xc0\xaf\"", {"not valid UTF-8"});      // an overlong '/'
+  // Valid multi-byte text, and a file that declares its encoding, are read as they are.
+  std::string text = kSample;
+  text.replace(text.find(R"(color="red")"), 11, "color=\"\xe7\xba\xa2\xf0\x9f\x94\xb4\"");
+  EXPECT_EQ(parse_harness_xml(text, "u.xml").cables[0].physical.color, "\xe7\xba\xa2\xf0\x9f\x94\xb4");
+  std::string latin1 = kSample;
+  latin1.replace(0, std::string(R"(<?xml version="1.0"?>)").size(), R"(<?xml version="1.0" encoding="ISO-8859-1"?>)");
+  latin1.replace(latin1.find(R"(color="red")"), 11, "color=\"r\xf6" "d\"");
+  EXPECT_EQ(parse_harness_xml(latin1, "l.xml").cables[0].physical.color, "r\xc3\xb6" "d");
+}
+
+// A <bspline>'s knots must span a domain (its derivatives scale as 1/width^k): an empty or
+// vanishing one is refused at the element, not met later as NaN positions.
+TEST(HarnessXml, BsplineKnotDomainMustNotVanish) {
+  const std::string knots = R"(knots="0 0 0 0 1 1 1 1")";
+  expect_bad(knots, R"(knots="0 0 0 0 0 0 0 0")", {"bad.xml:32:", "<bspline>", "domain [0, 0]", "not a curve"});
+  expect_bad(knots, R"(knots="0 0 0 0 1e-300 1e-300 1e-300 1e-300")", {"<bspline>", "narrower than 1e-12"});
+  expect_bad(knots, R"(knots="1e6 1e6 1e6 1e6 1000000.0000001 1000000.0000001 1000000.0000001 1000000.0000001")",
+             {"<bspline>", "narrower than 1e-12"});
+  // The domain is [knot 3, knot 4] of 8: clamping knots outside it may coincide.
+  std::string text = kSample;
+  text.replace(text.find(knots), knots.size(), R"(knots="-5 -5 -5 0 1e-6 7 7 7")");
+  EXPECT_NO_THROW(parse_harness_xml(text, "ok.xml"));
+}
+
+// A directory, a device or a pipe is not a harness file (a device such as /dev/zero was read
+// without end until memory ran out).
+TEST(HarnessXml, NonRegularFileIsRefused) {
+  const auto dir = std::filesystem::temp_directory_path() / "loom_harness_dir.xml";
+  std::filesystem::create_directories(dir);
+  for (const std::filesystem::path& p : {dir, std::filesystem::path("/dev/zero")}) {
+    if (!std::filesystem::exists(p)) continue;
+    try {
+      read_harness_xml(p);
+      ADD_FAILURE() << p;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(p.string() + ": not a regular file"), std::string::npos) << e.what();
+    }
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(HarnessXml, CableWithThreePorts) {

@@ -1,6 +1,7 @@
 // Mesh and CAD files: every format round-trips or loads with the right counts, including
 // real public files from ../shared/data (see its LICENSE-NOTE files).
 #include "core/error.hpp"
+#include "core/io/mesh_file_checks.hpp"
 #include "core/io/mesh_read.hpp"
 #include "core/io/mesh_write.hpp"
 #include "core/io/tessellation_cache.hpp"
@@ -12,7 +13,9 @@
 #include <STEPControl_Writer.hxx>
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <map>
 #include <set>
@@ -146,6 +149,90 @@ TEST_F(TempDir, BadMeshFiles) {
   }
 }
 
+/// The message of the InputError that reading `p` throws ("" and a test failure if none).
+std::string read_error(const fs::path& p) {
+  try {
+    read_mesh_file(p);
+    ADD_FAILURE() << "no error for " << p;
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return {};
+}
+
+const char* kPlyTriangleHeader =
+    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+    "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+
+// Assimp's PLY reader passes a face index beyond the vertices on, and its post-processing
+// read it out of bounds (SIGSEGV for -5): its structure validation now runs first. Its OFF
+// reader clamps such an index instead: checked before it reads.
+TEST_F(TempDir, FaceIndexBeyondTheVerticesIsAnInputError) {
+  for (const char* face : {"3 0 1 99\n", "3 0 1 -5\n"}) {
+    std::ofstream(dir_ / "f.ply") << kPlyTriangleHeader << face;
+    const std::string e = read_error(dir_ / "f.ply");
+    EXPECT_NE(e.find("f.ply"), std::string::npos) << e;
+    EXPECT_NE(e.find("out of range"), std::string::npos) << e;
+  }
+  // Assimp's OFF reader replaced such an index by the last vertex (another triangle).
+  std::ofstream(dir_ / "f.off") << "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 77\n";
+  const std::string e = read_error(dir_ / "f.off");
+  EXPECT_NE(e.find("f.off:6: face 0: vertex index 77 is not one of the 3 vertices"), std::string::npos) << e;
+}
+
+// Counts declared in a PLY or OFF header were allocated before any data was read: a
+// 200-byte file declaring 4e9 vertices asked for 48 GB. They are checked against the size.
+TEST_F(TempDir, DeclaredCountsBeyondTheFileAreRefused) {
+  std::ofstream(dir_ / "a.ply") << "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\n"
+                                   "property float y\nproperty float z\nend_header\n0 0 0\n";
+  std::string e = read_error(dir_ / "a.ply");
+  EXPECT_NE(e.find("a.ply:3: element vertex: declares 4000000000 instances"), std::string::npos) << e;
+  std::string bin = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                    "property float z\nelement face 100\nproperty list uchar int vertex_indices\nend_header\n";
+  bin += std::string(36, '\0') + std::string(1, '\3') + std::string(12, '\0');  // 3 vertices, 1 of 100 faces
+  std::ofstream(dir_ / "b.ply", std::ios::binary) << bin;
+  e = read_error(dir_ / "b.ply");
+  EXPECT_NE(e.find("b.ply:7: element face: declares 100 instances"), std::string::npos) << e;
+  std::ofstream(dir_ / "c.off") << "OFF\n# a comment\n4000000000 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  e = read_error(dir_ / "c.off");
+  EXPECT_NE(e.find("c.off:3: OFF header: declares 4000000000 vertices"), std::string::npos) << e;
+  // Right counts still read.
+  std::ofstream(dir_ / "d.ply") << kPlyTriangleHeader << "3 0 1 2\n";
+  EXPECT_EQ(read_mesh_file(dir_ / "d.ply").triangle_count(), 1u);
+}
+
+/// A glTF of one triangle under a chain of `depth` nodes.
+std::string gltf_chain(std::size_t depth) {
+  std::string nodes;
+  for (std::size_t i = 0; i + 1 < depth; ++i) nodes += "{\"children\":[" + std::to_string(i + 1) + "]},";
+  nodes += "{\"mesh\":0}";
+  // 9 floats: (0,0,0) (1,0,0) (0,1,0), base64.
+  return R"({"asset":{"version":"2.0"},"buffers":[{"uri":"data:application/octet-stream;base64,)"
+         R"(AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA","byteLength":36}],)"
+         R"("bufferViews":[{"buffer":0,"byteLength":36}],"accessors":[{"bufferView":0,"componentType":5126,)"
+         R"("count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],"meshes":[{"primitives":[{"attributes":)"
+         R"({"POSITION":0}}]}],"nodes":[)" + nodes + R"(],"scenes":[{"nodes":[0]}],"scene":0})";
+}
+
+// Assimp walks DAE and glTF node hierarchies recursively: 8,000 nested DAE nodes or 20,000
+// glTF nodes overflowed the stack (SIGSEGV). Deeper than kMaxMeshNesting is refused.
+TEST_F(TempDir, NestingDeeperThanTheLimitIsRefused) {
+  std::string dae = R"(<?xml version="1.0"?><COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" )"
+                    R"(version="1.4.1"><library_visual_scenes><visual_scene id="s">)";
+  for (int i = 0; i < 2000; ++i) dae += "<node>";
+  for (int i = 0; i < 2000; ++i) dae += "</node>";
+  dae += R"(</visual_scene></library_visual_scenes><scene><instance_visual_scene url="#s"/></scene></COLLADA>)";
+  std::ofstream(dir_ / "deep.dae") << dae;
+  std::string e = read_error(dir_ / "deep.dae");
+  EXPECT_NE(e.find("deep.dae:1: <node>: nested more than 1000 levels deep"), std::string::npos) << e;
+  std::ofstream(dir_ / "deep.gltf") << gltf_chain(kMaxMeshNesting + 2);
+  e = read_error(dir_ / "deep.gltf");
+  EXPECT_NE(e.find("deep.gltf: node"), std::string::npos) << e;
+  EXPECT_NE(e.find("nested more than 1000 levels deep"), std::string::npos) << e;
+  std::ofstream(dir_ / "ok.gltf") << gltf_chain(50);
+  EXPECT_EQ(read_mesh_file(dir_ / "ok.gltf").triangle_count(), 1u);
+}
+
 TEST(RealMeshes, CountsMatchTheirSources) {
   struct Case {
     const char* file;
@@ -239,6 +326,40 @@ TEST(RealCad, CacheReturnsTheSameMeshes) {
   tp.linear_deflection = 0.25;  // other parameters: a different key
   read_cad_file_cached(kData / "occt/linkrods.step", tp, true, &hit);
   EXPECT_FALSE(hit);
+  ::unsetenv("LOOM_CACHE_DIR");
+  fs::remove_all(dir);
+}
+
+// A cache entry whose vertex count is corrupt (2^32) sized its arrays from it: 96 GB,
+// std::bad_alloc on every run until the cache was deleted. It is now a miss, re-tessellated
+// and stored again.
+TEST(RealCad, CorruptCacheEntryIsAMiss) {
+  const fs::path dir = fs::temp_directory_path() / "loom_tess_cache_corrupt";
+  fs::remove_all(dir);
+  ::setenv("LOOM_CACHE_DIR", dir.c_str(), 1);
+  TessellationParams tp;
+  tp.linear_deflection = 0.5;
+  bool hit = true;
+  const auto a = read_cad_file_cached(kData / "occt/linkrods.step", tp, true, &hit);
+  ASSERT_FALSE(a.empty());
+  const fs::path entry = dir / (tessellation_cache_key(kData / "occt/linkrods.step", tp, true) + ".tess");
+  std::string bytes;
+  {
+    std::ifstream in(entry, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  // magic (8), mesh count (8), name length (8), name, B-rep faces (4), vertex count (8)
+  std::uint64_t name_length = 0;
+  std::memcpy(&name_length, bytes.data() + 16, 8);
+  const std::uint64_t corrupt = std::uint64_t{1} << 32;
+  std::memcpy(bytes.data() + 24 + name_length + 4, &corrupt, 8);
+  std::ofstream(entry, std::ios::binary) << bytes;
+  const auto b = read_cad_file_cached(kData / "occt/linkrods.step", tp, true, &hit);
+  EXPECT_FALSE(hit);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(a[0].mesh.vertices, b[0].mesh.vertices);
+  read_cad_file_cached(kData / "occt/linkrods.step", tp, true, &hit);
+  EXPECT_TRUE(hit) << "stored again";
   ::unsetenv("LOOM_CACHE_DIR");
   fs::remove_all(dir);
 }

@@ -166,6 +166,36 @@ TEST_F(SceneDir, BadNumbers) {
   expect_bad("[scene]\nname='t'\n[[part]]\nfile='cube.stl'\ntransform={translate=[1,2]}\n", {"array of 3"});
 }
 
+// A section given as anything but a table was ignored without a word (`harness = "h.xml"`
+// loaded a scene without its harness); it is now an error naming the key and line.
+TEST_F(SceneDir, SectionsMustBeTables) {
+  EXPECT_NO_THROW(load_scene(scene("[scene]\nname='t'\n[routing]\n")));
+  expect_bad("harness = 'harness.xml'\n[scene]\nname='t'\n", {"scene.toml:1", "harness", "expected a table [harness]"});
+  expect_bad("routing = 5\n[scene]\nname='t'\n", {"scene.toml:1", "expected a table [routing]"});
+  expect_bad("simplify = [1]\n[scene]\nname='t'\n", {"expected a table [simplify]"});
+  expect_bad("tessellation = true\n[scene]\nname='t'\n", {"expected a table [tessellation]"});
+  expect_bad("scene = 'x'\n", {"scene.toml:1", "expected a table [scene]"});
+}
+
+// The seed is the planner's unsigned 32-bit value: a larger one was cut to another seed.
+TEST_F(SceneDir, SeedMustFitThirtyTwoBits) {
+  EXPECT_EQ(load_scene(scene("[scene]\nname='t'\n[routing]\nseed=4294967295\n")).routing.seed, 4294967295u);
+  expect_bad("[scene]\nname='t'\n[routing]\nseed=4294967296\n", {"scene.toml:4", "routing.seed", "0..4294967295"});
+  expect_bad("[scene]\nname='t'\n[routing]\nseed=1e11\n", {"routing.seed", "0..4294967295"});
+}
+
+TEST_F(SceneDir, SceneAndHarnessMustBeRegularFilesWithNames) {
+  expect_bad("[scene]\nname='t'\n[harness]\nfile=''\n", {"scene.toml:4", "harness.file", "empty file name"});
+  fs::create_directories(dir_ / "sub");
+  expect_bad("[scene]\nname='t'\n[harness]\nfile='sub'\n", {"sub: not a regular file", "scene.toml:4 harness.file"});
+  try {
+    load_scene(dir_);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(dir_.string() + ": not a regular file"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(SceneDir, MalformedToml) {
   expect_bad("[scene]\nname = 't\n", {"scene.toml:2", "malformed TOML"});
 }

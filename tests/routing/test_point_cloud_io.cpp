@@ -325,6 +325,51 @@ TEST(PointCloudIo, MalformedFilesGiveLocatedInputErrors) {
   EXPECT_THROW(read_point_cloud("/nonexistent/cloud.ply"), InputError);
 }
 
+// Header counts are checked against the bytes that follow before anything is reserved or
+// looped over: a 4e9-vertex header reserved 96 GB (std::bad_alloc, naming no file), a
+// binary element without properties declaring 1e18 instances was skipped one by one (a
+// hang), a PCD COUNT of 2^64-1 wrapped the value count and indexed past a line's values,
+// and a compressed block claiming 4 GB was allocated from 4 compressed bytes.
+TEST(PointCloudIo, DeclaredCountsBeyondTheDataAreRefused) {
+  const std::string vertex3 = "property float x\nproperty float y\nproperty float z\n";
+  expect_error("ply\nformat ascii 1.0\nelement vertex 4000000000\n" + vertex3 + "end_header\n0 0 0\n", "a.ply",
+               {"a.ply:3", "element vertex", "declares 4000000000 instances", "bytes after the header"});
+  std::string bin = "ply\nformat binary_little_endian 1.0\nelement junk 1000000000000000000\nelement vertex 1\n" +
+                    vertex3 + "end_header\n" + std::string(12, '\0');
+  expect_error(bin, "b.ply", {"b.ply:3", "element junk", "declares 1000000000000000000 instances"});
+  expect_error("ply\nformat ascii 1.0\nelement vertex 1\n" + vertex3 +
+                   "property list uchar int l\nend_header\n0 0 0 255 1\n",
+               "l.ply", {"l.ply:9", "list length 255 is more than the values on the line"});
+  const std::string pcd = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n";
+  expect_error(pcd + "POINTS 4000000000\nDATA ascii\n0 0 0\n", "p.pcd", {"p.pcd:6", "POINTS", "declares 4000000000 points"});
+  expect_error(pcd + "POINTS 4000000000\nDATA binary\n" + std::string(24, '\0'), "p.pcd", {"declares 4000000000 points"});
+  expect_error("VERSION 0.7\nFIELDS pad x y z\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 18446744073709551615 1 1 1\nPOINTS 1\n"
+               "DATA ascii\n0 0 0\n",
+               "c.pcd", {"c.pcd:7", "COUNT", "field 'pad'", "overflows"});
+  expect_error(pcd + "WIDTH 4294967296\nHEIGHT 4294967296\nPOINTS 0\nDATA ascii\n", "w.pcd", {"WIDTH", "overflows"});
+  std::string compressed = pcd + "POINTS 357913941\nDATA binary_compressed\n";
+  put<std::uint32_t>(compressed, 4);
+  put<std::uint32_t>(compressed, 4294967292u);
+  compressed += std::string(4, '\0');
+  expect_error(compressed, "z.pcd", {"z.pcd:6", "POINTS", "more than the 12 bytes of compressed data can expand to"});
+}
+
+// A directory or a device is not a point cloud (/dev/zero was read until memory ran out).
+TEST(PointCloudIo, NonRegularFilesAreRefused) {
+  const fs::path dir = fs::temp_directory_path() / "loom_pc_dir.xyz";
+  fs::create_directories(dir);
+  for (const fs::path& p : {dir, fs::path("/dev/zero")}) {
+    if (!fs::exists(p)) continue;
+    try {
+      read_point_cloud(p);
+      ADD_FAILURE() << p;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(p.string() + ": not a regular file"), std::string::npos) << e.what();
+    }
+  }
+  fs::remove_all(dir);
+}
+
 // ---- round trip property -----------------------------------------------------------------
 
 RC_GTEST_PROP(PointCloudIoProperty, PlyWriteReadRoundTripsExactly, (bool binary)) {

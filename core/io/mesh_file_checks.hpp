@@ -1,0 +1,32 @@
+#pragma once
+/// Checks of a mesh file made before Assimp reads it, for what Assimp 5.2 does not check
+/// itself and what makes it crash or allocate without bound:
+///
+///  - PLY and OFF headers declare element counts that Assimp allocates up front; a count
+///    that the file's bytes cannot hold (a 200-byte file declaring 4·10⁹ vertices) is
+///    refused before any allocation.
+///  - Assimp's OFF reader replaces a face index beyond the vertices by the last vertex (a
+///    silently different triangle); such an index is refused, naming its line.
+///  - DAE (COLLADA) and glTF/GLB node hierarchies are walked recursively by Assimp; a
+///    hierarchy nested some thousands of levels deep overflows the stack (SIGSEGV). Nesting
+///    deeper than kMaxMeshNesting is refused.
+///
+/// Files of other formats, and files these checks cannot parse (Assimp then reports its own
+/// error), pass unchanged.
+
+#include <cstddef>
+#include <filesystem>
+
+namespace loom {
+
+/// Deepest XML element nesting of a DAE file, and deepest node hierarchy of a glTF/GLB file,
+/// accepted. Assimp 5.2 overflowed an 8 MB stack at 8,000 nested DAE nodes and at 20,000
+/// glTF nodes; real assemblies nest tens of levels.
+constexpr std::size_t kMaxMeshNesting = 1000;
+
+/// Throws InputError naming the file (and the line or element) when the file's declared
+/// counts exceed what its size can hold, an OFF face names no vertex, or its nesting
+/// exceeds kMaxMeshNesting.
+void check_mesh_file_structure(const std::filesystem::path& path);
+
+}  // namespace loom
