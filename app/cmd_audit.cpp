@@ -141,7 +141,7 @@ void add_audit_command(CLI::App& app, int& exit_code) {
       ->check(finite_number(0.0, false));
   cmd->add_option("--threads", f->threads, "Worker threads (default: all cores)")
       ->check(whole_number(1, std::numeric_limits<int>::max()));
-  cmd->add_option("--out", f->out, "Output directory for report.json")->capture_default_str();
+  cmd->add_option("--out", f->out, "Output directory for report.json")->check(non_empty_path())->capture_default_str();
   cmd->add_option("--render-size", f->render_size, "Size of render.png, WIDTHxHEIGHT")->capture_default_str();
   cmd->add_flag("--json", f->json, "Print the report as JSON instead of the summary");
   cmd->add_flag("--quiet", f->quiet, "Print nothing (exit status and report only)");

@@ -1,6 +1,7 @@
 // `loom demo [--out DIR] [--render-size WxH] [--quiet]`: the main job on the bundled
 // wing-section example.
 #include "app/commands.hpp"
+#include "app/option_checks.hpp"
 
 #include "routing/render.hpp"
 
@@ -28,7 +29,7 @@ void add_demo_command(CLI::App& app, int& exit_code) {
   auto out = std::make_shared<std::string>("loom-demo");
   auto quiet = std::make_shared<bool>(false);
   auto render_size = std::make_shared<std::string>(default_render_size());
-  cmd->add_option("--out", *out, "Output directory")->capture_default_str();
+  cmd->add_option("--out", *out, "Output directory")->check(non_empty_path())->capture_default_str();
   cmd->add_option("--render-size", *render_size, "Size of render.png, WIDTHxHEIGHT")->capture_default_str();
   cmd->add_flag("--quiet", *quiet, "Print nothing (exit status only)");
   cmd->callback([out, quiet, render_size, &exit_code]() {

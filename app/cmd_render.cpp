@@ -1,6 +1,7 @@
 // `loom render SCENE [--routes FILE] [--report FILE] [--out FILE] [--render-size WxH] [--quiet]`:
 // a PNG of the scene, its cables and (with --report) the report's clashes, ray-cast on the CPU.
 #include "app/commands.hpp"
+#include "app/option_checks.hpp"
 
 #include "core/error.hpp"
 #include "core/io/scene_load.hpp"
@@ -96,7 +97,7 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("SCENE", f->scene, "Scene file (TOML)")->required();
   cmd->add_option("--routes", f->routes, "Routed harness XML replacing the scene's harness");
   cmd->add_option("--report", f->report, "report.json whose clashes and violations are marked");
-  cmd->add_option("--out", f->out, "Output PNG")->capture_default_str();
+  cmd->add_option("--out", f->out, "Output PNG")->check(non_empty_path())->capture_default_str();
   cmd->add_option("--render-size", f->size, "Image size WIDTHxHEIGHT")->capture_default_str();
   cmd->add_flag("--quiet", f->quiet, "Print nothing");
   cmd->callback([f, &exit_code]() { exit_code = run_render(*f); });

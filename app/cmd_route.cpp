@@ -97,7 +97,7 @@ void add_route_command(CLI::App& app, int& exit_code) {
   auto o = std::make_shared<RouteCommandOptions>();
   o->render_size = default_render_size();
   cmd->add_option("SCENE", *scene, "Scene file (TOML)")->required();
-  cmd->add_option("--out", o->out, "Output directory (routed.xml, report.json, cables.ply)")->capture_default_str();
+  cmd->add_option("--out", o->out, "Output directory (routed.xml, report.json, cables.ply)")->check(non_empty_path())->capture_default_str();
   cmd->add_option("--planner", o->planner, "OMPL planner (rrtconnect, rrtstar, bitstar, prmstar, lazyprmstar, ...)");
   // Checked here: the options' "use the scene's" values (< 0) must not swallow a bad one.
   cmd->add_option("--time-limit", o->time_limit, "Planning seconds per segment (default: scene [routing])")

@@ -227,7 +227,7 @@ void add_scan_command(CLI::App& app, int& exit_code) {
   cmd->add_option("CLOUD", o->cloud, "Point cloud of one cable (PLY, XYZ text, PCD)")->required();
   cmd->add_option("--diameter", o->diameter, "Nominal cable diameter (default: estimated from the cloud)")
       ->check(finite_number(0.0, false));
-  cmd->add_option("--out", o->out, "Output directory")->capture_default_str();
+  cmd->add_option("--out", o->out, "Output directory")->check(non_empty_path())->capture_default_str();
   cmd->add_option("--method", o->method, "graph (blocks along the cable, robust) or axis (the paper's slabs)")
       ->check(CLI::IsMember({"graph", "axis"}))
       ->capture_default_str();

@@ -153,7 +153,7 @@ void add_simplify_command(CLI::App& app, int& exit_code) {
   cmd->add_option("SCENE", o->scene, "Scene file (TOML)")->required();
   auto* dim = cmd->add_option("--dim-pre", o->dim_pre, "Features smaller than this vanish (default: the scene's dim_pre)")
                   ->check(finite_number(0.0, false));
-  cmd->add_option("--out", o->out, "Output directory (DIR/<part>.stl, DIR/simplify.json)");
+  cmd->add_option("--out", o->out, "Output directory (DIR/<part>.stl, DIR/simplify.json)")->check(non_empty_path());
   cmd->add_flag("--step", o->step, "Also write DIR/<part>.step (OpenCASCADE)");
   cmd->add_flag("--quiet", o->quiet, "Print nothing");
   cmd->callback([o, dim, &exit_code]() {

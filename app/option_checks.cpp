@@ -37,4 +37,10 @@ CLI::Validator whole_number(long long min, long long max) {
       "INT in " + range);
 }
 
+CLI::Validator non_empty_path() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string { return text.empty() ? "must name a path, got an empty string" : ""; },
+      "PATH");
+}
+
 }  // namespace loom::app

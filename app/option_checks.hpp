@@ -17,4 +17,8 @@ CLI::Validator finite_number(double min, bool min_allowed);
 /// The message names the range and the value.
 CLI::Validator whole_number(long long min, long long max);
 
+/// Accepts a non-empty path. Why: an empty `--out ""` would otherwise write into the current
+/// directory, which the user did not name.
+CLI::Validator non_empty_path();
+
 }  // namespace loom::app

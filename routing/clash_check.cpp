@@ -6,6 +6,8 @@
 #include "routing/chord_plan.hpp"
 #include "routing/clash_context.hpp"
 
+#include "core/error.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -126,8 +128,13 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
   }
   if (index) ctx.abs_err = index->accuracy().abs_error;
   if (request.method == ClashMethod::Certified && !(ctx.abs_err < 0.5 * ctx.tol))
-    throw std::invalid_argument("check_clashes: tolerance " + std::to_string(ctx.tol) +
-                                " is not above twice the index error " + std::to_string(ctx.abs_err));
+    // A tolerance at or below the index's rounding cannot be certified: say where the
+    // tolerance came from (--tolerance, or the thinnest cable) at full precision.
+    throw std::invalid_argument("clash tolerance " + full_precision(ctx.tol) + " (" +
+                                (res.tolerance_source == "request" ? std::string("as requested") : res.tolerance_source) +
+                                ") is not above twice the index's distance rounding " + full_precision(ctx.abs_err) +
+                                " (scene units): give --tolerance above " + full_precision(2.0 * ctx.abs_err) +
+                                " or check the cable diameters and the scene's units");
   ctx.chord_error = kChordShareOfTolerance * (ctx.tol - ctx.abs_err);
   if (request.method == ClashMethod::Certified)
     for (const auto& c : cables) {

@@ -446,6 +446,25 @@ TEST(CliOptions, ThreadsAndSeedOutOfRangeAreUsageErrors) {
   EXPECT_EQ(loom("audit " + kAuditData + "/clean.toml --threads 1 --quiet --out " + out.string()).status, 0);
 }
 
+// `--out ""` wrote into the current directory, which nobody named; a tolerance below the
+// index's rounding failed as "tolerance 0.000000 is not above twice the index error
+// 0.000000", naming neither the option nor the values.
+TEST(CliOptions, EmptyOutAndUncertifiableToleranceAreNamed) {
+  for (const std::string& cmd : {"audit " + kAuditData + "/clean.toml", "route " + kRouteData + "/around.toml",
+                                std::string("demo")}) {
+    const auto r = loom(cmd + " --quiet --out ''");
+    EXPECT_EQ(r.status, 2) << cmd << "\n" << r.out;
+    EXPECT_NE(r.out.find("--out: must name a path, got an empty string"), std::string::npos) << cmd << "\n" << r.out;
+  }
+  const auto out = fresh_dir("tiny_tolerance");
+  const auto r = loom("audit " + kAuditData + "/clean.toml --quiet --tolerance 1e-300 --out " + out.string());
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("clash tolerance 1e-300 (as requested) is not above twice the index's distance rounding"),
+            std::string::npos)
+      << r.out;
+  EXPECT_FALSE(std::filesystem::exists(out / "report.json"));
+}
+
 // `render --report` took a report of the wrong shape silently (`"clashes": 5`: no markers)
 // or failed naming nothing (`"kind": 5`: nlohmann's type_error 302).
 TEST(CliRender, ReportOfTheWrongShapeIsExitTwoNamingTheEntry) {
