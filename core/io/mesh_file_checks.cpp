@@ -19,12 +19,6 @@ namespace loom {
 
 namespace {
 
-std::string lower_ext(const std::filesystem::path& p) {
-  std::string e = p.extension().string();
-  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
-  return e;
-}
-
 /// At most `limit` bytes from the start of the file.
 std::string head_of(const std::filesystem::path& path, std::size_t limit) {
   std::ifstream in(path, std::ios::binary);
@@ -297,8 +291,14 @@ void check_gltf(const std::filesystem::path& path, bool binary) {
 
 }  // namespace
 
+std::string lower_extension(const std::filesystem::path& path) {
+  std::string e = path.extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
+  return e;
+}
+
 void check_mesh_file_structure(const std::filesystem::path& path) {
-  const std::string ext = lower_ext(path);
+  const std::string ext = lower_extension(path);
   if (ext == ".ply") check_ply(path);
   else if (ext == ".off") check_off(path);
   else if (ext == ".dae") check_dae(path);

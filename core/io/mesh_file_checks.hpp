@@ -16,6 +16,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <string>
 
 namespace loom {
 
@@ -23,6 +24,10 @@ namespace loom {
 /// accepted. Assimp 5.2 overflowed an 8 MB stack at 8,000 nested DAE nodes and at 20,000
 /// glTF nodes; real assemblies nest tens of levels.
 constexpr std::size_t kMaxMeshNesting = 1000;
+
+/// The file's extension lower-cased, with its dot (".ply"; "" for none): the format key the
+/// checks here and the mesh reader dispatch on.
+std::string lower_extension(const std::filesystem::path& path);
 
 /// Throws InputError naming the file (and the line or element) when the file's declared
 /// counts exceed what its size can hold, an OFF face names no vertex, or its nesting

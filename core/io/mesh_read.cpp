@@ -42,11 +42,6 @@
 namespace loom {
 
 namespace {
-std::string lower_ext(const std::filesystem::path& p) {
-  std::string e = p.extension().string();
-  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
-  return e;
-}
 
 void require_readable(const std::filesystem::path& path) {
   std::error_code ec;
@@ -65,12 +60,12 @@ void finish_mesh(Mesh& m, const std::filesystem::path& path, const std::string& 
 }  // namespace
 
 bool is_cad_file(const std::filesystem::path& p) {
-  const auto e = lower_ext(p);
+  const auto e = lower_extension(p);
   return e == ".step" || e == ".stp" || e == ".iges" || e == ".igs";
 }
 
 bool is_mesh_file(const std::filesystem::path& p) {
-  const auto e = lower_ext(p);
+  const auto e = lower_extension(p);
   return e == ".stl" || e == ".obj" || e == ".ply" || e == ".off" || e == ".gltf" || e == ".glb" || e == ".dae";
 }
 
@@ -210,7 +205,7 @@ std::vector<NamedMesh> read_cad_file_occ(const std::filesystem::path& path, cons
   Handle(XCAFApp_Application) app = XCAFApp_Application::GetApplication();
   Handle(TDocStd_Document) doc;
   app->NewDocument("MDTV-XCAF", doc);
-  const std::string ext = lower_ext(path);
+  const std::string ext = lower_extension(path);
   // OpenCASCADE converts lengths to millimetres on transfer; we then scale to scene units.
   Interface_Static::SetCVal("xstep.cascade.unit", "MM");
   bool ok = false;

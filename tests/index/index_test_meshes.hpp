@@ -97,6 +97,14 @@ inline Part make_part(const std::string& name, Mesh mesh, bool closed) {
   return p;
 }
 
+/// An axis-aligned box part [lo, hi] with the given role, closed as its topology says.
+inline Part box_part(const std::string& name, const Vec3& lo, const Vec3& hi, PartRole role = PartRole::Structure) {
+  Part p = make_part(name, box(lo, hi), false);
+  p.role = role;
+  p.closed = analyse_topology(p.mesh).closed;
+  return p;
+}
+
 /// Resolution and randomness of mixed_scene().
 struct MixedSceneDetail {
   std::uint64_t seed = 42;       ///< seeds the soup

@@ -420,14 +420,6 @@ std::string regression_g17(double v) {
   return buf;
 }
 
-loom::Part regression_box(const char* name, const Vec3& lo, const Vec3& hi) {
-  loom::Part p;
-  p.name = name;
-  p.mesh = loom::testmesh::box(lo, hi);
-  p.closed = loom::analyse_topology(p.mesh).closed;
-  return p;
-}
-
 loom::CableInput regression_cable(const char* id, const std::vector<Vec3>& polyline, double r) {
   loom::CableInput c;
   c.id = id;
@@ -457,7 +449,7 @@ loom::ClashResult regression_audit(const std::vector<loom::CableInput>& cables, 
 TEST(Regression, SelfContactBesideAFoldWasExcusedWithTheFold) {
   const double r = 1.0, tol = 0.01, theta = M_PI / 3.0;
   const std::vector<Vec3> v{Vec3(10, 0, 0), Vec3::Zero(), 10.0 * Vec3(std::cos(theta), std::sin(theta), 0)};
-  const std::vector<loom::Part> far{regression_box("far", Vec3::Constant(1000), Vec3::Constant(1001))};
+  const std::vector<loom::Part> far{loom::testmesh::box_part("far", Vec3::Constant(1000), Vec3::Constant(1001))};
   const loom::ClashResult res = regression_audit({regression_cable("V", v, r)}, far, tol);
   const double truth = M_PI * r * std::sin(0.5 * theta) - 2.0 * r;
   const std::string in = "V (10,0,0) (0,0,0) (" + regression_g17(v[2].x()) + ", " + regression_g17(v[2].y()) +
@@ -472,8 +464,8 @@ TEST(Regression, SelfContactBesideAFoldWasExcusedWithTheFold) {
 // clashed with one of them only — or, crossing into the inner one, had the outer one's
 // stretch cut in two. Now every closed part holding the axis is tracked.
 TEST(Regression, CableInsideTwoOverlappingClosedPartsClashedWithOneOnly) {
-  const std::vector<loom::Part> parts{regression_box("a", Vec3(-100, -100, -100), Vec3(60, 100, 100)),
-                                      regression_box("b", Vec3(-60, -100, -100), Vec3(100, 100, 100))};
+  const std::vector<loom::Part> parts{loom::testmesh::box_part("a", Vec3(-100, -100, -100), Vec3(60, 100, 100)),
+                                      loom::testmesh::box_part("b", Vec3(-60, -100, -100), Vec3(100, 100, 100))};
   const loom::ClashResult res = regression_audit({regression_cable("C", {Vec3(-20, 0, 0), Vec3(20, 0, 0)}, 1.0)}, parts, 0.01);
   ASSERT_EQ(res.clashes.size(), 2u) << "cable (-20,0,0)-(20,0,0) r 1 in boxes a [-100,60]x[-100,100]^2 and b [-60,100]x[-100,100]^2";
   EXPECT_EQ(res.clashes[0].part + res.clashes[1].part, 1);
@@ -484,7 +476,7 @@ TEST(Regression, CableInsideTwoOverlappingClosedPartsClashedWithOneOnly) {
 // clash stretch running to the cable's end inside a part ended at the last sample of the
 // sphere trace, up to its longest step (50 r) short: s_end 270.85 for 310.
 TEST(Regression, InsideStretchEndedAtTheLastProvenClearSample) {
-  const std::vector<loom::Part> parts{regression_box("hull", Vec3(0, -200, -200), Vec3(400, 200, 200))};
+  const std::vector<loom::Part> parts{loom::testmesh::box_part("hull", Vec3(0, -200, -200), Vec3(400, 200, 200))};
   const loom::ClashResult res =
       regression_audit({regression_cable("C", {Vec3(-10, 0, 0), Vec3(300, 0, 0)}, 1.0)}, parts, 0.01);
   ASSERT_EQ(res.clashes.size(), 1u);
@@ -514,7 +506,7 @@ TEST(Regression, ContactLeavingAJunctionWasExcusedWithItsClosestPoints) {
   const double x = 40.0 + (-(0.75 * slope) + std::sqrt(0.75 * 0.75 * slope * slope + (1 + slope * slope) * (jr * jr - 0.5625))) /
                               (1 + slope * slope);
   const double truth = 1.5 + (x - 40.0) * slope - 2.0 * r;
-  const std::vector<loom::Part> far{regression_box("far", Vec3::Constant(1000), Vec3::Constant(1001))};
+  const std::vector<loom::Part> far{loom::testmesh::box_part("far", Vec3::Constant(1000), Vec3::Constant(1001))};
   const loom::ClashResult res = regression_audit({a, b}, far, tol);
   const std::string in = "A (-0.37,0,0) (40,0,0) (80,0,0); B (0,1.5,0) (40,1.5,0) (80, " +
                          regression_g17(1.5 + 40 * slope) + ", 0); r 1; junction (40,0.75,0) radius 3; truth " +
@@ -531,7 +523,7 @@ TEST(Regression, ContactLeavingAJunctionWasExcusedWithItsClosestPoints) {
 // violation was not reported at all. Chords now end where attachments do, and a chord is
 // excused only if it lies within the range.
 TEST(Regression, ClearanceJustPastAPortExitWasExcusedWithTheExit) {
-  const std::vector<loom::Part> parts{regression_box("box", Vec3(0, 0, 0), Vec3(10, 10, 10))};
+  const std::vector<loom::Part> parts{loom::testmesh::box_part("box", Vec3(0, 0, 0), Vec3(10, 10, 10))};
   loom::CableInput c = regression_cable("C", {Vec3(10, 5, 5), Vec3(40, 5, 5)}, 1.0);
   const double s_end = 3.0;
   c.attachments = {{0, 0.0, s_end, "J1"}};

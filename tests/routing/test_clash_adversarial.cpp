@@ -31,14 +31,7 @@ std::string g17(double v) {
 }
 std::string g17(const Vec3& v) { return "(" + g17(v.x()) + ", " + g17(v.y()) + ", " + g17(v.z()) + ")"; }
 
-Part box_part(const std::string& name, const Vec3& lo, const Vec3& hi, PartRole role = PartRole::Structure) {
-  Part p;
-  p.name = name;
-  p.mesh = testmesh::box(lo, hi);
-  p.role = role;
-  p.closed = analyse_topology(p.mesh).closed;
-  return p;
-}
+using testmesh::box_part;
 
 CableInput cable(const std::string& id, Centerline curve, double r = kR) {
   CableInput c;

@@ -33,14 +33,7 @@ namespace {
 // ---------------------------------------------------------------------------------------
 // Scene building.
 
-Part box_part(const std::string& name, const Vec3& lo, const Vec3& hi, PartRole role = PartRole::Structure) {
-  Part p;
-  p.name = name;
-  p.mesh = testmesh::box(lo, hi);
-  p.role = role;
-  p.closed = analyse_topology(p.mesh).closed;
-  return p;
-}
+using testmesh::box_part;
 
 /// Open rectangle (two triangles) with corners o, o+u, o+u+v, o+v.
 Part sheet_part(const std::string& name, const Vec3& o, const Vec3& u, const Vec3& v) {
