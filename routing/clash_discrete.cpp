@@ -17,11 +17,12 @@ namespace loom::audit {
 
 namespace {
 
-/// Nearest part to p by brute force over every triangle; inside via winding numbers.
+/// Nearest part to p by brute force over every triangle, and every closed part holding p
+/// (winding number > 1/2).
 struct BruteHit {
   int part = -1;
   double dist = kInf;
-  bool inside = false;
+  std::vector<int> inside;  ///< ascending
 };
 
 BruteHit brute_point(const Context& ctx, const Vec3& p) {
@@ -36,12 +37,7 @@ BruteHit brute_point(const Context& ctx, const Vec3& p) {
       d2 = std::min(d2, closest_point_on_triangle(p, c[0], c[1], c[2]).dist2);
       if (closed) wind += triangle_solid_angle(p, c[0], c[1], c[2]);
     }
-    if (closed && std::abs(wind) > 2.0 * M_PI) {  // winding number > 1/2
-      best.inside = true;
-      best.part = static_cast<int>(q);
-      best.dist = 0.0;
-      return best;
-    }
+    if (closed && std::abs(wind) > 2.0 * M_PI) best.inside.push_back(static_cast<int>(q));  // winding number > 1/2
     const double d = std::sqrt(d2);
     if (d < best.dist) {
       best.dist = d;
@@ -56,42 +52,41 @@ BruteHit brute_point(const Context& ctx, const Vec3& p) {
 void discrete_structure(Context& ctx, int cable, const DiscreteSamples& ds, StretchTracker& tr) {
   const double r = ctx.cables[cable].radius;
   ClashCounters count;
+  std::vector<int> inside;             // the closed parts holding a sample (reused)
+  std::vector<PartObservation> obs;  // what one sample sees (reused)
   for (std::size_t k = 0; k < ds.p.size(); ++k) {
     const Vec3& p = ds.p[k];
     const double s0 = k == 0 ? 0.0 : 0.5 * (ds.s[k - 1] + ds.s[k]);
     const double s1 = k + 1 == ds.p.size() ? ds.s[k] : 0.5 * (ds.s[k] + ds.s[k + 1]);
-    PartObservation o;
-    o.point = p;
-    o.s = ds.s[k];
+    // A sample inside closed parts clashes with each of them (parts modelled through each
+    // other, a keep-out zone around a box); else with the nearest part, within its band.
+    obs.clear();
+    auto observe = [&](int part, double key, bool in) {
+      PartObservation o;
+      o.point = p;
+      o.s = ds.s[k];
+      o.part = part;
+      o.key = key;
+      o.inside = in;
+      if (o.key < ctx.info[part].required) obs.push_back(o);
+    };
     if (ctx.req.use_index) {
-      int part = -1;
       ++count.inside_queries;
-      if (ctx.index->inside(p, &part)) {
-        o.part = part;
-        o.key = -r;
-        o.inside = true;
-      } else {
+      ctx.index->inside_parts(p, inside);
+      for (const int q : inside) observe(q, -r, true);
+      if (inside.empty()) {
         ++count.distance_queries;
         const ClosestHit h = ctx.index->closest(p, r + ctx.band);
-        if (h.found()) {
-          o.part = h.part;
-          o.key = h.distance - r;
-        }
+        if (h.found()) observe(h.part, h.distance - r, false);
       }
     } else {
       ++count.distance_queries;
       ++count.inside_queries;
       const BruteHit h = brute_point(ctx, p);
-      if (h.part >= 0) {
-        o.part = h.part;
-        o.key = h.inside ? -r : h.dist - r;
-        o.inside = h.inside;
-      }
+      for (const int q : h.inside) observe(q, -r, true);
+      if (h.inside.empty() && h.part >= 0) observe(h.part, h.dist - r, false);
     }
-    if (o.part >= 0 && o.key < ctx.info[o.part].required)
-      tr.step({o}, s0, s1);
-    else
-      tr.step({}, s0, s1);
+    tr.step(obs, s0, s1);
   }
   tr.flush();
   ctx.counters.add(count);

@@ -226,6 +226,26 @@ TEST(ClashAdversarial, CableInsideTwoOverlappingPartsClashesWithBoth) {
   }
 }
 
+// The seed's discrete method on the same scene, through the index and by brute force: a
+// sample inside two closed parts clashes with each (it named the first only).
+TEST(ClashAdversarial, DiscreteSamplesInsideTwoOverlappingPartsClashWithBoth) {
+  const std::vector<Part> parts{box_part("a", {-100, -100, -100}, {60, 100, 100}),
+                                box_part("b", {-60, -100, -100}, {100, 100, 100})};
+  const EmbreeIndex index(parts);
+  for (const bool use_index : {true, false}) {
+    ClashRequest req;
+    req.method = ClashMethod::Discrete;
+    req.use_index = use_index;
+    const ClashResult r = check_clashes({straight("C", {-20, 0, 0}, {20, 0, 0})}, parts,
+                                        use_index ? &index : nullptr, req);
+    for (int p = 0; p < 2; ++p) {
+      const auto e = entries(r, ClashKind::CableStructure, 0, p);
+      ASSERT_EQ(e.size(), 1u) << "part " << p << (use_index ? " (index)" : " (brute force)") << "\n" << describe(r);
+      EXPECT_TRUE(e[0]->inside);
+    }
+  }
+}
+
 // A cable that ends deep inside a part: the stretch runs to the cable's end (to one chord).
 TEST(ClashAdversarial, StretchEndingDeepInsideAPartEndsAtTheCableEnd) {
   const std::vector<Part> parts{box_part("hull", {0, -200, -200}, {400, 200, 200})};
