@@ -3,6 +3,7 @@
 // bend and clearance audit of a harness in its scene; writes DIR/report.json (DESIGN §4),
 // DIR/view.html and DIR/render.png. Progress bars on stderr when it is a terminal.
 #include "app/commands.hpp"
+#include "core/io/atomic_file.hpp"
 #include "app/option_checks.hpp"
 
 #include "core/error.hpp"
@@ -87,6 +88,11 @@ void print_summary(const AuditReport& rep, const std::filesystem::path& report_p
 }
 
 int run_audit_command(const AuditFlags& f) {
+  {
+    auto targets = view_output_files(f.out);
+    targets.push_back(std::filesystem::path(f.out) / "report.json");
+    check_output_targets(targets);
+  }
   AuditOptions opt;
   if (f.method == "certified") {
     opt.check.method = ClashMethod::Certified;

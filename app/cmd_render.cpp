@@ -1,6 +1,7 @@
 // `loom render SCENE [--routes FILE] [--report FILE] [--out FILE] [--render-size WxH] [--quiet]`:
 // a PNG of the scene, its cables and (with --report) the report's clashes, ray-cast on the CPU.
 #include "app/commands.hpp"
+#include "core/io/atomic_file.hpp"
 #include "app/option_checks.hpp"
 
 #include "core/error.hpp"
@@ -56,6 +57,7 @@ void check_report_markers(const nlohmann::json& report, const std::string& file)
 }
 
 int run_render(const RenderFlags& f) {
+  check_output_targets({f.out});
   RenderOptions opt;
   parse_render_size(f.size, "--render-size", opt);
   ProgressBar bar(stderr, f.quiet);

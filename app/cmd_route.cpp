@@ -2,6 +2,7 @@
 // report.json, cables.ply, view.html and render.png (--render-size WxH). Progress bars on
 // stderr when it is a terminal.
 #include "app/commands.hpp"
+#include "core/io/atomic_file.hpp"
 #include "app/option_checks.hpp"
 
 #include "core/error.hpp"
@@ -62,6 +63,11 @@ void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
 }  // namespace
 
 int run_route(const std::string& scene_path, const RouteCommandOptions& o) {
+  {
+    auto targets = route_output_files(o.out);
+    for (auto& p : view_output_files(o.out)) targets.push_back(std::move(p));
+    check_output_targets(targets);
+  }
   RenderOptions render;
   if (!o.render_size.empty()) parse_render_size(o.render_size, "--render-size", render);
   ProgressBar bar(stderr, o.quiet || o.json);

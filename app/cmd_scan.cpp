@@ -105,6 +105,8 @@ Harness scan_harness(const ScanResult& r, const std::string& cloud_name, Unit un
 }
 
 int run_scan(const ScanCommandOptions& o) {
+  check_output_targets({std::filesystem::path(o.out) / "centerline.xml", std::filesystem::path(o.out) / "tube.ply",
+                        std::filesystem::path(o.out) / "report.json"});
   using nlohmann::json;
   const auto t_start = std::chrono::steady_clock::now();
   const PointCloud pc = read_point_cloud(o.cloud);

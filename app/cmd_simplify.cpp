@@ -46,6 +46,16 @@ int run_simplify(const SimplifyCommandOptions& o) {
   const double dim_pre = given ? o.dim_pre : scene.simplify.dim_pre.value;
   // Both are finite and > 0: a given --dim-pre is checked on the option, the scene's by load_scene.
   const std::filesystem::path out_dir(o.out);
+  {
+    std::vector<std::string> part_names;
+    for (const auto& p : scene.parts) part_names.push_back(p.name);
+    std::vector<std::filesystem::path> targets{out_dir / "simplify.json"};
+    for (const auto& stem : output_file_stems(part_names)) {
+      targets.push_back(out_dir / (stem + ".stl"));
+      if (o.step) targets.push_back(out_dir / (stem + ".step"));
+    }
+    check_output_targets(targets);
+  }
 
   AlphaSimOptions opt;
   opt.dim_pre = dim_pre;

@@ -104,6 +104,10 @@ json route_report_json(const RouteReport& rep) {
   return j;
 }
 
+std::vector<std::filesystem::path> route_output_files(const std::filesystem::path& dir) {
+  return {dir / "routed.xml", dir / "report.json", dir / "cables.ply"};
+}
+
 void write_route_outputs(const RouteReport& rep, const std::filesystem::path& dir, double chord_tolerance) {
   // The tubes first: if they are refused (the budget), no file is written.
   const HarnessTopology topo(rep.routed);

@@ -19,4 +19,7 @@ nlohmann::json route_report_json(const RouteReport& report);
 /// it throws std::invalid_argument naming the cable, and writes nothing.
 void write_route_outputs(const RouteReport& report, const std::filesystem::path& dir, double chord_tolerance);
 
+/// The files write_route_outputs() writes into `dir` (routed.xml, report.json, cables.ply).
+std::vector<std::filesystem::path> route_output_files(const std::filesystem::path& dir);
+
 }  // namespace loom

@@ -292,6 +292,10 @@ ViewStats write_view_html(const std::filesystem::path& file, const Scene& scene,
   return st;
 }
 
+std::vector<std::filesystem::path> view_output_files(const std::filesystem::path& dir) {
+  return {dir / "view.html", dir / "render.png"};
+}
+
 ViewStats write_view_outputs(const std::filesystem::path& dir, const Scene& scene, const Harness& harness,
                              const nlohmann::json& report, const RenderOptions& render) {
   // Render first: if the picture is refused (its tube budget), neither file is written.

@@ -57,6 +57,9 @@ std::string view_data_json(const Scene& scene, const Harness& harness, const nlo
 ViewStats write_view_html(const std::filesystem::path& file, const Scene& scene, const Harness& harness,
                           const nlohmann::json& report, const ViewOptions& opt = {});
 
+/// The files write_view_outputs() writes into `dir` (view.html, render.png).
+std::vector<std::filesystem::path> view_output_files(const std::filesystem::path& dir);
+
 /// What `loom route` and `loom audit` write beside report.json: DIR/view.html and
 /// DIR/render.png (routing/render.hpp; size, camera and progress from `render`). Returns the
 /// page's stats. The picture is made first: if render_scene throws, neither file is written.

@@ -1,5 +1,7 @@
 #include "core/io/atomic_file.hpp"
 
+#include "core/error.hpp"
+
 #include <atomic>
 #include <stdexcept>
 #include <system_error>
@@ -47,6 +49,28 @@ void write_file_atomic(const std::filesystem::path& path, const std::string& con
   AtomicFile f(path, true);
   f.stream().write(content.data(), static_cast<std::streamsize>(content.size()));
   f.commit();
+}
+
+void check_output_targets(const std::vector<std::filesystem::path>& paths) {
+  namespace fs = std::filesystem;
+  for (const fs::path& p : paths) {
+    std::error_code ec;
+    const fs::file_status st = fs::status(p, ec);
+    if (fs::exists(st) && !fs::is_regular_file(st))
+      throw InputError({p.string(), 0, ""}, fs::is_directory(st) ? "is a directory: the output file cannot replace it"
+                                                                  : "is not a regular file: the output cannot replace it");
+    // The nearest existing ancestor must be a directory (the rest is created).
+    for (fs::path a = p.parent_path(); !a.empty(); a = a.parent_path()) {
+      const fs::file_status sa = fs::status(a, ec);
+      if (!fs::exists(sa)) {
+        if (a == a.parent_path()) break;
+        continue;
+      }
+      if (!fs::is_directory(sa))
+        throw InputError({p.string(), 0, ""}, "lies below " + a.string() + ", which is not a directory");
+      break;
+    }
+  }
 }
 
 }  // namespace loom

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 namespace loom {
 
@@ -29,6 +30,13 @@ class AtomicFile {
   std::ofstream out_;
   bool committed_ = false;
 };
+
+/// Throws InputError naming the first of `paths` that no output file could replace: an
+/// existing directory or other non-regular file, or a path below an existing file. Why:
+/// each output is atomic, but a command writes several; checked before any work, a target
+/// that is bound to fail no longer leaves the outputs before it written and those after it
+/// missing.
+void check_output_targets(const std::vector<std::filesystem::path>& paths);
 
 /// Writes a whole string to `path` atomically.
 void write_file_atomic(const std::filesystem::path& path, const std::string& content);

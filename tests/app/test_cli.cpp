@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <tuple>
 #include <iterator>
 #include <string>
 #include <utility>
@@ -463,6 +464,32 @@ TEST(CliOptions, EmptyOutAndUncertifiableToleranceAreNamed) {
             std::string::npos)
       << r.out;
   EXPECT_FALSE(std::filesystem::exists(out / "report.json"));
+}
+
+// An output path that is a directory failed only when its turn came: `audit` had written
+// nothing of use, `route` had left routed.xml, report.json and cables.ply beside a missing
+// view. Every target is now checked before any work, and nothing is written.
+TEST(CliOutputs, ATargetThatIsADirectoryStopsTheCommandBeforeAnyOutput) {
+  namespace fs = std::filesystem;
+  const std::vector<std::tuple<std::string, std::string, std::vector<std::string>>> cases = {
+      {"audit " + kAuditData + "/clean.toml", "render.png", {"report.json", "view.html"}},
+      {"route " + kRouteData + "/around.toml", "view.html", {"routed.xml", "report.json", "cables.ply", "render.png"}},
+      {"route " + kRouteData + "/around.toml", "cables.ply", {"routed.xml", "report.json", "view.html"}}};
+  for (const auto& [cmd, blocked, others] : cases) {
+    const auto out = fresh_dir("blocked_target");
+    fs::create_directories(out / blocked);
+    const auto r = loom(cmd + " --quiet --out " + out.string());
+    EXPECT_EQ(r.status, 2) << cmd << "\n" << r.out;
+    EXPECT_NE(r.out.find((out / blocked).string() + ": is a directory"), std::string::npos) << cmd << "\n" << r.out;
+    for (const auto& f : others) EXPECT_FALSE(fs::exists(out / f)) << cmd << ": " << f << " was written";
+  }
+  // A path below a file.
+  const auto out = fresh_dir("below_file");
+  fs::create_directories(out);
+  std::ofstream(out / "plain") << "x";
+  const auto r = loom("audit " + kAuditData + "/clean.toml --quiet --out " + (out / "plain" / "sub").string());
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("which is not a directory"), std::string::npos) << r.out;
 }
 
 // `render --report` took a report of the wrong shape silently (`"clashes": 5`: no markers)
