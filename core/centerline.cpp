@@ -693,9 +693,10 @@ std::vector<std::pair<double, Vec3>> Centerline::sample_by_arc_length(double spa
     throw std::invalid_argument("Centerline::sample_by_arc_length: spacing must be positive and finite");
   const double L = length();
   const double count = std::ceil(L / spacing);
-  if (count > 1e8)
+  if (count > kMaxArcSamples)
     throw std::invalid_argument("Centerline::sample_by_arc_length: spacing " + full_precision(spacing) +
-                                " gives more than 1e8 samples on a curve of length " + full_precision(L));
+                                " gives more than " + full_precision(kMaxArcSamples) +
+                                " samples on a curve of length " + full_precision(L));
   const std::size_t n = std::max<std::size_t>(1, static_cast<std::size_t>(count));
   const double step = L / static_cast<double>(n);
   out.reserve(n + 1);

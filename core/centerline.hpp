@@ -149,7 +149,11 @@ class Centerline {
   };
   /// Both bounds of HullBounds, from one pass over the pieces' Bézier points.
   HullBounds hull_bounds(double a, double b) const;
+  /// Most points sample_by_arc_length() returns (it throws beyond: ~2.4 GB of samples).
+  static constexpr double kMaxArcSamples = 1e8;
   /// Points at equal arc spacing ≤ `spacing`, first and last included; with their s.
+  /// Throws std::invalid_argument for a spacing that is not positive and finite, or that
+  /// asks for more than kMaxArcSamples points.
   std::vector<std::pair<double, Vec3>> sample_by_arc_length(double spacing) const;
   /// Smallest bend radius and where it occurs (dense search + local refinement); 0 at a
   /// kink (tangent jump at a knot, e.g. polyline corners) or a fold (C' = 0 with the

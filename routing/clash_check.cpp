@@ -183,6 +183,18 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
   } else {
     std::vector<DiscreteSamples> ds(cables.size());
     res.spacing = request.spacing > 0.0 ? request.spacing : 0.0;
+    // A spacing far below the cable's length is a request mistake: name the cable and where
+    // the spacing came from before any sampling.
+    for (const auto& c : cables) {
+      const double l = request.spacing > 0.0 ? request.spacing : 2.0 * c.radius;
+      const double n = std::ceil(c.curve.length() / l);
+      if (n > Centerline::kMaxArcSamples)
+        throw std::invalid_argument("cable '" + c.id + "': sample spacing " + full_precision(l) +
+                                    (request.spacing > 0.0 ? " (--spacing)" : " (its diameter)") + " gives " +
+                                    full_precision(n) + " samples over its length " +
+                                    full_precision(c.curve.length()) + ", more than the " +
+                                    full_precision(Centerline::kMaxArcSamples) + " the discrete method takes");
+    }
     parallel_indices(cables.size(), request.threads, [&](std::size_t c) {
       const double l = request.spacing > 0.0 ? request.spacing : 2.0 * cables[c].radius;
       const auto samples = cables[c].curve.sample_by_arc_length(l);

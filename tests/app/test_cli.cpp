@@ -466,6 +466,16 @@ TEST(CliOptions, EmptyOutAndUncertifiableToleranceAreNamed) {
   EXPECT_FALSE(std::filesystem::exists(out / "report.json"));
 }
 
+// `--method discrete --spacing 1e-9` failed inside Centerline, naming neither the cable
+// nor the option.
+TEST(CliOptions, SpacingFarBelowTheCableNamesTheCableAndTheOption) {
+  const auto out = fresh_dir("tiny_spacing");
+  const auto r = loom("audit " + kAuditData + "/clean.toml --quiet --method discrete --spacing 1e-9 --out " + out.string());
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("cable 'C1': sample spacing 1.0000000000000001e-09 (--spacing) gives"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(out / "report.json"));
+}
+
 // An output path that is a directory failed only when its turn came: `audit` had written
 // nothing of use, `route` had left routed.xml, report.json and cables.ply beside a missing
 // view. Every target is now checked before any work, and nothing is written.
