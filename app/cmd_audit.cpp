@@ -3,10 +3,10 @@
 // bend and clearance audit of a harness in its scene; writes DIR/report.json (DESIGN §4),
 // DIR/view.html and DIR/render.png. Progress bars on stderr when it is a terminal.
 #include "app/commands.hpp"
-#include "core/io/atomic_file.hpp"
 #include "app/option_checks.hpp"
 
 #include "core/error.hpp"
+#include "core/io/atomic_file.hpp"
 #include "core/progress.hpp"
 #include "routing/audit.hpp"
 #include "routing/render.hpp"

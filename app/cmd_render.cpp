@@ -1,10 +1,10 @@
 // `loom render SCENE [--routes FILE] [--report FILE] [--out FILE] [--render-size WxH] [--quiet]`:
 // a PNG of the scene, its cables and (with --report) the report's clashes, ray-cast on the CPU.
 #include "app/commands.hpp"
-#include "core/io/atomic_file.hpp"
 #include "app/option_checks.hpp"
 
 #include "core/error.hpp"
+#include "core/io/atomic_file.hpp"
 #include "core/io/scene_load.hpp"
 #include "core/progress.hpp"
 #include "core/units.hpp"

@@ -2,10 +2,10 @@
 // report.json, cables.ply, view.html and render.png (--render-size WxH). Progress bars on
 // stderr when it is a terminal.
 #include "app/commands.hpp"
-#include "core/io/atomic_file.hpp"
 #include "app/option_checks.hpp"
 
 #include "core/error.hpp"
+#include "core/io/atomic_file.hpp"
 #include "core/io/scene_load.hpp"
 #include "core/progress.hpp"
 #include "routing/render.hpp"

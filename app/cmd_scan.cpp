@@ -105,8 +105,10 @@ Harness scan_harness(const ScanResult& r, const std::string& cloud_name, Unit un
 }
 
 int run_scan(const ScanCommandOptions& o) {
-  check_output_targets({std::filesystem::path(o.out) / "centerline.xml", std::filesystem::path(o.out) / "tube.ply",
-                        std::filesystem::path(o.out) / "report.json"});
+  const std::filesystem::path out(o.out);
+  const std::filesystem::path centerline_file = out / "centerline.xml", tube_file = out / "tube.ply",
+                              report_file = out / "report.json";
+  check_output_targets({centerline_file, tube_file, report_file});
   using nlohmann::json;
   const auto t_start = std::chrono::steady_clock::now();
   const PointCloud pc = read_point_cloud(o.cloud);
@@ -201,10 +203,9 @@ int run_scan(const ScanCommandOptions& o) {
   // Every output's text is made before the first file is written (a failure writes nothing).
   const std::string report_text = json_text(j, 2) + "\n";
   const std::string centerline_text = harness_to_xml(h);
-  const std::filesystem::path out(o.out);
-  write_file_atomic(out / "centerline.xml", centerline_text);
-  write_mesh(out / "tube.ply", tube.mesh);
-  write_file_atomic(out / "report.json", report_text);
+  write_file_atomic(centerline_file, centerline_text);
+  write_mesh(tube_file, tube.mesh);
+  write_file_atomic(report_file, report_text);
 
   if (!o.quiet) {
     std::printf("scan %s: %zu points (%s), method %s\n", o.cloud.c_str(), pc.points.size(), to_string(pc.format),

@@ -46,11 +46,14 @@ int run_simplify(const SimplifyCommandOptions& o) {
   const double dim_pre = given ? o.dim_pre : scene.simplify.dim_pre.value;
   // Both are finite and > 0: a given --dim-pre is checked on the option, the scene's by load_scene.
   const std::filesystem::path out_dir(o.out);
+  // One file stem per part, as simplify_parts names the STEP files; every target is
+  // checked before any work.
+  std::vector<std::string> part_names;
+  for (const auto& p : scene.parts) part_names.push_back(p.name);
+  const std::vector<std::string> stems = output_file_stems(part_names);
   {
-    std::vector<std::string> part_names;
-    for (const auto& p : scene.parts) part_names.push_back(p.name);
     std::vector<std::filesystem::path> targets{out_dir / "simplify.json"};
-    for (const auto& stem : output_file_stems(part_names)) {
+    for (const auto& stem : stems) {
       targets.push_back(out_dir / (stem + ".stl"));
       if (o.step) targets.push_back(out_dir / (stem + ".step"));
     }
@@ -75,9 +78,6 @@ int run_simplify(const SimplifyCommandOptions& o) {
 
   using nlohmann::json;
   json parts = json::array();
-  std::vector<std::string> names;
-  for (const auto& p : simple) names.push_back(p.name);
-  const std::vector<std::string> stems = output_file_stems(names);  // as simplify_parts named the STEP files
   for (std::size_t i = 0; i < simple.size(); ++i) {
     const AlphaSimResult& r = results[i];
     const std::string& stem = stems[i];

@@ -2,6 +2,8 @@
 
 #include "core/error.hpp"
 #include "core/io/atomic_file.hpp"
+#include "core/io/input_file.hpp"
+#include "core/io/mesh_file_checks.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -281,21 +283,14 @@ PointCloud parse_ply(const std::string& bytes, const std::string& file) {
   // (binary; a list at least its length field). A binary element without properties takes
   // none, yet skipping a huge count of them would loop without end: its count must fit too.
   {
-    const std::size_t bytes_after = bytes.size() - std::min(lr.pos, bytes.size());
-    std::size_t needed = 0;
+    std::vector<PlyElementExtent> extents;
     for (const PlyElement& e : elems) {
-      std::size_t per = 1;
-      if (pc.format != PointCloudFormat::PlyAscii) {
-        per = 0;
-        for (const auto& p : e.props) per += static_cast<std::size_t>(scalar_size(p.is_list ? p.count_type : p.type));
-      }
-      const std::size_t room = bytes_after - std::min(needed, bytes_after);
-      if (e.count > bytes_after || (per > 0 && e.count > room / per))
-        fail(file, e.line, "element " + e.name,
-             "declares " + std::to_string(e.count) + " instances, more than the " + std::to_string(bytes_after) +
-                 " bytes after the header can hold (truncated data?)");
-      needed += e.count * per;
+      PlyElementExtent x{e.name, e.count, 0, e.line};
+      for (const auto& p : e.props) x.min_bytes += static_cast<std::uint64_t>(scalar_size(p.is_list ? p.count_type : p.type));
+      extents.push_back(x);
     }
+    check_ply_extents(extents, pc.format == PointCloudFormat::PlyAscii, bytes.size() - std::min(lr.pos, bytes.size()),
+                      file);
   }
   pc.declared = ve.count;
   pc.points.reserve(ve.count);
@@ -654,10 +649,7 @@ PointCloud parse_point_cloud(const std::string& bytes, const std::string& name) 
 }
 
 PointCloud read_point_cloud(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) fail(path.string(), 0, "", "point cloud file not found");
-  // A directory, a device (/dev/zero) or a pipe would never end or not read at all.
-  if (!std::filesystem::is_regular_file(path, ec)) fail(path.string(), 0, "", "not a regular file");
+  require_input_file(path, "point cloud file");
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path.string(), 0, "", "cannot open point cloud file");
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

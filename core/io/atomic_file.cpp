@@ -60,16 +60,10 @@ void check_output_targets(const std::vector<std::filesystem::path>& paths) {
       throw InputError({p.string(), 0, ""}, fs::is_directory(st) ? "is a directory: the output file cannot replace it"
                                                                   : "is not a regular file: the output cannot replace it");
     // The nearest existing ancestor must be a directory (the rest is created).
-    for (fs::path a = p.parent_path(); !a.empty(); a = a.parent_path()) {
-      const fs::file_status sa = fs::status(a, ec);
-      if (!fs::exists(sa)) {
-        if (a == a.parent_path()) break;
-        continue;
-      }
-      if (!fs::is_directory(sa))
-        throw InputError({p.string(), 0, ""}, "lies below " + a.string() + ", which is not a directory");
-      break;
-    }
+    fs::path a = p.parent_path();
+    while (!a.empty() && !fs::exists(a, ec) && a != a.parent_path()) a = a.parent_path();
+    if (!a.empty() && fs::exists(a, ec) && !fs::is_directory(a, ec))
+      throw InputError({p.string(), 0, ""}, "lies below " + a.string() + ", which is not a directory");
   }
 }
 

@@ -3,6 +3,7 @@
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
 #include "core/io/atomic_file.hpp"
+#include "core/io/input_file.hpp"
 
 #include <pugixml.hpp>
 
@@ -21,7 +22,6 @@ namespace {
 /// k-th derivative scales as 1/width^k and overflows long before 1e-100 (measured: a
 /// domain of 1e-100 already broke the tube sweep, 1e-300 gave infinite positions).
 constexpr double kMinKnotDomain = 1e-12;
-constexpr const char* kMinKnotDomainText = "1e-12";
 
 /// Index of the first byte of `s` that does not belong to a valid UTF-8 sequence (overlong
 /// forms, surrogates and code points beyond U+10FFFF included), or npos.
@@ -287,9 +287,12 @@ class Reader {
           const double lo = b.knots[static_cast<std::size_t>(b.degree)];
           const double hi = b.knots[b.knots.size() - 1 - static_cast<std::size_t>(b.degree)];
           const double scale = std::max({1.0, std::abs(lo), std::abs(hi)});
-          if (!(hi - lo >= kMinKnotDomain * scale))
+          if (!(hi - lo >= kMinKnotDomain * scale)) {
+            std::ostringstream limit;  // shortest form ("1e-12"), as written above
+            limit << kMinKnotDomain;
             fail(c, "the knots span the domain [" + full_precision(lo) + ", " + full_precision(hi) +
-                        "], narrower than " + kMinKnotDomainText + " x max(1, |knot|): not a curve");
+                        "], narrower than " + limit.str() + " x max(1, |knot|): not a curve");
+          }
         }
         seg.bspline = std::move(b);
       } else {
@@ -390,10 +393,7 @@ Harness parse_harness_xml(const std::string& text, const std::string& name_for_e
 }
 
 Harness read_harness_xml(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError({path.string(), 0, ""}, "harness file not found");
-  // A directory reads as nothing, a device (/dev/zero) or pipe without end.
-  if (!std::filesystem::is_regular_file(path, ec)) throw InputError({path.string(), 0, ""}, "not a regular file");
+  require_input_file(path, "harness file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError({path.string(), 0, ""}, "cannot read harness file");
   std::stringstream ss;

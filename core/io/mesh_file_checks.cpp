@@ -80,13 +80,7 @@ void check_ply(const std::filesystem::path& path) {
   if (ec || size < data_at + 1) return;
   const std::uint64_t bytes = size - (data_at + 1);
 
-  struct Element {
-    std::string name;
-    std::uint64_t count = 0;
-    std::uint64_t min_bytes = 0;  // one instance, binary
-    int line = 0;
-  };
-  std::vector<Element> elements;
+  std::vector<PlyElementExtent> elements;
   bool ascii = false;
   std::istringstream is(head.substr(0, end));
   int line_no = 0;
@@ -97,7 +91,7 @@ void check_ply(const std::filesystem::path& path) {
     if (w[0] == "format" && w.size() >= 2) {
       ascii = w[1] == "ascii";
     } else if (w[0] == "element" && w.size() == 3) {
-      Element e;
+      PlyElementExtent e;
       e.name = w[1];
       e.line = line_no;
       if (!parse_count(w[2], e.count)) return;
@@ -109,19 +103,7 @@ void check_ply(const std::filesystem::path& path) {
       elements.back().min_bytes += b;
     }
   }
-  std::uint64_t needed = 0;
-  for (const Element& e : elements) {
-    const std::uint64_t per = ascii ? 1 : e.min_bytes;
-    const std::uint64_t room = bytes - std::min(needed, bytes);
-    // Each instance takes at least one byte, or (binary) its fixed properties' bytes; a
-    // binary element without properties takes none, but Assimp still allocates each one.
-    const bool too_many = e.count > bytes || (per > 0 && e.count > room / per);
-    if (too_many)
-      throw InputError({path.string(), e.line, "element " + e.name},
-                       "declares " + std::to_string(e.count) + " instances, more than the " + std::to_string(bytes) +
-                           " bytes after the header can hold (a truncated or corrupt file?)");
-    needed += e.count * per;
-  }
+  check_ply_extents(elements, ascii, bytes, path.string());
 }
 
 // --- OFF ---------------------------------------------------------------------------------
@@ -290,6 +272,20 @@ void check_gltf(const std::filesystem::path& path, bool binary) {
 }
 
 }  // namespace
+
+void check_ply_extents(const std::vector<PlyElementExtent>& elements, bool ascii, std::uint64_t bytes,
+                       const std::string& file) {
+  std::uint64_t needed = 0;
+  for (const PlyElementExtent& e : elements) {
+    const std::uint64_t per = ascii ? 1 : e.min_bytes;
+    const std::uint64_t room = bytes - std::min(needed, bytes);
+    if (e.count > bytes || (per > 0 && e.count > room / per))
+      throw InputError({file, e.line, "element " + e.name},
+                       "declares " + std::to_string(e.count) + " instances, more than the " + std::to_string(bytes) +
+                           " bytes after the header can hold (a truncated or corrupt file?)");
+    needed += e.count * per;
+  }
+}
 
 std::string lower_extension(const std::filesystem::path& path) {
   std::string e = path.extension().string();

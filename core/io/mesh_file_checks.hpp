@@ -15,8 +15,10 @@
 /// error), pass unchanged.
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace loom {
 
@@ -24,6 +26,23 @@ namespace loom {
 /// accepted. Assimp 5.2 overflowed an 8 MB stack at 8,000 nested DAE nodes and at 20,000
 /// glTF nodes; real assemblies nest tens of levels.
 constexpr std::size_t kMaxMeshNesting = 1000;
+
+/// One element of a PLY header: its declared instance count and the bytes one instance
+/// takes at least in binary (its fixed properties; a list at least its length field).
+struct PlyElementExtent {
+  std::string name;
+  std::uint64_t count = 0;
+  std::uint64_t min_bytes = 0;
+  int line = 0;  ///< header line, 1-based
+};
+
+/// Throws InputError naming `file`, the element and its header line when the declared
+/// counts cannot fit the `bytes` after the header: an instance takes at least a byte in
+/// ASCII (a line) and min_bytes in binary, and no count may exceed `bytes` (a binary
+/// element without properties takes none, yet readers allocate or loop over each one).
+/// Shared by the mesh check (before Assimp) and loom's own point-cloud PLY reader.
+void check_ply_extents(const std::vector<PlyElementExtent>& elements, bool ascii, std::uint64_t bytes,
+                       const std::string& file);
 
 /// The file's extension lower-cased, with its dot (".ply"; "" for none): the format key the
 /// checks here and the mesh reader dispatch on.

@@ -1,6 +1,7 @@
 #include "core/io/mesh_read.hpp"
 
 #include "core/error.hpp"
+#include "core/io/input_file.hpp"
 #include "core/io/mesh_file_checks.hpp"
 
 #include <assimp/Importer.hpp>
@@ -43,14 +44,6 @@ namespace loom {
 
 namespace {
 
-void require_readable(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError({path.string(), 0, ""}, "file not found");
-  if (!std::filesystem::is_regular_file(path, ec)) throw InputError({path.string(), 0, ""}, "not a regular file");
-  std::ifstream probe(path, std::ios::binary);
-  if (!probe) throw InputError({path.string(), 0, ""}, "cannot open file for reading");
-}
-
 void finish_mesh(Mesh& m, const std::filesystem::path& path, const std::string& what) {
   const long bad = first_non_finite_vertex(m);
   if (bad >= 0)
@@ -70,7 +63,7 @@ bool is_mesh_file(const std::filesystem::path& p) {
 }
 
 Mesh read_mesh_file(const std::filesystem::path& path) {
-  require_readable(path);
+  require_input_file(path, "file");
   if (!is_mesh_file(path))
     throw InputError({path.string(), 0, ""}, "unknown mesh extension '" + path.extension().string() +
                                                  "' (meshes: .stl .obj .ply .off .gltf .glb .dae; CAD: .step .stp .iges .igs)");
@@ -197,7 +190,7 @@ std::vector<NamedMesh> read_cad_file(const std::filesystem::path& path, const Te
 
 namespace {
 std::vector<NamedMesh> read_cad_file_occ(const std::filesystem::path& path, const TessellationParams& tp, bool split) {
-  require_readable(path);
+  require_input_file(path, "file");
   if (!is_cad_file(path))
     throw InputError({path.string(), 0, ""}, "not a STEP/IGES file: '" + path.extension().string() + "'");
   if (!(tp.linear_deflection > 0.0))

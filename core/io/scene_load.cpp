@@ -3,6 +3,7 @@
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
 #include "core/io/harness_xml.hpp"
+#include "core/io/input_file.hpp"
 #include "core/io/mesh_read.hpp"
 #include "core/io/tessellation_cache.hpp"
 
@@ -140,13 +141,7 @@ void apply_routes(Scene& scene, const std::filesystem::path& routes) {
 Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions& opt, SceneLoadReport* report) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::string file = toml_path.string();
-  {
-    std::error_code ec;
-    if (!std::filesystem::exists(toml_path, ec)) throw InputError({file, 0, ""}, "scene file not found");
-    if (!std::filesystem::is_regular_file(toml_path, ec)) throw InputError({file, 0, ""}, "not a regular file");
-    std::ifstream probe(toml_path);
-    if (!probe) throw InputError({file, 0, ""}, "cannot read scene file");
-  }
+  require_input_file(toml_path, "scene file");
   toml::table doc;
   try {
     doc = toml::parse_file(file);

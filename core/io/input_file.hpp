@@ -1,0 +1,15 @@
+#pragma once
+/// The check every reader makes before it opens an input file.
+
+#include <filesystem>
+#include <string>
+
+namespace loom {
+
+/// Throws InputError naming `path` unless it is an existing regular file that opens for
+/// reading: "<what> not found", "not a regular file" (a directory reads as nothing, a device
+/// such as /dev/zero or a pipe never ends), or "cannot read <what>". `what` names the kind
+/// of file ("scene file", "harness file", ...).
+void require_input_file(const std::filesystem::path& path, const std::string& what);
+
+}  // namespace loom
