@@ -6,12 +6,14 @@
 #include <pugixml.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <charconv>
 #include <cstdint>
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -65,23 +67,37 @@ std::uint64_t ply_scalar_bytes(const std::string& t) {
   return 0;
 }
 
-/// The PLY header's elements against the bytes after it: an instance takes at least one
-/// byte in ASCII (a line) and at least its fixed properties' bytes in binary (a list at
-/// least its length field). A header this check cannot parse is left to Assimp.
-void check_ply(const std::filesystem::path& path) {
+/// One property of a PLY element: a scalar of `bytes`, or a list whose length field takes
+/// `count_bytes` and each of whose items takes `bytes`.
+struct PlyProperty {
+  bool list = false;
+  std::uint64_t count_bytes = 0;
+  bool count_signed = false;  ///< the length field's type is signed (a negative length is corrupt)
+  std::uint64_t bytes = 0;
+};
+
+/// Whether a PLY integer type is signed.
+bool ply_scalar_signed(const std::string& t) {
+  return t == "char" || t == "int8" || t == "short" || t == "int16" || t == "int" || t == "int32";
+}
+
+/// A PLY header as the checks need it: where the data starts and each element's layout.
+struct PlyLayout {
+  enum class Format { Ascii, BinaryLittle, BinaryBig } format = Format::Ascii;
+  std::uint64_t data_at = 0;  ///< byte offset of the first byte after the header
+  std::vector<PlyElementExtent> extents;
+  std::vector<std::vector<PlyProperty>> properties;  ///< per element
+};
+
+/// The header of a PLY file; false for a header this check cannot parse (left to Assimp).
+bool read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
   constexpr std::size_t kMaxHeader = 1 << 20;  // PLY headers are a few hundred bytes
   const std::string head = head_of(path, kMaxHeader);
   const std::size_t end = head.find("end_header");
-  if (end == std::string::npos) return;
+  if (end == std::string::npos) return false;
   const std::size_t data_at = head.find('\n', end);
-  if (data_at == std::string::npos) return;
-  std::error_code ec;
-  const auto size = static_cast<std::uint64_t>(std::filesystem::file_size(path, ec));
-  if (ec || size < data_at + 1) return;
-  const std::uint64_t bytes = size - (data_at + 1);
-
-  std::vector<PlyElementExtent> elements;
-  bool ascii = false;
+  if (data_at == std::string::npos) return false;
+  out.data_at = data_at + 1;
   std::istringstream is(head.substr(0, end));
   int line_no = 0;
   for (std::string line; std::getline(is, line);) {
@@ -89,21 +105,184 @@ void check_ply(const std::filesystem::path& path) {
     const auto w = words(line);
     if (w.empty()) continue;
     if (w[0] == "format" && w.size() >= 2) {
-      ascii = w[1] == "ascii";
+      if (w[1] == "ascii") out.format = PlyLayout::Format::Ascii;
+      else if (w[1] == "binary_little_endian") out.format = PlyLayout::Format::BinaryLittle;
+      else if (w[1] == "binary_big_endian") out.format = PlyLayout::Format::BinaryBig;
+      else return false;
     } else if (w[0] == "element" && w.size() == 3) {
       PlyElementExtent e;
       e.name = w[1];
       e.line = line_no;
-      if (!parse_count(w[2], e.count)) return;
-      elements.push_back(e);
-    } else if (w[0] == "property" && !elements.empty()) {
-      const std::string& type = (w.size() == 5 && w[1] == "list") ? w[2] : (w.size() >= 2 ? w[1] : w[0]);
-      const std::uint64_t b = ply_scalar_bytes(type);
-      if (b == 0) return;
-      elements.back().min_bytes += b;
+      if (!parse_count(w[2], e.count)) return false;
+      out.extents.push_back(e);
+      out.properties.emplace_back();
+    } else if (w[0] == "property" && !out.extents.empty()) {
+      PlyProperty p;
+      p.list = w.size() == 5 && w[1] == "list";
+      p.count_bytes = p.list ? ply_scalar_bytes(w[2]) : 0;
+      p.count_signed = p.list && ply_scalar_signed(w[2]);
+      p.bytes = ply_scalar_bytes(p.list ? w[3] : (w.size() >= 2 ? w[1] : w[0]));
+      if (p.bytes == 0 || (p.list && p.count_bytes == 0)) return false;
+      out.extents.back().min_bytes += p.list ? p.count_bytes : p.bytes;
+      out.properties.back().push_back(p);
     }
   }
-  check_ply_extents(elements, ascii, bytes, path.string());
+  return true;
+}
+
+/// Sequential reads over a file in blocks, so that walking a large PLY body costs one pass
+/// and a block of memory.
+class ByteCursor {
+ public:
+  ByteCursor(const std::filesystem::path& path, std::uint64_t at, std::uint64_t size)
+      : in_(path, std::ios::binary), pos_(at), size_(size) {
+    in_.seekg(static_cast<std::streamoff>(at));
+  }
+  /// Bytes left after the current position.
+  std::uint64_t left() const { return size_ - pos_; }
+  /// Moves on by n bytes (n ≤ left()).
+  void skip(std::uint64_t n) {
+    const std::uint64_t buffered = block_.size() - at_;
+    if (n <= buffered) {
+      at_ += static_cast<std::size_t>(n);
+    } else {
+      block_.clear();
+      at_ = 0;
+      in_.seekg(static_cast<std::streamoff>(pos_ + n));
+    }
+    pos_ += n;
+  }
+  /// The next n ≤ 8 bytes (n ≤ left()), in file order.
+  std::array<unsigned char, 8> take(std::size_t n) {
+    std::array<unsigned char, 8> b{};
+    for (std::size_t k = 0; k < n; ++k) {
+      if (at_ == block_.size()) refill();
+      b[k] = static_cast<unsigned char>(block_[at_++]);
+    }
+    pos_ += n;
+    return b;
+  }
+
+ private:
+  void refill() {
+    constexpr std::size_t kBlock = 1 << 20;
+    block_.resize(static_cast<std::size_t>(std::min<std::uint64_t>(kBlock, size_ - pos_)));
+    in_.read(block_.data(), static_cast<std::streamsize>(block_.size()));
+    block_.resize(static_cast<std::size_t>(std::max<std::streamsize>(in_.gcount(), 0)));
+    at_ = 0;
+    if (block_.empty()) throw std::runtime_error("read past the end of the file");  // size changed under us
+  }
+  std::ifstream in_;
+  std::string block_;
+  std::size_t at_ = 0;
+  std::uint64_t pos_ = 0, size_ = 0;
+};
+
+/// A binary list length of `bytes` bytes as the integer the header names, in decimal
+/// ("-1" for a signed field with its top bit set).
+std::string list_length_text(const std::array<unsigned char, 8>& b, std::size_t bytes, bool big_endian,
+                             bool is_signed, std::uint64_t& value) {
+  value = 0;
+  for (std::size_t k = 0; k < bytes; ++k) value = (value << 8) | b[big_endian ? k : bytes - 1 - k];
+  const std::uint64_t top = std::uint64_t{1} << (8 * bytes - 1);
+  if (!is_signed || (value & top) == 0) return std::to_string(value);
+  const std::uint64_t magnitude = (top << 1) - value;  // two's complement of a `bytes`-byte field
+  value = UINT64_MAX;                                    // no file holds a negative length
+  return "-" + std::to_string(magnitude);
+}
+
+[[noreturn]] void bad_list(const std::filesystem::path& path, const PlyElementExtent& e, std::uint64_t instance,
+                           const std::string& length, std::uint64_t left) {
+  const std::string where = "element " + e.name + " instance " + std::to_string(instance);
+  if (!length.empty() && length[0] == '-')
+    throw InputError({path.string(), e.line, where}, "list length " + length + " is negative (a corrupt file?)");
+  throw InputError({path.string(), e.line, where},
+                   "list length " + length + " is more than the " + std::to_string(left) +
+                       " bytes left in the file can hold (a truncated or corrupt file?)");
+}
+
+/// Every binary list length against the bytes left after it. Why: Assimp allocates a list
+/// by its length field before reading it, so a 100-byte file with a face of 10⁸ indices
+/// took 830 MB and one of 4·10⁹ ended in std::bad_alloc. Elements without lists are
+/// skipped whole.
+void check_ply_binary_lists(const std::filesystem::path& path, const PlyLayout& layout, std::uint64_t size) {
+  const bool big = layout.format == PlyLayout::Format::BinaryBig;
+  ByteCursor cur(path, layout.data_at, size);
+  for (std::size_t i = 0; i < layout.extents.size(); ++i) {
+    const PlyElementExtent& e = layout.extents[i];
+    const auto& props = layout.properties[i];
+    const bool has_list = std::any_of(props.begin(), props.end(), [](const PlyProperty& p) { return p.list; });
+    if (!has_list) {
+      if (e.count > cur.left() / std::max<std::uint64_t>(e.min_bytes, 1)) return;  // the extent check's job
+      cur.skip(e.count * e.min_bytes);
+      continue;
+    }
+    for (std::uint64_t k = 0; k < e.count; ++k)
+      for (const PlyProperty& p : props) {
+        if (!p.list) {
+          if (p.bytes > cur.left()) return;  // a short file: Assimp reports it
+          cur.skip(p.bytes);
+          continue;
+        }
+        if (p.count_bytes > cur.left()) return;
+        const auto raw = cur.take(static_cast<std::size_t>(p.count_bytes));
+        std::uint64_t n = 0;
+        const std::string text =
+            list_length_text(raw, static_cast<std::size_t>(p.count_bytes), big, p.count_signed, n);
+        if (n > cur.left() / p.bytes) bad_list(path, e, k, text, cur.left());
+        cur.skip(n * p.bytes);
+      }
+  }
+}
+
+/// Every ASCII list length against the bytes left after it (each value takes at least a
+/// digit and a separator). Why: as for binary lists, Assimp allocates a list before reading
+/// it ("4000000000 0 1 2" ended in std::bad_alloc).
+void check_ply_ascii_lists(const std::filesystem::path& path, const PlyLayout& layout) {
+  const bool any_list = std::any_of(layout.properties.begin(), layout.properties.end(), [](const auto& ps) {
+    return std::any_of(ps.begin(), ps.end(), [](const PlyProperty& p) { return p.list; });
+  });
+  if (!any_list) return;
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(static_cast<std::streamoff>(layout.data_at));
+  std::error_code ec;
+  const auto size = static_cast<std::uint64_t>(std::filesystem::file_size(path, ec));
+  if (ec) return;
+  std::string token;
+  for (std::size_t i = 0; i < layout.extents.size(); ++i) {
+    const PlyElementExtent& e = layout.extents[i];
+    for (std::uint64_t k = 0; k < e.count; ++k)
+      for (const PlyProperty& p : layout.properties[i]) {
+        if (!(in >> token)) return;  // a short file: Assimp reports it
+        if (!p.list) continue;
+        std::uint64_t n = 0;
+        const auto at = in.tellg();
+        const std::uint64_t left = at < 0 ? 0 : size - std::min<std::uint64_t>(size, static_cast<std::uint64_t>(at));
+        if (!parse_count(token, n)) {
+          if (!token.empty() && token[0] == '-') bad_list(path, e, k, token, left);
+          return;  // not a number: Assimp reports it
+        }
+        if (n > left / 2) bad_list(path, e, k, token, left);  // " v" per value at least
+        for (std::uint64_t v = 0; v < n; ++v)
+          if (!(in >> token)) return;
+      }
+  }
+}
+
+/// The PLY header's elements against the bytes after it (an instance takes at least one
+/// byte in ASCII, a line, and at least its fixed properties' bytes in binary, a list at
+/// least its length field), then every list's length against the bytes left after it.
+/// A header this check cannot parse is left to Assimp.
+void check_ply(const std::filesystem::path& path) {
+  PlyLayout layout;
+  if (!read_ply_layout(path, layout)) return;
+  std::error_code ec;
+  const auto size = static_cast<std::uint64_t>(std::filesystem::file_size(path, ec));
+  if (ec || size < layout.data_at) return;
+  const bool ascii = layout.format == PlyLayout::Format::Ascii;
+  check_ply_extents(layout.extents, ascii, size - layout.data_at, path.string());
+  if (ascii) check_ply_ascii_lists(path, layout);
+  else check_ply_binary_lists(path, layout, size);
 }
 
 // --- OFF ---------------------------------------------------------------------------------

@@ -201,6 +201,68 @@ TEST_F(TempDir, DeclaredCountsBeyondTheFileAreRefused) {
   EXPECT_EQ(read_mesh_file(dir_ / "d.ply").triangle_count(), 1u);
 }
 
+/// A binary PLY of a unit quad's 4 vertices and the given face records (list length field of
+/// `count_type`, int indices), in little or big endian byte order.
+std::string binary_ply(bool big_endian, const std::string& count_type, const std::vector<std::vector<std::int64_t>>& faces,
+                       std::size_t count_bytes) {
+  std::string s = std::string("ply\nformat ") + (big_endian ? "binary_big_endian" : "binary_little_endian") +
+                  " 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+                  std::to_string(faces.size()) + "\nproperty list " + count_type + " int vertex_indices\nend_header\n";
+  auto put = [&](std::uint64_t v, std::size_t bytes) {
+    for (std::size_t k = 0; k < bytes; ++k) {
+      const std::size_t shift = 8 * (big_endian ? bytes - 1 - k : k);
+      s.push_back(static_cast<char>((v >> shift) & 0xFF));
+    }
+  };
+  const float xyz[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  for (const auto& v : xyz)
+    for (float c : v) {
+      std::uint32_t bits = 0;
+      std::memcpy(&bits, &c, 4);
+      put(bits, 4);
+    }
+  for (const auto& f : faces) {
+    put(static_cast<std::uint64_t>(f[0]), count_bytes);  // the length field as written, maybe a lie
+    for (std::size_t k = 1; k < f.size(); ++k) put(static_cast<std::uint64_t>(f[k]), 4);
+  }
+  return s;
+}
+
+// Assimp allocates a PLY list by its length field before reading it: a 100-byte file with a
+// face of 10⁸ indices took 830 MB, and 4·10⁹ ended in std::bad_alloc naming nothing. Every
+// list length is now checked against the bytes left, in both byte orders and in ASCII.
+TEST_F(TempDir, PlyListLengthsBeyondTheFileAreRefused) {
+  for (bool big : {false, true}) {
+    std::ofstream(dir_ / "l.ply", std::ios::binary) << binary_ply(big, "uint", {{3, 0, 1, 2}, {100000000, 0, 2, 3}}, 4);
+    std::string e = read_error(dir_ / "l.ply");
+    EXPECT_NE(e.find("l.ply:7: element face instance 1: list length 100000000 is more than the 12 bytes left"),
+              std::string::npos)
+        << e;
+    std::ofstream(dir_ / "n.ply", std::ios::binary) << binary_ply(big, "int", {{-1, 0, 1, 2}}, 4);
+    e = read_error(dir_ / "n.ply");
+    EXPECT_NE(e.find("n.ply:7: element face instance 0: list length -1 is negative"), std::string::npos) << e;
+    std::ofstream(dir_ / "c.ply", std::ios::binary) << binary_ply(big, "char", {{0xFF, 0, 1, 2}}, 1);
+    e = read_error(dir_ / "c.ply");
+    EXPECT_NE(e.find("list length -1 is negative"), std::string::npos) << e;
+    // Right lengths still read: a triangle and a quad (two triangles), either byte order and
+    // either width of length field.
+    std::ofstream(dir_ / "ok.ply", std::ios::binary) << binary_ply(big, "uchar", {{3, 0, 1, 2}, {4, 0, 1, 2, 3}}, 1);
+    EXPECT_EQ(read_mesh_file(dir_ / "ok.ply").triangle_count(), 3u);
+    std::ofstream(dir_ / "ok4.ply", std::ios::binary) << binary_ply(big, "int", {{3, 0, 2, 3}}, 4);
+    EXPECT_EQ(read_mesh_file(dir_ / "ok4.ply").triangle_count(), 1u);
+  }
+  std::ofstream(dir_ / "a.ply") << kPlyTriangleHeader << "4000000000 0 1 2\n";
+  std::string e = read_error(dir_ / "a.ply");
+  EXPECT_NE(e.find("a.ply:7: element face instance 0: list length 4000000000 is more than the"), std::string::npos)
+      << e;
+  std::ofstream(dir_ / "m.ply") << kPlyTriangleHeader << "-3 0 1 2\n";
+  e = read_error(dir_ / "m.ply");
+  EXPECT_NE(e.find("list length -3 is negative"), std::string::npos) << e;
+  // An ASCII list whose values exactly fill the file's end passes to Assimp.
+  std::ofstream(dir_ / "e.ply") << kPlyTriangleHeader << "3 0 1 2";
+  EXPECT_EQ(read_mesh_file(dir_ / "e.ply").triangle_count(), 1u);
+}
+
 /// A glTF of one triangle under a chain of `depth` nodes.
 std::string gltf_chain(std::size_t depth) {
   std::string nodes;

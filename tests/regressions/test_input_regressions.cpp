@@ -143,6 +143,22 @@ TEST(Regression, MeshHeaderCountsWereAllocatedUnchecked) {
   EXPECT_NE(e.find("m.ply:3: element vertex: declares 4000000000 instances"), std::string::npos) << e;
 }
 
+// A PLY face whose list length field says 10⁸ (or 4·10⁹) in a 100-byte file: Assimp
+// allocated the list before reading it (830 MB; "cannot read mesh: std::bad_alloc" for
+// 4·10⁹, naming no element). Every list length is now checked against the bytes left.
+TEST(Regression, PlyListLengthWasAllocatedUnchecked) {
+  const fs::path d = scratch();
+  std::string bin = replaced(replaced(kPlyTriangle, "ascii", "binary_little_endian"), "0 0 0\n1 0 0\n0 1 0\n", "");
+  bin += std::string(36, '\0');                   // three vertices at the origin
+  bin += std::string("\x00\xe1\xf5\x05", 4);       // uint 100,000,000, little endian
+  bin += std::string(12, '\0');                   // the three indices actually there
+  write(d / "m.ply", replaced(bin, "property list uchar int", "property list uint int"));
+  const std::string e = input_error([&] { loom::read_mesh_file(d / "m.ply"); });
+  EXPECT_NE(e.find("m.ply:7: element face instance 0: list length 100000000 is more than the 12 bytes left"),
+            std::string::npos)
+      << e;
+}
+
 // A tessellation cache entry whose vertex count was corrupt (2^32: a truncated write, a
 // flipped bit) sized its arrays from it: 96 GB, "loom: error: std::bad_alloc" on every run
 // of every scene with that STEP file until the cache was deleted by hand.
