@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "core/io/atomic_file.hpp"
+#include "core/io/output_set.hpp"
 #include "core/progress.hpp"
 #include "routing/audit.hpp"
 #include "routing/render.hpp"
@@ -88,11 +89,9 @@ void print_summary(const AuditReport& rep, const std::filesystem::path& report_p
 }
 
 int run_audit_command(const AuditFlags& f) {
-  {
-    auto targets = view_output_files(f.out);
-    targets.push_back(std::filesystem::path(f.out) / "report.json");
-    check_output_targets(targets);
-  }
+  auto targets = view_output_files(f.out);
+  targets.push_back(std::filesystem::path(f.out) / "report.json");
+  OutputSet outputs(f.out, targets);  // every target checked before any work; all replaced together
   AuditOptions opt;
   if (f.method == "certified") {
     opt.check.method = ClashMethod::Certified;
@@ -120,9 +119,9 @@ int run_audit_command(const AuditFlags& f) {
   const AuditReport rep = audit_scene_file(f.scene, opt, &scene);
   const std::filesystem::path report_path = std::filesystem::path(f.out) / "report.json";
   const nlohmann::json report = audit_report_json(rep);
-  // The view first: if it is refused (exit 2), no report.json claims the audit ran.
-  write_view_outputs(f.out, scene, scene.harness, report, render);  // view.html, render.png (issue 9)
-  write_audit_report(rep, report_path);
+  write_view_outputs(outputs.staging(), scene, scene.harness, report, render);  // view.html, render.png (issue 9)
+  write_audit_report(rep, outputs.staging() / "report.json");
+  outputs.commit();
   if (f.json)
     std::cout << json_text(report, 2) << "\n";
   else if (!f.quiet)

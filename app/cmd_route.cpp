@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "core/io/atomic_file.hpp"
+#include "core/io/output_set.hpp"
 #include "core/io/scene_load.hpp"
 #include "core/progress.hpp"
 #include "routing/render.hpp"
@@ -63,11 +64,9 @@ void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
 }  // namespace
 
 int run_route(const std::string& scene_path, const RouteCommandOptions& o) {
-  {
-    auto targets = route_output_files(o.out);
-    for (auto& p : view_output_files(o.out)) targets.push_back(std::move(p));
-    check_output_targets(targets);
-  }
+  auto targets = route_output_files(o.out);
+  for (auto& p : view_output_files(o.out)) targets.push_back(std::move(p));
+  OutputSet outputs(o.out, targets);  // every target checked before any work; all replaced together
   RenderOptions render;
   if (!o.render_size.empty()) parse_render_size(o.render_size, "--render-size", render);
   ProgressBar bar(stderr, o.quiet || o.json);
@@ -90,8 +89,9 @@ int run_route(const std::string& scene_path, const RouteCommandOptions& o) {
   for (const auto& n : lr.notes) rep.notes.push_back(n);
   // Tube resolution: a tenth of the smallest cable radius is finer than any viewer needs.
   const double chord = 0.1 * 0.5 * scene.harness.smallest_diameter();
-  write_route_outputs(rep, o.out, chord > 0 ? chord : 0.01);
-  write_view_outputs(o.out, scene, rep.routed, route_report_json(rep), render);  // view.html, render.png (issue 9)
+  write_route_outputs(rep, outputs.staging(), chord > 0 ? chord : 0.01);
+  write_view_outputs(outputs.staging(), scene, rep.routed, route_report_json(rep), render);  // view.html, render.png
+  outputs.commit();
   if (o.json) std::cout << json_text(route_report_json(rep), 2) << "\n";
   else if (!o.quiet) print_summary(rep, o.out);
   return rep.exit_code();

@@ -7,6 +7,7 @@
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
 #include "core/io/atomic_file.hpp"
+#include "core/io/output_set.hpp"
 #include "core/io/harness_xml.hpp"
 #include "core/io/mesh_write.hpp"
 #include "routing/cable_geometry.hpp"
@@ -108,7 +109,7 @@ int run_scan(const ScanCommandOptions& o) {
   const std::filesystem::path out(o.out);
   const std::filesystem::path centerline_file = out / "centerline.xml", tube_file = out / "tube.ply",
                               report_file = out / "report.json";
-  check_output_targets({centerline_file, tube_file, report_file});
+  OutputSet outputs(out, {centerline_file, tube_file, report_file});  // checked now, replaced together
   using nlohmann::json;
   const auto t_start = std::chrono::steady_clock::now();
   const PointCloud pc = read_point_cloud(o.cloud);
@@ -200,12 +201,12 @@ int run_scan(const ScanCommandOptions& o) {
                     {"extract", r.timing.total_ms},
                     {"total", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count()}};
 
-  // Every output's text is made before the first file is written (a failure writes nothing).
   const std::string report_text = json_text(j, 2) + "\n";
   const std::string centerline_text = harness_to_xml(h);
-  write_file_atomic(centerline_file, centerline_text);
-  write_mesh(tube_file, tube.mesh);
-  write_file_atomic(report_file, report_text);
+  write_file_atomic(outputs.staging() / centerline_file.filename(), centerline_text);
+  write_mesh(outputs.staging() / tube_file.filename(), tube.mesh);
+  write_file_atomic(outputs.staging() / report_file.filename(), report_text);
+  outputs.commit();
 
   if (!o.quiet) {
     std::printf("scan %s: %zu points (%s), method %s\n", o.cloud.c_str(), pc.points.size(), to_string(pc.format),

@@ -4,6 +4,7 @@
 #include "app/option_checks.hpp"
 
 #include "core/io/atomic_file.hpp"
+#include "core/io/output_set.hpp"
 #include "core/io/file_stems.hpp"
 #include "core/io/mesh_write.hpp"
 #include "core/io/scene_load.hpp"
@@ -51,19 +52,17 @@ int run_simplify(const SimplifyCommandOptions& o) {
   std::vector<std::string> part_names;
   for (const auto& p : scene.parts) part_names.push_back(p.name);
   const std::vector<std::string> stems = output_file_stems(part_names);
-  {
-    std::vector<std::filesystem::path> targets{out_dir / "simplify.json"};
-    for (const auto& stem : stems) {
-      targets.push_back(out_dir / (stem + ".stl"));
-      if (o.step) targets.push_back(out_dir / (stem + ".step"));
-    }
-    check_output_targets(targets);
+  std::vector<std::filesystem::path> targets{out_dir / "simplify.json"};
+  for (const auto& stem : stems) {
+    targets.push_back(out_dir / (stem + ".stl"));
+    if (o.step) targets.push_back(out_dir / (stem + ".step"));
   }
+  OutputSet outputs(out_dir, targets);  // every target checked before any work; all replaced together
 
   AlphaSimOptions opt;
   opt.dim_pre = dim_pre;
   opt.scene_size = scene.bounds().diagonal();
-  if (o.step) opt.step_dir = out_dir;
+  if (o.step) opt.step_dir = outputs.staging();
   opt.progress = bar.fn();
   const double tolerance = opt.containment_tolerance_factor * opt.scene_size;
   if (!o.quiet)
@@ -81,7 +80,7 @@ int run_simplify(const SimplifyCommandOptions& o) {
   for (std::size_t i = 0; i < simple.size(); ++i) {
     const AlphaSimResult& r = results[i];
     const std::string& stem = stems[i];
-    if (!simple[i].mesh.empty()) write_mesh(out_dir / (stem + ".stl"), simple[i].mesh);
+    if (!simple[i].mesh.empty()) write_mesh(outputs.staging() / (stem + ".stl"), simple[i].mesh);
     json projections = json::array();
     for (const auto& p : r.projections)
       projections.push_back({{"plane", p.plane},
@@ -146,7 +145,8 @@ int run_simplify(const SimplifyCommandOptions& o) {
             {"triangles_before", before},
             {"triangles_after", after},
             {"parts", parts}};
-  write_file_atomic(out_dir / "simplify.json", json_text(j, 2) + "\n");
+  write_file_atomic(outputs.staging() / "simplify.json", json_text(j, 2) + "\n");
+  outputs.commit();
   if (!o.quiet)
     std::fprintf(stderr, "loom simplify: %zu -> %zu triangles (%.1f%%) in %.2f s; wrote %s\n", before, after,
                  before > 0 ? 100.0 * after / before : 0.0,

@@ -502,6 +502,33 @@ TEST(CliOutputs, ATargetThatIsADirectoryStopsTheCommandBeforeAnyOutput) {
   EXPECT_NE(r.out.find("which is not a directory"), std::string::npos) << r.out;
 }
 
+// The outputs of a run replace the last run's together or not at all: they are staged in
+// the output directory and moved into place at the end (core/io/output_set). A run that
+// fails after the stage is made leaves the last run's set as it was and no stage behind.
+TEST(CliOutputs, AFailedRunLeavesTheLastRunsOutputsWhole) {
+  namespace fs = std::filesystem;
+  const auto out = fresh_dir("output_set");
+  const std::string cmd = "audit " + kAuditData + "/clash.toml --quiet --out " + out.string();
+  ASSERT_EQ(loom(cmd).status, 1);
+  auto read = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string report = read(out / "report.json"), view = read(out / "view.html");
+  ASSERT_FALSE(report.empty());
+  const auto r = loom(cmd + " --routes " + (out / "no-such-routes.xml").string());
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_EQ(read(out / "report.json"), report);
+  EXPECT_EQ(read(out / "view.html"), view);
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_NE(e.path().filename().string().rfind(".loom", 0), 0u) << e.path() << " was left behind";
+  // A clean run replaces the set and leaves no stage either.
+  ASSERT_EQ(loom("audit " + kAuditData + "/clean.toml --quiet --out " + out.string()).status, 0);
+  EXPECT_NE(read(out / "report.json"), report);
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_NE(e.path().filename().string().rfind(".loom", 0), 0u) << e.path() << " was left behind";
+}
+
 // `render --report` took a report of the wrong shape silently (`"clashes": 5`: no markers)
 // or failed naming nothing (`"kind": 5`: nlohmann's type_error 302).
 TEST(CliRender, ReportOfTheWrongShapeIsExitTwoNamingTheEntry) {
