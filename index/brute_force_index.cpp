@@ -12,6 +12,9 @@ namespace loom {
 
 namespace {
 
+/// Ulps of the largest coordinate that the double closest-point kernel may be off by.
+constexpr double kRoundingUlps = 16.0;
+
 void check_part(int part, std::size_t n) {
   if (part < 0 || static_cast<std::size_t>(part) >= n)
     throw std::out_of_range("obstacle index: part id " + std::to_string(part) + " out of range [0, " +
@@ -55,7 +58,7 @@ IndexAccuracy BruteForceIndex::accuracy() const {
   for (const auto& p : parts_)
     if (!p.bounds.empty()) extent = std::max(extent, p.bounds.min.cwiseAbs().cwiseMax(p.bounds.max.cwiseAbs()).maxCoeff());
   // Double rounding in the closest-point kernel: a few ulps of the largest coordinate.
-  a.abs_error = 16.0 * std::numeric_limits<double>::epsilon() * extent;
+  a.abs_error = kRoundingUlps * std::numeric_limits<double>::epsilon() * extent;
   a.description = "brute force over every triangle, double precision: <= " + full_precision(a.abs_error) +
                   " scene units";
   return a;
@@ -101,12 +104,23 @@ double BruteForceIndex::part_winding_number(int part, const Vec3& p) const {
   return winding_number(parts_[part], p);
 }
 
+double surface_rounding(const AABB& bounds) {
+  if (bounds.empty()) return 0.0;
+  const double extent = bounds.min.cwiseAbs().cwiseMax(bounds.max.cwiseAbs()).maxCoeff();
+  return kRoundingUlps * std::numeric_limits<double>::epsilon() * extent;
+}
+
 void parts_holding(const std::vector<PartTriangles>& parts, const Vec3& p, bool first_only, std::vector<int>& out) {
   out.clear();
   for (std::size_t i = 0; i < parts.size(); ++i) {
     const PartTriangles& pt = parts[i];
     if (!pt.closed || pt.triangles.empty() || !pt.bounds.contains(p)) continue;
     if (winding_number(pt, p) > 0.5) {
+      const double on = surface_rounding(pt.bounds);
+      const bool on_surface = std::any_of(pt.triangles.begin(), pt.triangles.end(), [&](const auto& c) {
+        return closest_point_on_triangle(p, c[0], c[1], c[2]).dist2 <= on * on;
+      });
+      if (on_surface) continue;
       out.push_back(static_cast<int>(i));
       if (first_only) return;
     }

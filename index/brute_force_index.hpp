@@ -27,7 +27,14 @@ std::vector<PartTriangles> extract_part_triangles(const std::vector<Part>& parts
 /// orientation); sum of signed solid angles / 4π.
 double winding_number(const PartTriangles& part, const Vec3& p);
 
-/// The closed parts holding p (winding number > 1/2), as ascending indices into `parts`, in
+/// Distance (scene units) within which a point counts as on the surface of a part with the
+/// given bounds, not inside it: the double closest-point kernel's rounding at the part's
+/// scale, a few ulps of its largest coordinate (as BruteForceIndex::accuracy).
+double surface_rounding(const AABB& bounds);
+
+/// The closed parts holding p strictly (winding number > 1/2 and p farther from the surface
+/// than surface_rounding: on a face the face's own solid angle is ±2π by the sign of a
+/// rounded zero, so the winding number there is 0 or 1), as ascending indices into `parts`, in
 /// *out (cleared first); with first_only, at most the first of them. O(all triangles of the
 /// parts whose boxes contain p): the oracle's inside test, shared by the exact indices.
 void parts_holding(const std::vector<PartTriangles>& parts, const Vec3& p, bool first_only, std::vector<int>& out);

@@ -53,13 +53,14 @@ std::vector<std::string> attach_ports(const Harness& h, const std::vector<Part>&
   // cable end (assemblies have thousands of parts, harnesses thousands of cable ends).
   const BoxTree part_tree(boxes);
   std::vector<std::uint32_t> near_port;
-  std::map<int, int> containing;  // port -> part containing it (−1: none), when asked
-  auto part_containing = [&](int port) {
+  std::map<int, std::vector<int>> containing;  // port -> the closed parts holding it, when asked
+  auto port_inside = [&](int port, int part) {
     auto it = containing.find(port);
-    if (it != containing.end()) return it->second;
-    int part = -1;
-    if (!index->inside(h.ports[port].position, &part)) part = -1;  // only asked with an index
-    return containing[port] = part;
+    if (it == containing.end()) {
+      it = containing.emplace(port, std::vector<int>{}).first;
+      index->inside_parts(h.ports[port].position, it->second);  // only asked with an index
+    }
+    return std::find(it->second.begin(), it->second.end(), part) != it->second.end();
   };
   std::set<std::pair<std::string, std::string>> said;
   std::vector<std::string> notes;
@@ -85,17 +86,22 @@ std::vector<std::string> attach_ports(const Harness& h, const std::vector<Part>&
         if (parts[q].role == PartRole::KeepOut) continue;  // never excused
         const double reach = in.radius + routing_clearance + parts[q].clearance;
         if (!boxes[q].inflated(reach).contains(at)) continue;
-        bool on = false;
+        // The port's depth inside the part (0 outside or on it; `reach` for deeper): the
+        // checker excuses the centerline inside the part only where the part holds the port.
+        bool inside = false;
+        ClosestHit nearest;
         if (index) {
-          on = part_containing(p) == static_cast<int>(q) ||
-               index->closest_on_part(at, static_cast<int>(q), reach).found();
+          inside = port_inside(p, static_cast<int>(q));
+          nearest = index->closest_on_part(at, static_cast<int>(q), reach);
         } else {  // the brute-force baseline has no index: measure this one part directly
           const BruteForceIndex one({parts[q]});
-          on = one.inside(at) || one.closest(at, reach).found();
+          inside = one.inside(at);
+          nearest = one.closest(at, reach);
         }
-        if (!on) continue;
+        if (!inside && !nearest.found()) continue;
+        const double depth = inside ? (nearest.found() ? nearest.distance : reach) : 0.0;
         in.attachments.push_back({static_cast<int>(q), end == 0 ? 0.0 : len - exit, end == 0 ? exit : len,
-                                  h.ports[p].id});
+                                  h.ports[p].id, depth});
         if (said.insert({h.ports[p].id, parts[q].name}).second)
           notes.push_back("port " + h.ports[p].id + " sits on part '" + parts[q].name +
                           "': cables are not checked against it over their straight exit from the port");

@@ -65,18 +65,20 @@ struct AuditReport {
 /// `cables` receives one AuditCable per harness cable.
 std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCable>& cables);
 
-/// Audits a loaded scene (its parts and harness). Builds the index unless the request is
-/// the brute-force baseline (use_index = false, discrete). Throws InputError for an
-/// inconsistent harness.
 /// Fills each cable's PartAttachment list: a part (not keep-out) whose surface is within the
 /// cable radius + required clearance of one of its ports, or that contains the port, is the
 /// connector or box the port sits on, and is excused over the port's straight exit
-/// (derived_stub_length: max(min bend radius, 2r), at most half the cable). Returns one note
-/// per (port, part) pair for the report. Distances through `index` (the audit's, indexing
-/// `parts`); null: measured on each candidate part directly.
+/// (derived_stub_length: max(min bend radius, 2r), at most half the cable) — except, for a
+/// port not inside the part, where the centerline enters it or (past the audit tolerance
+/// from the port) touches it. Returns one note per (port, part) pair for the report.
+/// Distances through `index` (the audit's, indexing `parts`); null: measured on each
+/// candidate part directly.
 std::vector<std::string> attach_ports(const Harness& h, const std::vector<Part>& parts, double routing_clearance,
                                       std::vector<CableInput>& inputs, const ObstacleIndex* index = nullptr);
 
+/// Audits a loaded scene (its parts and harness). Builds the index unless the request is
+/// the brute-force baseline (use_index = false, discrete). Throws InputError for an
+/// inconsistent harness.
 AuditReport run_audit(const Scene& scene, const AuditOptions& opt);
 
 /// Loads the scene file (timed as timing_ms.load), applies --routes, and audits it.

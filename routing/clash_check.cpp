@@ -208,7 +208,7 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
       sum.length = cables[c].curve.length();
       sum.min_clearance = kInf;
       if (request.check_structure && !parts.empty()) {
-        StretchTracker tr(static_cast<int>(c), cables[c].radius, ctx.info, cables[c].attachments);
+        StretchTracker tr(static_cast<int>(c), cables[c].radius, ctx.info, cables[c].attachments, {}, ctx.tol);
         discrete_structure(ctx, static_cast<int>(c), ds[c], tr);
         per_clash[c] = std::move(tr.clashes);
         per_viol[c] = std::move(tr.violations);

@@ -61,13 +61,21 @@ struct CableJunction {
 
 /// A part a cable end is attached to: the connector (or the box it is mounted on) that its
 /// port sits on. Contacts and clearance shortfalls with that part over the port's straight
-/// exit are the connector's own, not findings.
+/// exit are the connector's own, not findings. The centerline inside the part is excused
+/// only where the port itself lies inside it, deeper than the audit tolerance (a connector
+/// modelled solid, which the exit leaves; holds_port): a port on a face whose exit runs
+/// into the part goes through it, a clash.
 struct PartAttachment {
   int part = -1;         ///< index into the checked parts
   double s_begin = 0.0;  ///< arc-length range of the cable over which the part is excused
   double s_end = 0.0;
   std::string port;      ///< the port id, for the report
+  double port_depth = 0.0;  ///< how deep the port lies inside the (closed) part; 0 outside or on it
 };
+
+/// True if the attachment's part holds its port: deeper inside it than `tolerance` (scene
+/// units), so that a port on a face, up to rounding and the tolerance, is on the face.
+inline bool holds_port(const PartAttachment& a, double tolerance) { return a.port_depth > tolerance; }
 
 /// One cable as the checker sees it.
 struct CableInput {

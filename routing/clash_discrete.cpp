@@ -4,6 +4,7 @@
 #include "routing/pair_contacts.hpp"
 
 #include "core/error.hpp"
+#include "index/brute_force_index.hpp"
 #include "index/triangle_distance.hpp"
 
 #include <algorithm>
@@ -18,7 +19,8 @@ namespace loom::audit {
 namespace {
 
 /// Nearest part to p by brute force over every triangle, and every closed part holding p
-/// (winding number > 1/2).
+/// strictly (winding number > 1/2, and off its surface by more than its rounding, as
+/// parts_holding decides).
 struct BruteHit {
   int part = -1;
   double dist = kInf;
@@ -37,8 +39,9 @@ BruteHit brute_point(const Context& ctx, const Vec3& p) {
       d2 = std::min(d2, closest_point_on_triangle(p, c[0], c[1], c[2]).dist2);
       if (closed) wind += triangle_solid_angle(p, c[0], c[1], c[2]);
     }
-    if (closed && std::abs(wind) > 2.0 * M_PI) best.inside.push_back(static_cast<int>(q));  // winding number > 1/2
     const double d = std::sqrt(d2);
+    if (closed && std::abs(wind) > 2.0 * M_PI && d > surface_rounding(ctx.info[q].box))  // winding number > 1/2
+      best.inside.push_back(static_cast<int>(q));
     if (d < best.dist) {
       best.dist = d;
       best.part = static_cast<int>(q);

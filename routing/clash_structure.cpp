@@ -353,7 +353,7 @@ class StructureTracer {
           o.inside = true;
           obs.push_back(o);
         }
-        excuse_attached(obs, f.a.s, f.s_end);
+        excuse_attached(obs, f.a.s, f.s_end, 0.0);
         tracker_.step(obs, f.a.s, f.s_end);
       }
     } else if (!free_.empty()) {
@@ -367,10 +367,12 @@ class StructureTracer {
     flush_free();
     Chords ch;
     const Centerline& c = in_.curve;
-    // Chords end where an attachment's range does: each lies within it or outside it.
+    // Chords end where an attachment's range does, and where its lift off a port on a face
+    // does (exit_lifted): each lies within the range or outside it, and within the lift or
+    // past it.
     std::vector<double> cuts{s0};
     for (const PartAttachment& at : in_.attachments)
-      for (const double x : {at.s_begin, at.s_end})
+      for (const double x : {at.s_begin, at.s_end, lift_end(at)})
         if (x > s0 && x < s1) cuts.push_back(x);
     std::sort(cuts.begin(), cuts.end());
     cuts.push_back(s1);
@@ -439,7 +441,7 @@ class StructureTracer {
           secondary(a, b, ch.s[k], ch.s[k + 1], q, obs);
         }
       }
-      excuse_attached(obs, ch.s[k], ch.s[k + 1]);
+      excuse_attached(obs, ch.s[k], ch.s[k + 1], touch);
       tracker_.step(obs, ch.s[k], ch.s[k + 1]);
     }
   }
@@ -463,17 +465,40 @@ class StructureTracer {
   /// chord past a port's exit is often the exit's end itself, which the attachment holds,
   /// while the rest of the chord is not excused and may fall short of the clearance (a
   /// violation of 2.0 for 3.0 required, 3 r from a connector, went unreported).
-  void excuse_attached(std::vector<PartObservation>& obs, double sa, double sb) const {
+  /// The centerline inside the part, or with its axis within `touch` of it past the lift
+  /// (exit_lifted), is excused only where the port lies inside the part: a port on a face
+  /// whose exit runs into the part, or through a plate, goes through it (a clash).
+  void excuse_attached(std::vector<PartObservation>& obs, double sa, double sb, double touch) const {
     const double slack = kTouchRel * (1.0 + L_);
+    auto excused = [&](const PartObservation& o, const PartAttachment& at) {
+      if (at.part != o.part || sa < at.s_begin - slack || sb > at.s_end + slack) return false;
+      if (holds_port(at, ctx_.tol)) return true;
+      if (o.inside) return false;
+      return !(o.key + r_ <= touch && exit_lifted(at, sa, sb));
+    };
     obs.erase(std::remove_if(obs.begin(), obs.end(),
                              [&](const PartObservation& o) {
                                return std::any_of(in_.attachments.begin(), in_.attachments.end(),
-                                                  [&](const PartAttachment& at) {
-                                                    return at.part == o.part && sa >= at.s_begin - slack &&
-                                                           sb <= at.s_end + slack;
-                                                  });
+                                                  [&](const PartAttachment& at) { return excused(o, at); });
                              }),
               obs.end());
+  }
+
+  /// Arc length of the attachment's port: the cable's start or its end.
+  static double port_s(const PartAttachment& at) { return at.s_begin <= 0.0 ? at.s_begin : at.s_end; }
+
+  /// Where the lift off a port on a face ends: the first tolerance of the exit, over which
+  /// the axis may touch the part it leaves (the port is on its surface, up to rounding and
+  /// the tolerance). NaN for a part holding its port (no lift: the exit leaves the part).
+  double lift_end(const PartAttachment& at) const {
+    if (holds_port(at, ctx_.tol)) return std::numeric_limits<double>::quiet_NaN();
+    return at.s_begin <= 0.0 ? at.s_begin + ctx_.tol : at.s_end - ctx_.tol;
+  }
+
+  /// True if the step [sa, sb] lies past the lift off the attachment's port.
+  bool exit_lifted(const PartAttachment& at, double sa, double sb) const {
+    const double slack = kTouchRel * (1.0 + L_);
+    return port_s(at) == at.s_begin ? sa >= lift_end(at) - slack : sb <= lift_end(at) + slack;
   }
 
   bool is_inside(int part) const {

@@ -6,9 +6,10 @@
 
 namespace loom::audit {
 
-bool is_attached(const std::vector<PartAttachment>& attachments, int part, double s) {
-  return std::any_of(attachments.begin(), attachments.end(),
-                     [&](const PartAttachment& a) { return a.part == part && s >= a.s_begin && s <= a.s_end; });
+bool is_attached(const std::vector<PartAttachment>& attachments, int part, double s, bool inside, double tolerance) {
+  return std::any_of(attachments.begin(), attachments.end(), [&](const PartAttachment& a) {
+    return a.part == part && s >= a.s_begin && s <= a.s_end && (!inside || holds_port(a, tolerance));
+  });
 }
 
 void StretchTracker::step(const std::vector<PartObservation>& all, double s0, double s1) {
@@ -16,7 +17,7 @@ void StretchTracker::step(const std::vector<PartObservation>& all, double s0, do
   if (!attachments_.empty()) {
     kept_.clear();  // reused: steps are the checker's inner loop
     for (const auto& o : all)
-      if (!is_attached(attachments_, o.part, o.s)) kept_.push_back(o);
+      if (!is_attached(attachments_, o.part, o.s, o.inside, tolerance_)) kept_.push_back(o);
     seen_obs = &kept_;
   }
   const std::vector<PartObservation>& obs = *seen_obs;

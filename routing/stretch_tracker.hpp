@@ -47,8 +47,11 @@ struct PartObservation {
 /// Replaces a deferred observation's bounds by the exact key, point and arc length.
 using ObservationResolver = std::function<void(PartObservation&)>;
 
-/// True if the cable is attached to `part` at arc length s (see PartAttachment).
-bool is_attached(const std::vector<PartAttachment>& attachments, int part, double s);
+/// True if the cable is attached to `part` at arc length s (see PartAttachment); for an
+/// observation of the centerline inside the part (`inside`), only where the part holds the
+/// port (holds_port at `tolerance`).
+bool is_attached(const std::vector<PartAttachment>& attachments, int part, double s, bool inside = false,
+                 double tolerance = 0.0);
 
 /// Collects observations in s order. A part's band stretch (clearance < required) ends
 /// when a step no longer sees it; inside it, each contiguous contact stretch (clearance < 0)
@@ -59,10 +62,17 @@ bool is_attached(const std::vector<PartAttachment>& attachments, int part, doubl
 /// reaches the stretch's smallest upper bound — only then can it be the deepest.
 class StretchTracker {
  public:
-  /// `resolve` measures deferred observations (may be empty if none are ever stepped).
+  /// `resolve` measures deferred observations (may be empty if none are ever stepped);
+  /// `tolerance` is the audit's (scene units), for holds_port.
   StretchTracker(int cable, double radius, const std::vector<PartInfo>& parts,
-                 const std::vector<PartAttachment>& attachments, ObservationResolver resolve = {})
-      : cable_(cable), radius_(radius), parts_(parts), attachments_(attachments), resolve_(std::move(resolve)) {}
+                 const std::vector<PartAttachment>& attachments, ObservationResolver resolve = {},
+                 double tolerance = 0.0)
+      : cable_(cable),
+        radius_(radius),
+        tolerance_(tolerance),
+        parts_(parts),
+        attachments_(attachments),
+        resolve_(std::move(resolve)) {}
 
   /// One step along the cable (a chord, a sample or a free interval) seeing `obs` (parts
   /// within their band), spanning arc lengths [s0, s1]. Observations of a part the cable
@@ -110,6 +120,7 @@ class StretchTracker {
   void close(Open& st);
   int cable_;
   double radius_;
+  double tolerance_;
   const std::vector<PartInfo>& parts_;
   const std::vector<PartAttachment>& attachments_;
   ObservationResolver resolve_;

@@ -539,3 +539,20 @@ TEST(Regression, ClearanceJustPastAPortExitWasExcusedWithTheExit) {
   ASSERT_EQ(res.violations.size(), 1u) << in;
   EXPECT_NEAR(res.violations[0].value, s_end - 1.0, 0.01) << in << " value " << regression_g17(res.violations[0].value);
 }
+
+// A port on the face of a 1 mm plate whose exit pointed into the plate: the cable went
+// through the plate it is mounted on, and the audit said clean (exit 0), because the
+// attachment excused every contact with the plate over the exit. The centerline inside
+// the part, or touching it past the first tolerance of the exit, is excused only where the
+// part holds the port (deeper than the tolerance: a connector modelled solid).
+TEST(Regression, AnExitThroughThePlateItsPortSitsOnWasExcused) {
+  const std::vector<loom::Part> parts{loom::testmesh::box_part("plate", Vec3(-21, -30, -30), Vec3(-20, 30, 30))};
+  loom::CableInput c = regression_cable("C1", {Vec3(-21, 5, 5), Vec3(90, 5, 5)}, 1.0);
+  c.attachments = {{0, 0.0, 10.0, "J1", 0.0}};  // what attach_ports gives: on the face, exit 10
+  const loom::ClashResult res = regression_audit({c}, parts, 0.01);
+  const std::string in = "cable (-21,5,5)-(90,5,5) r 1 from a port on the -x face of plate x in [-21,-20], exit 10";
+  ASSERT_EQ(res.clashes.size(), 1u) << in;
+  EXPECT_NEAR(res.clashes[0].clearance, -1.0, 0.01) << in << " clearance " << regression_g17(res.clashes[0].clearance);
+  EXPECT_GT(res.clashes[0].s, 0.0) << in;
+  EXPECT_LT(res.clashes[0].s, 1.0 + 0.01) << in;
+}

@@ -401,6 +401,55 @@ TEST_P(ClashKnown, AttachedConnectorIsExcusedOverThePortExitOnly) {
   }
 }
 
+// The attachment excuses the connector's contacts over a port's exit, not a centerline that
+// goes into the part the port sits on: a port on the face of a 1 mm plate whose exit points
+// into it crosses the plate (clearance −r there), and one on the face of a box whose exit
+// points into the box runs inside it. A port inside a connector modelled solid leaves it
+// along its exit: excused, as before.
+TEST_P(ClashKnown, AnExitIntoThePartItsPortSitsOnIsAClash) {
+  const double clearance = 3.0;
+  struct Case {
+    const char* what;
+    Part part;
+    Vec3 port;
+    bool clash;
+    bool discrete_sees_it;  // the discrete method's samples (2r apart) may step over a thin plate
+  };
+  const std::vector<Case> cases{
+      {"through a 1 mm plate", box_part("plate", {-21, -30, -30}, {-20, 30, 30}), Vec3(-21, 5, 5), true, false},
+      {"into a box", box_part("box", {-21, -30, -30}, {-1, 30, 30}), Vec3(-21, 5, 5), true, true},
+      {"out of a connector holding the port", box_part("connector", {-30, 0, 0}, {-19, 10, 10}), Vec3(-21, 5, 5),
+       false, false},
+      {"out of the face it sits on", box_part("wall", {-31, -30, -30}, {-21, 30, 30}), Vec3(-21, 5, 5), false,
+       false}};
+  for (const Case& c : cases) {
+    const std::vector<Part> parts{c.part};
+    Harness h;
+    h.ports = {{"J1", c.port, Vec3::UnitX(), 0}, {"J2", Vec3(90, 5, 5), -Vec3::UnitX(), 0}};
+    Cable cab;
+    cab.id = "C1";
+    cab.ports[0] = "J1";
+    cab.ports[1] = "J2";
+    cab.physical.diameter = 2 * kR;
+    cab.physical.min_bend_radius = 10.0;
+    h.cables.push_back(cab);
+    std::vector<CableInput> cables{straight_cable("C1", c.port, {90, 5, 5}, kR)};
+    cables[0].min_bend_radius = 10.0;
+    const auto idx = make_index(GetParam(), parts);
+    attach_ports(h, parts, clearance, cables, idx.get());
+    ASSERT_EQ(cables[0].attachments.size(), 1u) << c.what;
+    for (ClashMethod m : {ClashMethod::Certified, ClashMethod::Discrete}) {
+      const auto r = run(cables, parts, m, kTol, GetParam(), clearance);
+      const bool expect = c.clash && (m == ClashMethod::Certified || c.discrete_sees_it);
+      EXPECT_EQ(has_structure_clash(r, 0, 0), expect) << c.what << ", " << clash_method_name(m);
+      if (expect && m == ClashMethod::Certified) {
+        ASSERT_FALSE(r.clashes.empty());
+        EXPECT_NEAR(r.clashes[0].clearance, -kR, kTol) << c.what;  // the axis is in the part: dist 0
+      }
+    }
+  }
+}
+
 TEST_P(ClashKnown, TwoContactsInOneClearanceStretchAreTwoClashes) {
   // Dips into the box top twice (−0.1) and stays within the 2.0 clearance band between.
   const std::vector<Part> parts{box_part("box", {0, 0, 0}, {10, 10, 10})};
