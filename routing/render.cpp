@@ -5,6 +5,7 @@
 #include "core/io/atomic_file.hpp"
 #include "index/embree_index.hpp"
 #include "routing/cable_geometry.hpp"
+#include "routing/report_json.hpp"
 #include "routing/sweep.hpp"
 
 #include <png.h>
@@ -14,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <set>
 #include <string>
 
 namespace loom {
@@ -197,7 +199,9 @@ Image render_scene(const Scene& scene, const Harness& harness, const nlohmann::j
   const HarnessTopology topo(harness);
   SegmentCurves curves(topo);
   TubeBudget budget("render", opt.max_tube_triangles);
+  const std::set<std::string> unrouted = unrouted_cable_ids(report);  // no route, nothing to draw
   for (std::size_t c = 0; c < harness.cables.size(); ++c) {
+    if (unrouted.count(harness.cables[c].id)) continue;
     const auto cl = curves.cable(static_cast<int>(c));
     const double r = harness.cables[c].radius();
     if (!cl || !(r > 0.0)) continue;

@@ -115,6 +115,15 @@ json audit_report_json(const AuditReport& rep) {
   return j;
 }
 
+std::set<std::string> unrouted_cable_ids(const nlohmann::json& report) {
+  std::set<std::string> ids;
+  if (!report.is_object() || !report.contains("cables") || !report["cables"].is_array()) return ids;
+  for (const auto& c : report["cables"])
+    if (c.is_object() && c.contains("id") && c["id"].is_string() && c.contains("routed") && c["routed"] == false)
+      ids.insert(c["id"].get<std::string>());
+  return ids;
+}
+
 std::string json_text(const nlohmann::json& j, int indent) {
   return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
 }

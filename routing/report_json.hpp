@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <set>
+#include <string>
 
 namespace loom {
 
@@ -19,6 +21,10 @@ std::string json_text(const nlohmann::json& j, int indent = -1);
 
 /// The report as JSON (numbers in scene units, times in milliseconds).
 nlohmann::json audit_report_json(const AuditReport& report);
+
+/// Ids of the cables a report (audit or route) marks `"routed": false` — no curve to draw:
+/// a route that failed keeps only its nodes, and a straight line between them is no route.
+std::set<std::string> unrouted_cable_ids(const nlohmann::json& report);
 
 /// Writes audit_report_json(report) to `path` atomically (pretty-printed).
 void write_audit_report(const AuditReport& report, const std::filesystem::path& path);

@@ -3,6 +3,7 @@
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
 #include "index/alpha_sim.hpp"
+#include "index/box_tree.hpp"
 #include "index/embree_index.hpp"
 #include "routing/bend_repair.hpp"
 #include "routing/branch_layout.hpp"
@@ -30,6 +31,14 @@ constexpr double kStubShare = 0.5;
 /// Re-plans of a segment whose bend repair failed: each with a fresh seed and twice the
 /// previous budget; the first whose curve meets the bend radius is kept.
 constexpr int kBendReplans = 2;
+
+/// Slack of the port-exit checks, as a share of the tube radius (the audit's default
+/// tolerance, r/100): the exit is checked not to enter the part its port sits on from this far
+/// off the port; an exit on a part runs at least `required` plus twice this, so that the
+/// planner starts clear of it; a keep-out zone near a port is measured from `required` plus
+/// this. A port on a face leaving along the normal is exactly `required` from the face at
+/// `required`: rounding must not make that face a wall.
+constexpr double kAttachSlackPerRadius = 0.01;
 
 /// A segment's key-point polyline and the curve through it.
 struct SegmentGeometry {
@@ -94,6 +103,72 @@ double free_stub(const ObstacleIndex& index, const Vec3& p, const Vec3& dir, dou
   return 0.0;
 }
 
+/// A part whose surface comes within the tube's required distance of a port, and how far
+/// along the port's straight exit the cable may run closer to it than that.
+struct NearPart {
+  int part = -1;
+  double excused = 0.0;  ///< scene units along the exit from the port
+};
+
+/// The parts near a port. One the port sits on (its connector: any part but a keep-out zone,
+/// DESIGN / README "Attached parts") is excused over `excused_on` — the audit does not check
+/// the cable against it over the port's straight exit; a keep-out zone never is, but its
+/// first `excused_near` cannot be helped (the audit reports it).
+std::vector<NearPart> near_port_parts(const ObstacleIndex& index, const std::vector<AABB>& part_boxes,
+                                      const std::vector<Part>& parts, const Vec3& port, double required,
+                                      double excused_on, double excused_near) {
+  std::vector<NearPart> near;
+  for (std::size_t q = 0; q < parts.size(); ++q)
+    if (part_boxes[q].inflated(required).contains(port) &&
+        index.closest_on_part(port, static_cast<int>(q), required).found())
+      near.push_back({static_cast<int>(q), parts[q].role == PartRole::KeepOut ? excused_near : excused_on});
+  return near;
+}
+
+/// The nearest part that the straight exit port → stub_end comes within `required` of
+/// (found() == false if none). A part near the port is measured only past its excused run,
+/// and over that run (from `lift` off the port, where the port's own surface is left behind)
+/// it must not be entered; every other part is measured over the whole exit. An exit lifted
+/// off the port inside a part meets it at distance 0 there.
+ClosestHit exit_obstacle(const ObstacleIndex& index, const std::vector<AABB>& part_boxes, const Vec3& port,
+                         const Vec3& stub_end, const std::vector<NearPart>& near, double lift, double required) {
+  ClosestHit best;
+  const double len = (stub_end - port).norm();
+  if (!(len > 0.0)) return best;
+  const Vec3 dir = (stub_end - port) / len;
+  // Lifted off the port, the exit must be outside every part (a segment that starts inside
+  // a part need not touch its surface).
+  const Vec3 lifted = port + std::min(lift, len) * dir;
+  int inside_part = -1;
+  if (index.inside(lifted, &inside_part)) {
+    best.distance = 0.0;
+    best.point = lifted;
+    best.part = inside_part;
+    return best;
+  }
+  AABB exit_box;
+  exit_box.extend(port);
+  exit_box.extend(stub_end);
+  auto measure = [&](int q, double from, double to, double need) {
+    if (!(to > from)) return;
+    const ClosestHit hit = index.segment_closest_on_part(port + from * dir, port + to * dir, q, need);
+    if (hit.found() && hit.distance <= best.distance) best = hit;
+  };
+  for (std::size_t q = 0; q < part_boxes.size(); ++q) {
+    if (!boxes_overlap(exit_box.inflated(required), part_boxes[q])) continue;
+    const int id = static_cast<int>(q);
+    const auto it = std::find_if(near.begin(), near.end(), [id](const NearPart& n) { return n.part == id; });
+    if (it == near.end()) {
+      measure(id, 0.0, len, required);
+    } else {
+      const double excused = std::min(it->excused, len);
+      measure(id, std::min(lift, len), excused, 0.0);  // not into it
+      measure(id, excused, len, required);
+    }
+  }
+  return best;
+}
+
 BSplineData to_bspline(const Centerline& c) {
   return BSplineData{c.degree(), c.knots(), c.control_points()};
 }
@@ -141,6 +216,11 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
   ProgressCounter indexed(opt.progress, "index", 1, "indices");
   const EmbreeIndex plan_index(planning_parts);
   indexed.finish();
+  std::vector<AABB> part_boxes;
+  for (std::size_t q = 0; q < planning_parts.size(); ++q) {
+    const auto kept = plan_index.part_bounds(static_cast<int>(q));
+    part_boxes.push_back(kept ? *kept : planning_parts[q].mesh.bounds());
+  }
   rep.timing.index = ms_since(t0);
 
   // 2. Branch points the file leaves open, placed where the legs are short and can turn
@@ -199,13 +279,31 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
     // breakout length (shortened if something is in the way). The planner starts at the
     // stub ends.
     const EndFrame ea = end_frame(s, true), eb = end_frame(s, false);
-    auto stub_for = [&](const EndFrame& e) {
-      return e.is_port ? ends[s].port_stub : free_stub(plan_index, e.position, e.exit, breakout[e.node], required);
+    // The parts each port end sits on, and how far along its exit they are excused: the
+    // audit's straight exit (the shortest of the cables here: derived_stub_length of each),
+    // and at least `required` and the slack (a port on a face leaving along its normal is
+    // exactly `required` from the face there).
+    const double attach_slack = kAttachSlackPerRadius * radius;
+    double excused = std::numeric_limits<double>::infinity();
+    for (int c : topo.segment_cables(s))
+      excused = std::min(excused, derived_stub_length(h.cables[c].radius(), h.cables[c].physical.min_bend_radius));
+    excused = std::max(std::isfinite(excused) ? excused : 0.0, required + attach_slack);
+    auto near_parts = [&](const EndFrame& e) {
+      return e.is_port ? near_port_parts(plan_index, part_boxes, planning_parts, e.position, required, excused,
+                                         required + attach_slack)
+                       : std::vector<NearPart>{};
+    };
+    const std::vector<NearPart> on_a = near_parts(ea), on_b = near_parts(eb);
+    // A port on its connector leaves it straight until clear of it: at least `required` and
+    // the slack twice, so that the planner starts clear of it.
+    auto stub_for = [&](const EndFrame& e, const std::vector<NearPart>& on) {
+      if (!e.is_port) return free_stub(plan_index, e.position, e.exit, breakout[e.node], required);
+      return on.empty() ? ends[s].port_stub : std::max(ends[s].port_stub, required + 2.0 * attach_slack);
     };
     // Stubs heading towards each other may together cover at most kStubShare of the way
     // between the ends; longer ones would cross and force the route into a hairpin. A stub
     // leaving sideways takes nothing from the way and is kept whole.
-    double la = stub_for(ea), lb = stub_for(eb);
+    double la = stub_for(ea, on_a), lb = stub_for(eb, on_b);
     const double span = (b - a).norm();
     if (span > 0.0) {
       const Vec3 u = (b - a) / span;
@@ -262,27 +360,30 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
         continue;
       }
       const Vec3 stub_end = e == &ea ? a_stub : b_stub;
-      // The connector the port sits on may touch the first `required` of the stub.
+      // The connector the port sits on may touch its exit over the excused run; every other
+      // part is kept `required` away from all of it, and the planner starts at its end.
       const double len = (stub_end - e->position).norm();
-      const Vec3 from = plan_index.any_within(e->position, required) ? Vec3(e->position + std::min(required, len) * e->exit)
-                                                                     : e->position;
-      if (plan_index.segment_within(from, stub_end, required)) {
-        double t = 0.0;
-        const ClosestHit hit = plan_index.segment_closest(from, stub_end, required, &t);
+      const std::vector<NearPart>& on = e == &ea ? on_a : on_b;
+      ClosestHit hit;
+      if (plan_index.segment_within(e->position, stub_end, required))
+        hit = exit_obstacle(plan_index, part_boxes, e->position, stub_end, on, attach_slack, required);
+      const ClosestHit at_end = hit.found() ? ClosestHit{} : plan_index.closest(stub_end, required);
+      if (hit.found() || at_end.found()) {
+        const ClosestHit& w = hit.found() ? hit : at_end;
         blocked.reason = e == &ea ? NoPathReason::StartPortBlocked : NoPathReason::GoalPortBlocked;
-        blocked.blocked_at = hit.found() ? hit.point : stub_end;
-        blocked.blocking_part = hit.part;
+        blocked.blocked_at = w.point;
+        blocked.blocking_part = w.part;
         blocked.message = "port " + e->node + " faces a wall: its straight exit of length " + full_precision(len) +
-                          " comes within " + full_precision(hit.distance) + " of part '" +
-                          (hit.part >= 0 ? planning_parts[hit.part].name : std::string("?")) + "' (needs " +
-                          full_precision(required) + ")";
+                          (hit.found() ? " comes" : " ends") + " within " + full_precision(w.distance) +
+                          " of part '" + (w.part >= 0 ? planning_parts[w.part].name : std::string("?")) +
+                          "' (needs " + full_precision(required) + ")";
       }
     }
     t0 = Clock::now();
     PlanResult plan;
     if (!blocked.message.empty()) {
       plan = blocked;
-    } else if ((b_stub - a_stub).norm() < 1e-9) {
+    } else if ((b_stub - a_stub).norm() <= eps) {  // nothing to plan (and plan_path refuses equal ends)
       plan.status = PlanStatus::Solved;
       plan.key_points = {a_stub, b_stub};
     } else {
@@ -397,6 +498,8 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
   };
   auto bend_failed = [&](int s) { return info_of(s).bend_status.rfind("failed", 0) == 0; };
   for (auto& [s, g] : geom) {
+    // Stub ends that coincide leave nothing to re-plan (and plan_path refuses equal ends).
+    if ((g.b_stub - g.a_stub).norm() <= eps) continue;
     for (int attempt = 1; attempt <= kBendReplans && bend_failed(s); ++attempt) {
       PlanRequest req = g.request;
       req.seed = g.request.seed + 7919u * static_cast<unsigned>(attempt);

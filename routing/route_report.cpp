@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <map>
+#include <set>
 
 namespace loom {
 
@@ -117,7 +118,10 @@ void write_route_outputs(const RouteReport& rep, const std::filesystem::path& di
   so.chord_tolerance = chord_tolerance;
   SegmentCurves curves(topo);
   TubeBudget budget("cables.ply");
+  std::set<std::string> unrouted;  // blocked cables are reported, never drawn
+  for (const auto& u : rep.unrouted) unrouted.insert(u.cable);
   for (std::size_t c = 0; c < rep.routed.cables.size(); ++c) {
+    if (unrouted.count(rep.routed.cables[c].id)) continue;
     auto curve = curves.cable(static_cast<int>(c));
     if (!curve) continue;
     const SweepResult tube = budget.sweep(*curve, rep.routed.cables[c].radius(), so, rep.routed.cables[c].id);

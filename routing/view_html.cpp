@@ -12,6 +12,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
+#include <set>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
@@ -216,10 +218,11 @@ std::string view_data_json(const Scene& scene, const Harness& harness, const nlo
   s += "],\"cables\":[";
   const HarnessTopology topo(harness);
   SegmentCurves curves(topo);
+  const std::set<std::string> unrouted = unrouted_cable_ids(report);  // listed, never drawn
   for (std::size_t c = 0; c < harness.cables.size(); ++c) {
     const Cable& cab = harness.cables[c];
     std::vector<Vec3> pts;
-    if (auto cl = curves.cable(static_cast<int>(c))) {
+    if (auto cl = unrouted.count(cab.id) ? std::nullopt : curves.cable(static_cast<int>(c))) {
       const double len = cl->length();
       const double spacing = len / static_cast<double>(std::max<std::size_t>(2, opt.max_cable_samples));
       if (spacing > 0.0)
