@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <stdexcept>
@@ -52,6 +53,23 @@ constexpr std::size_t kFitSubsample = 384;
 constexpr int kPolishIterations = 2;
 /// A segment of the ordering curve longer than this (× d) bridges a gap in the scan.
 constexpr double kBridgeLength = 2.5;
+/// A bridge over a gap must carry on from the runs either side: its direction may turn from
+/// theirs (measured over kBridgeTangentLength × d) by at most this (radians). The chord of
+/// a gap of length g in a cable bent to radius R turns by g / 2R from the ends' tangents;
+/// 80° is a gap of 0.9 R·π, beyond which a gap cannot be told from two cables lying side by
+/// side, whose bridge joins their ends across (≥ 90°).
+constexpr double kPiScan = 3.14159265358979323846;
+constexpr double kMaxBridgeTurn = 80.0 * kPiScan / 180.0;
+constexpr double kBridgeTangentLength = 2.0;
+/// A given diameter may differ from the one the cloud's cross-sections fit by this fraction
+/// of it (nominal against measured sheath); beyond, the given one is refused.
+constexpr double kGivenDiameterTolerance = 0.25;
+/// Around its axis a block's inliers must fill kMinArcSectors of kArcSectors equal sectors
+/// (120°: a scanner sees about half of a cable, a line or a plane one or two sectors), each
+/// with at least kSectorShare of them.
+constexpr std::size_t kArcSectors = 12;
+constexpr int kMinArcSectors = 4;
+constexpr double kSectorShare = 0.02;
 /// Fraction of a block's inliers ignored at each end when locating the cable's ends.
 constexpr double kEndQuantile = 0.02;
 /// Points may project this far (× d) beyond the ends of the ordering curve.
@@ -60,6 +78,11 @@ constexpr double kEndOvershoot = 1.0;
 constexpr double kConverged = 1e-5;
 /// Neighbourhood radius of the coarse diameter estimate (× d), and its slab half-width (× ρ).
 constexpr double kEstimateScale = 2.5, kEstimateSlab = 0.25;
+/// Neighbours searched for the nearest one at a non-zero distance (repeated points).
+constexpr std::size_t kSpacingNeighbours = 16;
+/// Scale steps of the diameter estimate: enough to double from 10⁻⁶ of the cloud's size to
+/// all of it (20) and then settle.
+constexpr int kEstimateIterations = 24;
 
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) {
@@ -125,6 +148,9 @@ struct FitOut {
   double t_min = 0.0, t_max = 0.0;  ///< robust extent of the inliers along the axis (quantiles)
   std::size_t inliers = 0;
   bool ok = false;
+  /// The inliers cover fewer than kMinArcSectors of the kArcSectors sectors around the axis:
+  /// the cross-section is not determined (points on a line or a surface fit any tube).
+  bool thin = false;
   Vec3 at(double t) const { return c + t * a + 0.5 * t * t * b; }
 };
 
@@ -187,13 +213,19 @@ class BlockFitter {
         g(2) += pw * d.dot(e1);
         g(3) += pw * d.dot(e2);
       }
-      auto Hs = H.topLeftCorner(np, np).eval();
-      const double tr = std::max(Hs.trace() / np, 1e-300);
+      // Solve in parameters made dimensionless by the nominal radius (centre and radius
+      // in radii, bend in 1/radii): the damping floor below compares the diagonal entries,
+      // which otherwise scale as 1, L² and L⁴ and freeze the centre (huge clouds) or the
+      // bend (tiny ones).
+      const Eigen::VectorXd S = parameter_scales(np, ib, ir);
+      auto Hs = (S.asDiagonal() * H.topLeftCorner(np, np) * S.asDiagonal()).eval();
+      const double tr = std::max(Hs.trace() / np, std::numeric_limits<double>::min());
       for (int k = 0; k < np; ++k) Hs(k, k) += lambda * std::max(Hs(k, k), 1e-9 * tr);
-      Eigen::VectorXd delta = Hs.ldlt().solve(-g.head(np));
+      Eigen::VectorXd delta = Hs.ldlt().solve(-(S.asDiagonal() * g.head(np)).eval());
+      delta = (S.asDiagonal() * delta).eval();
       if (!delta.allFinite()) break;
       // Keep each step within the trust of the linearisation.
-      const double R = std::max(f.r, 1e-12);
+      const double R = std::max(f.r, 1e-12 * cfg_.radius);
       const double step_c = std::hypot(delta(0), delta(1)), step_a = std::hypot(delta(2), delta(3));
       double shrink = 1.0;
       if (step_c > 0.5 * R) shrink = std::min(shrink, 0.5 * R / step_c);
@@ -237,6 +269,7 @@ class BlockFitter {
       ts.push_back(t_[i]);
       ++k;
     }
+    f.thin = arc_sectors(f) < kMinArcSectors;
     if (!ts.empty()) {
       // Extent along the axis, ignoring the outermost kEndQuantile of the inliers (a stray
       // point beyond the cable end must not stretch the curve).
@@ -266,6 +299,34 @@ class BlockFitter {
   FitConfig cfg_;
   std::vector<double> res_, t_, w_, trial_res_, trial_t_;
   std::vector<Vec3> nrm_, trial_nrm_;
+
+  /// Number of the kArcSectors equal sectors around the axis that hold at least
+  /// kSectorShare of the inliers (directions of the points from their foot on the axis).
+  int arc_sectors(const FitOut& f) const {
+    Vec3 e1, e2;
+    frame(f.a, e1, e2);
+    std::vector<std::size_t> count(kArcSectors, 0);
+    std::size_t total = 0;
+    for (std::size_t i = 0; i < n_; ++i) {
+      if (w_[i] <= 0.0) continue;
+      const double ang = std::atan2(nrm_[i].dot(e2), nrm_[i].dot(e1)) + kPiScan;  // 0 .. 2π
+      const auto k = std::min<std::size_t>(kArcSectors - 1, static_cast<std::size_t>(ang / (2.0 * kPiScan) * kArcSectors));
+      ++count[k];
+      ++total;
+    }
+    const double need = std::max(1.0, kSectorShare * static_cast<double>(total));
+    return static_cast<int>(std::count_if(count.begin(), count.end(), [&](std::size_t c) { return static_cast<double>(c) >= need; }));
+  }
+
+  /// Per-parameter unit of the LM step (centre, direction, bend, radius): the nominal
+  /// radius to the power that makes each parameter dimensionless.
+  Eigen::VectorXd parameter_scales(int np, int ib, int ir) const {
+    Eigen::VectorXd S = Eigen::VectorXd::Ones(np);
+    S(0) = S(1) = cfg_.radius;
+    if (cfg_.curved) S(ib) = S(ib + 1) = 1.0 / cfg_.radius;
+    if (cfg_.free_radius) S(ir) = cfg_.radius;
+    return S;
+  }
 
   /// Paper's normalisation: the data term is Σ w·res² / (m r²); the smoothness term μ|a − ā|²
   /// is therefore weighted by μ·m·r² against the raw weighted squares.
@@ -384,13 +445,21 @@ std::optional<double> coarse_diameter(const std::vector<Vec3>& pts, const KdTree
   if (pts.size() < 2 * kMinBlockPoints) return std::nullopt;
   std::mt19937_64 rng(seed);
   std::uniform_int_distribution<std::size_t> pick(0, pts.size() - 1);
-  // Median nearest-neighbour spacing h sets the smallest meaningful neighbourhood.
+  // Median nearest-neighbour spacing h sets the smallest meaningful neighbourhood. The
+  // nearest neighbour at a non-zero distance: a cloud whose points are repeated (merged
+  // scans, re-exported files) would otherwise give h = 0 and start the search far below
+  // the tube's scale.
   std::vector<double> nn;
+  std::uint32_t idx[kSpacingNeighbours];
+  double d2[kSpacingNeighbours];
   for (int i = 0; i < 200; ++i) {
-    std::uint32_t idx[2];
-    double d2[2];
     const Vec3& p = pts[pick(rng)];
-    if (tree.knnSearch(p.data(), 2, idx, d2) == 2) nn.push_back(std::sqrt(d2[1]));
+    const std::size_t got = tree.knnSearch(p.data(), kSpacingNeighbours, idx, d2);
+    for (std::size_t k = 1; k < got; ++k)
+      if (d2[k] > 0.0) {
+        nn.push_back(std::sqrt(d2[k]));
+        break;
+      }
   }
   const double h = median(nn);
   AABB box;
@@ -400,7 +469,7 @@ std::optional<double> coarse_diameter(const std::vector<Vec3>& pts, const KdTree
   double rho = std::max(12.0 * h, 1e-6 * diag);
   std::optional<double> best;
   std::vector<std::pair<std::uint32_t, double>> found;
-  for (int iter = 0; iter < 12 && rho <= diag; ++iter) {
+  for (int iter = 0; iter < kEstimateIterations && rho <= diag; ++iter) {
     std::vector<double> radii;
     for (int sidx = 0; sidx < 48; ++sidx) {
       const Vec3& p = pts[pick(rng)];
@@ -477,6 +546,24 @@ struct UnionFind {
     return true;
   }
 };
+
+/// Unit direction of the run of `path` that ends (step −1: the run before node i, pointing
+/// towards it) or starts (step +1: the run after node i, pointing away) at node i, over about
+/// `length`; nullopt when the run is shorter than half of that (a lone node).
+std::optional<Vec3> run_direction(const std::vector<Vec3>& path, const std::vector<char>& bridge, std::size_t i, int step,
+                                  double length) {
+  std::size_t j = i;
+  double acc = 0.0;
+  while (acc < length) {
+    if (step < 0 ? (j == 0 || bridge[j - 1]) : (j + 1 >= path.size() || bridge[j])) break;
+    const std::size_t k = step < 0 ? j - 1 : j + 1;
+    acc += (path[k] - path[j]).norm();
+    j = k;
+  }
+  if (acc < 0.5 * length) return std::nullopt;
+  const Vec3 v = step < 0 ? Vec3(path[i] - path[j]) : Vec3(path[j] - path[i]);
+  return v.normalized();
+}
 
 /// Contracts the cloud onto its axis and orders the contracted nodes by the longest path of
 /// their minimum spanning tree. Returns false (with a reason) if nothing tube-like is found.
@@ -682,6 +769,23 @@ bool build_chain(const std::vector<Vec3>& pts, const std::vector<Vec3>& sub, con
     for (std::size_t i = 1; i + 1 < path.size(); ++i)
       if (!bridge[i - 1] && !bridge[i]) sm[i] = 0.25 * path[i - 1] + 0.5 * path[i] + 0.25 * path[i + 1];
     path.swap(sm);
+  }
+  // A bridge joins two scanned stretches of one cable only if it carries on from both:
+  // pieces joined at a sharp turn are separate cables (or a cable and something else).
+  for (std::size_t i = 0; i + 1 < path.size(); ++i) {
+    if (!bridge[i]) continue;
+    const Vec3 across = path[i + 1] - path[i];
+    const auto before = run_direction(path, bridge, i, -1, kBridgeTangentLength * d);
+    const auto after = run_direction(path, bridge, i + 1, +1, kBridgeTangentLength * d);
+    double turn = 0.0;
+    for (const auto& dir : {before, after})
+      if (dir) turn = std::max(turn, std::acos(std::clamp(dir->dot(across.normalized()), -1.0, 1.0)));
+    if (turn > kMaxBridgeTurn) {
+      why = "the cloud holds separate pieces that do not continue each other (a gap of " +
+            std::to_string(across.norm()) + " between them turns by " + std::to_string(turn * 180.0 / kPiScan) +
+            " degrees): more than one cable, or a cable and another object";
+      return false;
+    }
   }
   chain.bridge = std::move(bridge);
   chain.nodes = std::move(path);
@@ -939,21 +1043,41 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
           fits[b] = fitter.run(f0, warm);
         }
         if (fits[b].ok && (fits[b].c - c0[b]).norm() > kMaxCentreShift * d) fits[b].ok = false;
+        if (fits[b].ok && fits[b].thin) fits[b].ok = false;
       }
     });
   };
   std::vector<std::optional<Vec3>> no_prior(m);
-  run_pass(res.diameter_estimated, 0.5 * d, no_prior, nullptr);
+  // Pass 1 fits the radius too, also when a diameter is given: the cloud's own diameter
+  // checks the given one (a wrong one moves every fitted axis by the difference of the
+  // radii, and more where the scan saw one side) and the final fits use it.
+  run_pass(true, 0.5 * d, no_prior, nullptr);
+  std::vector<double> diam;
+  for (const auto& f : fits)
+    if (f.ok && f.r < d) diam.push_back(2.0 * f.r);  // a radius beyond d is a failed fit
+  if (diam.size() < 2) {
+    std::string why = "the block fits do not agree on a diameter";
+    const std::size_t thin = static_cast<std::size_t>(
+        std::count_if(fits.begin(), fits.end(), [](const FitOut& f) { return f.thin; }));
+    if (thin > 0)
+      why += ": in " + std::to_string(thin) + " of " + std::to_string(m) +
+             " blocks the points cover less than " + std::to_string(kMinArcSectors * 360 / kArcSectors) +
+             " degrees around the fitted axis (a line or a surface, not a tube)";
+    else if (opt.diameter)
+      why += " (is the given diameter " + std::to_string(*opt.diameter) + " right?)";
+    return finish(ScanStatus::NotATube, why);
+  }
+  const double fitted_d = median(diam);
   if (res.diameter_estimated) {
-    std::vector<double> diam;
-    for (const auto& f : fits)
-      if (f.ok && f.r < d) diam.push_back(2.0 * f.r);  // a radius beyond d is a failed fit
-    if (diam.size() < 2) return finish(ScanStatus::NotATube, "the block fits do not agree on a diameter");
-    d = median(diam);
+    d = fitted_d;
     std::vector<double> dev(diam.size());
     for (std::size_t i = 0; i < diam.size(); ++i) dev[i] = std::abs(diam[i] - d);
     res.diameter_spread = 1.4826 * median(dev);
     res.diameter = d;
+  } else if (std::abs(fitted_d - d) > kGivenDiameterTolerance * d) {
+    return finish(ScanStatus::NotATube, "the given diameter " + std::to_string(d) +
+                                            " does not match the cloud: its cross-sections fit a diameter of " +
+                                            std::to_string(fitted_d));
   }
   std::vector<std::optional<Vec3>> priors(m);
   if (!graph && opt.smoothness > 0.0) {  // the paper's E_ext; the graph method's curved blocks need none
@@ -967,7 +1091,7 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
     }
   }
   const std::vector<FitOut> pass1 = fits;
-  if (!graph || res.diameter_estimated) run_pass(false, 0.5 * d, priors, &pass1);
+  run_pass(false, 0.5 * fitted_d, priors, &pass1);
   res.timing.fitting_ms = ms_since(t0);
 
   // Key points in order along the cable.
