@@ -108,6 +108,7 @@ int run_simplify(const SimplifyCommandOptions& o) {
                      {"containment", finite_or_zero(r.containment)},
                      {"containment_samples", r.containment_samples},
                      {"hausdorff", finite_or_zero(r.hausdorff)},
+                     {"float_rounding", finite_or_zero(r.float_rounding)},
                      {"lost_space_radius", finite_or_zero(r.lost_space_radius)},
                      {"time_ms", finite_or_zero(r.time_ms)},
                      {"fallback", alpha_sim_fallback_name(r.fallback)},

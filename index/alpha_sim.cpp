@@ -316,7 +316,9 @@ double plane_sample_estimate(const Mesh& mesh, const std::vector<MeshEdge>& edge
     const Vec2 lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
     const double area = 0.5 * std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
     // Lattice rows crossed times nodes per row is at most area/h² plus one per row and column.
-    n += area / (l_max * l_max) + (hi - lo).sum() / l_max + 1.0;
+    // Divided twice: h² underflows to 0 for h < ~1e-154 (0/0 would be NaN for a triangle
+    // seen edge-on, and NaN passes every comparison with the limit).
+    n += area / l_max / l_max + (hi - lo).sum() / l_max + 1.0;
   }
   return n;
 }
@@ -871,6 +873,52 @@ std::vector<PlaneSpec> planes_for(const AlphaSimOptions& opt) {
 
 // --- Mesh queries for the measures (Embree) ---------------------------------------------
 
+/// Rounds every vertex of m to the nearest float32 (what a binary STL stores) and returns
+/// the largest distance a vertex moved (scene units). Coordinate by coordinate: GCC 12.2
+/// at -O2/-O3 (SLP vectorizer) dropped the store of `v = Vec3(float(x), float(y),
+/// float(z))` in this loop for the first vertex (checked with a stand-alone copy).
+double round_vertices_to_float(Mesh& m) {
+  double moved2 = 0.0;
+  for (Vec3& v : m.vertices) {
+    double d2 = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double f = static_cast<double>(static_cast<float>(v[k]));
+      d2 += (f - v[k]) * (f - v[k]);
+      v[k] = f;
+    }
+    moved2 = std::max(moved2, d2);
+  }
+  return std::sqrt(moved2);
+}
+
+/// Largest share of the containment tolerance kept for float32 rounding of the output
+/// (float32_vertices).
+constexpr double kMaxFloatRoundingShare = 0.5;
+
+/// The prisms run this far past the part (scene units; simplify_part), so that no cap of
+/// one coincides with a face of another.
+double prism_margin(const AlphaSimOptions& opt, double tol) { return std::max(10.0 * tol, 1e-3 * opt.dim_pre); }
+
+/// Bound on how far rounding to float32 moves a vertex of the simplified mesh of a part
+/// with bounding box `box` (scene units): rounding a coordinate x moves it by at most
+/// 2^-24·|x|, and the mesh lies within the box grown by the prisms' margin and tol (its
+/// outlines may grow further: the rounding is checked after).
+double float_rounding_bound(const AABB& box, const AlphaSimOptions& opt, double tol) {
+  const double m = std::max(box.min.cwiseAbs().maxCoeff(), box.max.cwiseAbs().maxCoeff()) + prism_margin(opt, tol) + tol;
+  return std::sqrt(3.0) * std::ldexp(m, -24);
+}
+
+/// The part of the containment tolerance tol kept for rounding the simplified mesh of a
+/// part with bounding box `box` to float32 (scene units; 0 without float32_vertices):
+/// opt.float_rounding_reserve, or where that is < 0 float_rounding_bound(), at most
+/// kMaxFloatRoundingShare·tol (far from the origin only vertices that are float32 already,
+/// like the corners of a box read from an STL file, stay within it).
+double float_rounding_reserve(const AABB& box, const AlphaSimOptions& opt, double tol) {
+  if (!opt.float32_vertices) return 0.0;
+  const double reserve = opt.float_rounding_reserve >= 0.0 ? opt.float_rounding_reserve : float_rounding_bound(box, opt, tol);
+  return std::min(reserve, kMaxFloatRoundingShare * tol);
+}
+
 /// One closed or open mesh as a one-part EmbreeIndex: exact (double) distances and
 /// ray-parity inside tests (DESIGN §9: Embree for BVH queries). `watertight`: checked to
 /// have no boundary and no misoriented edge, so one ray that grazes nothing decides an
@@ -1318,7 +1366,11 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   const AABB box = part.mesh.bounds();
   const double size = opt.scene_size > 0.0 ? opt.scene_size : box.diagonal();
   r.tolerance = opt.containment_tolerance_factor * (size > 0.0 ? size : 1.0);
-  const double tol = r.tolerance;
+  // Rounding the output mesh to float32 (float32_vertices) may move its vertices by
+  // rounding_reserve (checked once it is made): the shapes are built and checked within the
+  // rest of the tolerance, tol.
+  const double rounding_reserve = float_rounding_reserve(box, opt, r.tolerance);
+  const double tol = r.tolerance - rounding_reserve;
   auto finish = [&]() {
     r.time_ms = ms_since(t0);
     return std::move(out);
@@ -1356,11 +1408,13 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       projected[k] = project_vertices(part.mesh, specs[k].frame);
       per_plane[k] = plane_sample_estimate(part.mesh, edges, projected[k], r.l_max);
     });
-    const double estimate = *std::max_element(per_plane.begin(), per_plane.end());
-    if (estimate > static_cast<double>(opt.max_cloud_points)) {
+    double estimate = 0.0;  // NaN (not expected) is taken as too many
+    for (double e : per_plane) estimate = std::isnan(e) ? e : std::max(estimate, e);
+    if (!(estimate <= static_cast<double>(opt.max_cloud_points))) {
+      // The estimate may exceed any integer type (+inf): printed as a double.
       keep_original(out, part, AlphaSimStatus::TooFine,
                     "sampling at L_max = " + full_precision(r.l_max) + " needs about " +
-                        std::to_string(static_cast<long long>(estimate)) + " points in a plane > " +
+                        full_precision(std::round(estimate)) + " points in a plane > " +
                         std::to_string(opt.max_cloud_points) + ": original kept (raise dim_pre)");
       return finish();
     }
@@ -1639,7 +1693,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
 
   // 5–6. extrude and intersect, mesh the result. Each prism runs a margin past the part
   // so that no cap of one coincides with a face of another.
-  const double margin = std::max(10.0 * tol, 1e-3 * opt.dim_pre);
+  const double margin = prism_margin(opt, r.tolerance);
   std::vector<Extrusion> extrusions(specs.size());
   for (std::size_t k = 0; k < specs.size(); ++k)
     extrusions[k] = {prisms[k].u, prisms[k].v, prisms[k].n, prisms[k].depth_min - margin,
@@ -1654,7 +1708,10 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   r.prisms_absorbed = static_cast<int>(reduced.absorbed);
   // Watertight: no boundary and no misoriented edge. Edges shared by four triangles are
   // allowed: two pieces of the intersection may touch along an edge.
-  auto watertight_mesh = [](Mesh& m, MeshTopology& t) {
+  // The vertices are rounded to float32 first (float32_vertices): rounding can fold a
+  // sliver or merge two vertices, and the checks below must hold for the mesh as written.
+  auto watertight_mesh = [&](Mesh& m, MeshTopology& t) {
+    if (opt.float32_vertices) r.float_rounding = round_vertices_to_float(m);
     weld_identical_vertices(m);
     t = analyse_topology(m);
     return t.boundary_edges == 0 && t.misoriented_edges == 0;
@@ -1710,6 +1767,13 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   r.mesh_ms = ms_since(t_mesh);
   if (watertight && out.mesh.signed_volume() < 0.0)
     for (auto& f : out.mesh.triangles) std::swap(f[1], f[2]);
+  if (r.float_rounding > rounding_reserve) {
+    keep_original(out, part, AlphaSimStatus::Failed,
+                  "rounding the simplified mesh to float32 (binary STL) moved a vertex by " +
+                      full_precision(r.float_rounding) + " > the " + full_precision(rounding_reserve) +
+                      " of the containment tolerance kept for it (the part lies far from the origin): original kept");
+    return finish();
+  }
   r.closed_after = watertight;
   r.triangles_after = out.mesh.triangle_count();
   r.volume_after = watertight ? std::abs(out.mesh.signed_volume()) : 0.0;
@@ -1734,20 +1798,24 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       const std::size_t in = tbb::parallel_reduce(
           tbb::blocked_range<std::size_t>(0, samples.size(), 4096), std::size_t(0),
           [&](const auto& rg, std::size_t acc) {
-            for (std::size_t i = rg.begin(); i != rg.end(); ++i) acc += solid->contains(samples[i], tol) ? 1 : 0;
+            for (std::size_t i = rg.begin(); i != rg.end(); ++i) acc += solid->contains(samples[i], r.tolerance) ? 1 : 0;
             return acc;
           },
           std::plus<std::size_t>());
       r.containment_implicit = samples.empty() ? 1.0 : static_cast<double>(in) / samples.size();
     }
     const EmbreeIndex simplified = mesh_index(out.mesh, true, true);  // watertight: checked above
-    const std::size_t in = count_contained_mesh(simplified, samples, tol);
+    // The mesh as written (float32 vertices) within the whole tolerance.
+    const std::size_t in = count_contained_mesh(simplified, samples, r.tolerance);
     r.containment = samples.empty() ? 1.0 : static_cast<double>(in) / samples.size();
-    if (in != samples.size()) {
-      const double c = r.containment;
+    if (in != samples.size() || r.containment_implicit < 1.0) {
+      // Either model missing a sample is a failure: the implicit solid is a result too.
+      const double c = r.containment, ci = r.containment_implicit;
       keep_original(out, part, AlphaSimStatus::Failed,
-                    "output mesh contains only " + full_precision(c) + " of the surface samples: original kept");
+                    (in != samples.size() ? "output mesh" : "implicit solid") + std::string(" contains only ") +
+                        full_precision(in != samples.size() ? c : ci) + " of the surface samples: original kept");
       r.containment = c;  // report what was measured before falling back
+      r.containment_implicit = ci;
       return finish();
     }
     // One-sided Hausdorff distance: output surface → original surface.
@@ -1824,6 +1892,15 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
   // onto themselves (projection planes go to projection planes) and a translation. With
   // user planes only translations qualify: a rotation would turn those planes.
   const double copy_tol = 1e-2 * o.containment_tolerance_factor * o.scene_size;
+  // Every part keeps the same share of the tolerance for float32 rounding: the bound of all
+  // parts' box twice over, and the copies' deviation, so that a copy's mesh — the first
+  // part's rounded mesh moved and rounded again — stays within it.
+  if (o.float32_vertices && o.float_rounding_reserve < 0.0) {
+    AABB all;
+    for (const auto& p : parts) all.extend(p.mesh.bounds());
+    const double tol = o.containment_tolerance_factor * o.scene_size;
+    o.float_rounding_reserve = 2.0 * float_rounding_bound(all, o, tol) + copy_tol;
+  }
   const std::vector<Eigen::Matrix3d> motions = axis_rotations(o.extra_planes.empty());
   std::vector<std::size_t> source(parts.size());
   std::vector<Eigen::Affine3d> move(parts.size(), Eigen::Affine3d::Identity());
@@ -1862,6 +1939,16 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
   // go on with planes never built. Each part's exception is kept; the first (in part
   // order) is rethrown once every part has finished.
   std::vector<std::exception_ptr> failed(parts.size());
+  // Part i simplified on its own: its result in out and res.
+  auto store = [&](std::size_t i, AlphaSimPart sp) {
+    Part p = parts[i];
+    p.mesh = std::move(sp.mesh);
+    p.closed = sp.result.closed_after;
+    if (sp.result.fallback != AlphaSimFallback::Original) p.source_faces = sp.result.faces_after;
+    out[i] = std::move(p);
+    res[i] = std::move(sp.result);
+    simplified.add();
+  };
   tbb::parallel_for(std::size_t(0), unique.size(), [&](std::size_t u) {
     const std::size_t i = unique[u];
     AlphaSimPart sp;
@@ -1871,13 +1958,7 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
       failed[i] = std::current_exception();
       return;
     }
-    Part p = parts[i];
-    p.mesh = std::move(sp.mesh);
-    p.closed = sp.result.closed_after;
-    if (sp.result.fallback != AlphaSimFallback::Original) p.source_faces = sp.result.faces_after;
-    out[i] = std::move(p);
-    res[i] = std::move(sp.result);
-    simplified.add();
+    store(i, std::move(sp));
   });
   for (const auto& e : failed)
     if (e) std::rethrow_exception(e);
@@ -1886,6 +1967,7 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
     const auto t0 = Clock::now();
     const std::size_t j = source[i];
     Part p = parts[i];
+    double rounding = 0.0;
     if (res[j].fallback == AlphaSimFallback::Original) {
       p.mesh = parts[i].mesh;
     } else {
@@ -1893,9 +1975,31 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
       for (auto& v : p.mesh.vertices) v = move[i] * v;  // a proper rotation: windings stay outward
       p.closed = out[j].closed;
       p.source_faces = out[j].source_faces;
+      if (o.float32_vertices) {
+        // The moved mesh is rounded to float32 again: with the rounding of the first part's
+        // mesh and the copy's own deviation it must stay within the share of the tolerance
+        // that the first part's shapes left for rounding, and closed; else the copy is
+        // simplified on its own.
+        rounding = round_vertices_to_float(p.mesh);
+        const double budget = float_rounding_reserve(parts[j].mesh.bounds(), o, res[j].tolerance);
+        weld_identical_vertices(p.mesh);
+        const MeshTopology topo = analyse_topology(p.mesh);
+        if (res[j].float_rounding + rounding + copy_tol > budget || topo.boundary_edges > 0 || topo.misoriented_edges > 0) {
+          store(i, simplify_part(parts[i], o, stems[i]));
+          continue;
+        }
+      }
     }
+    const std::size_t triangles = p.mesh.triangle_count();
+    const double volume = std::abs(p.mesh.signed_volume());
     out[i] = std::move(p);
     res[i] = res[j];
+    if (res[j].fallback != AlphaSimFallback::Original && o.float32_vertices) {
+      // Rounding may have merged vertices (and dropped a triangle): the report describes the copy's mesh.
+      res[i].float_rounding = rounding;
+      res[i].triangles_after = triangles;
+      res[i].volume_after = volume;
+    }
     if (!move[i].linear().isIdentity()) res[i].projections = turned_projections(res[j].projections, move[i].linear(), planes_for(o));
     res[i].name = parts[i].name;
     res[i].copy_of = parts[j].name;

@@ -100,6 +100,19 @@ struct AlphaSimOptions {
   /// always uses OpenCASCADE (it needs the B-rep).
   bool occt_booleans = false;
   bool measure = true;          ///< containment of the mesh + Hausdorff distance
+  /// The output mesh's vertices are rounded to float32 (the binary STL that `loom
+  /// simplify` writes holds nothing finer) before the mesh is checked closed and measured,
+  /// so that the checks hold for the file. The shapes are built within the tolerance less
+  /// float_rounding_reserve; a rounding larger than that (a part far from the origin,
+  /// |x| ≳ 2^23·tolerance, whose simplified mesh has vertices that are not float32 already)
+  /// keeps the original (status failed, with the reason). false keeps the exact double
+  /// vertices (then a binary STL of the mesh may not contain the original).
+  bool float32_vertices = true;
+  /// The part of the containment tolerance kept for that rounding (scene units, at most
+  /// half the tolerance): the shapes are built within the rest. < 0: a bound on the
+  /// rounding derived from the part's bounding box (simplify_parts sets one for all parts,
+  /// from all of them, that also covers a moved copy's second rounding).
+  double float_rounding_reserve = -1.0;
   /// With measure: also the Hausdorff distance (a figure for the report: routing, which
   /// needs the containment check and the lost-space probe only, skips it; then 0).
   bool hausdorff = true;
@@ -180,6 +193,8 @@ struct AlphaSimResult {
   /// Verification rounds that found random samples outside a shape and repaired it.
   int repair_rounds = 0;
   double hausdorff = 0.0;             ///< max over the output surface of the distance to the original (0 unless measured)
+  /// Largest move of an output vertex rounded to float32 (float32_vertices; scene units).
+  double float_rounding = 0.0;
   double lost_space_radius = 0.0;     ///< largest probed ball radius filled by the simplification
   double lost_space_resolution = 0.0; ///< grid spacing of that probe
   double time_ms = 0.0;
