@@ -1,6 +1,6 @@
 set terminal pngcairo size 1500,480
 set output '/work/main/bench/results/route.png'
-set multiplot layout 1,3 title 'Routing the wing-section harness (24 cables): time budget per segment vs quality; α-SIM 147094→3188 triangles in 1138 ms (seed 20261121)'
+set multiplot layout 1,3 title 'Routing the wing-section harness (24 cables): time budget per segment vs quality; α-SIM 147094→3024 triangles in 324 ms (seed 20261121)'
 set logscale x
 set xrange [0.035:1.5]
 set xlabel 'time budget per segment (s)'
