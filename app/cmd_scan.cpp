@@ -73,6 +73,31 @@ Closest closest_on_polyline(const std::vector<std::pair<double, Vec3>>& poly, co
   return best;
 }
 
+/// The sample of `from` (arc length, point) farthest from the polyline `to`, and the sum of
+/// the squared distances of all of them (scene units).
+struct Farthest {
+  double max = -1.0;
+  double sum_sq = 0.0;
+  double s = 0.0;  ///< arc length of the farthest sample on its own curve
+  Vec3 p = Vec3::Zero();
+  Closest on;  ///< its closest point on `to`
+};
+
+Farthest farthest_from(const std::vector<std::pair<double, Vec3>>& from, const std::vector<std::pair<double, Vec3>>& to) {
+  Farthest f;
+  for (const auto& [s, p] : from) {
+    const Closest c = closest_on_polyline(to, p);
+    f.sum_sq += c.dist * c.dist;
+    if (c.dist > f.max) {
+      f.max = c.dist;
+      f.s = s;
+      f.p = p;
+      f.on = c;
+    }
+  }
+  return f;
+}
+
 /// The one-cable harness that carries the recovered centerline as a routed segment.
 Harness scan_harness(const ScanResult& r, const std::string& cloud_name, Unit units) {
   Harness h;
@@ -136,27 +161,29 @@ int run_scan(const ScanCommandOptions& o) {
     if (!designed)
       throw InputError(SourceLocation{o.compare, design->cables[static_cast<std::size_t>(ci)].line, "cable " + o.cable},
                        "the cable is not routed (a segment of its chain has no position)");
-    const auto dense = r.centerline.sample_by_arc_length(kDensePolyline * d);
+    // Both ways: the design from the scan (where the cable was not laid as designed) and the
+    // scan from the design (what was laid beyond the design: a slack loop, a longer run),
+    // which the first cannot see.
     const auto along = designed->sample_by_arc_length(kDeviationSpacing * d);
-    double sq = 0.0, mx = -1.0;
-    json where;
-    for (const auto& [s, p] : along) {
-      const Closest c = closest_on_polyline(dense, p);
-      sq += c.dist * c.dist;
-      if (c.dist > mx) {
-        mx = c.dist;
-        where = {{"s", s}, {"point", vec_json(p)}, {"scanned_point", vec_json(c.point)}, {"scanned_s", c.s}};
-      }
-    }
+    const Farthest fwd = farthest_from(along, r.centerline.sample_by_arc_length(kDensePolyline * d));
+    const Farthest back = farthest_from(r.centerline.sample_by_arc_length(kDeviationSpacing * d),
+                                        designed->sample_by_arc_length(kDensePolyline * d));
+    const json where = {{"s", fwd.s}, {"point", vec_json(fwd.p)}, {"scanned_point", vec_json(fwd.on.point)},
+                        {"scanned_s", fwd.on.s}};
+    const json back_where = {{"scanned_s", back.s}, {"scanned_point", vec_json(back.p)},
+                             {"point", vec_json(back.on.point)}, {"s", back.on.s}};
     deviation = {{"cable", o.cable},
                  {"routes", o.compare},
                  {"designed_length", designed->length()},
                  {"scanned_length", r.centerline.length()},
                  {"samples", along.size()},
                  {"spacing", kDeviationSpacing * d},
-                 {"max", mx},
-                 {"rms", along.empty() ? 0.0 : std::sqrt(sq / static_cast<double>(along.size()))},
-                 {"where", where}};
+                 {"max", fwd.max},
+                 {"rms", along.empty() ? 0.0 : std::sqrt(fwd.sum_sq / static_cast<double>(along.size()))},
+                 {"where", where},
+                 {"max_scan_to_design", back.max},
+                 {"where_scan_to_design", back_where},
+                 {"hausdorff", std::max(fwd.max, back.max)}};
   }
 
   // Tube and outputs (computed first, then written, so that a failure writes nothing).
@@ -215,8 +242,11 @@ int run_scan(const ScanCommandOptions& o) {
                 r.diameter_estimated ? "estimated" : "given", r.centerline.length(), r.blocks.size(), r.residual_rms,
                 r.residual_max, r.outliers, r.gaps);
     if (!deviation.is_null())
-      std::printf("  deviation from %s cable %s: max %.4g at s=%.4g, rms %.4g\n", o.compare.c_str(), o.cable.c_str(),
-                  deviation["max"].get<double>(), deviation["where"]["s"].get<double>(), deviation["rms"].get<double>());
+      std::printf("  deviation from %s cable %s: max %.4g at s=%.4g, rms %.4g; scan from design max %.4g at scanned "
+                  "s=%.4g\n",
+                  o.compare.c_str(), o.cable.c_str(), deviation["max"].get<double>(), deviation["where"]["s"].get<double>(),
+                  deviation["rms"].get<double>(), deviation["max_scan_to_design"].get<double>(),
+                  deviation["where_scan_to_design"]["scanned_s"].get<double>());
     std::printf("  wrote %s/{centerline.xml, tube.ply, report.json} in %.0f ms\n", o.out.c_str(),
                 j["timing_ms"]["total"].get<double>());
   }

@@ -1,5 +1,6 @@
 // The command line as a user meets it: exit codes, help, version, errors naming files.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <array>
 #include <cerrno>
@@ -580,6 +581,51 @@ TEST(CliRoutes, RouteThatIsNoCurveNamesFileAndCableInEveryCommand) {
     const auto r = loom(cmd);
     EXPECT_EQ(r.status, 2) << cmd << "\n" << r.out;
     EXPECT_NE(r.out.find("r.xml:5: cable C1: its route does not make a curve"), std::string::npos) << cmd << "\n" << r.out;
+  }
+}
+
+/// A routed harness of one straight cable C1 (d = 2) from `a` to `b` through their midpoint.
+using Point = std::array<double, 3>;
+std::string straight_route(const Point& a, const Point& b) {
+  auto xyz = [](const Point& p) {
+    return "x=\"" + std::to_string(p[0]) + "\" y=\"" + std::to_string(p[1]) + "\" z=\"" + std::to_string(p[2]) + "\"";
+  };
+  const Point m{0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2])};
+  return "<?xml version=\"1.0\"?>\n<harness name=\"s\" units=\"mm\">\n<attributes>\n<cable id=\"C1\">"
+         "<electrical><port id=\"J1\"/><port id=\"J2\"/></electrical>"
+         "<physical diameter=\"2\" min_bend_radius=\"10\"/></cable>\n</attributes>\n<structure>\n"
+         "<port id=\"J1\" " + xyz(a) + " dx=\"1\" dy=\"0\" dz=\"0\"/>\n<port id=\"J2\" " + xyz(b) +
+         " dx=\"-1\" dy=\"0\" dz=\"0\"/>\n<segment from=\"J1\" to=\"J2\"><path interp=\"polyline\"><pt " + xyz(m) +
+         "/></path></segment>\n</structure>\n</harness>\n";
+}
+
+// `scan --compare` measured the design from the scan only: cable laid beyond the design
+// (a longer run, a slack loop) was never counted. The scan from the design is reported
+// too, and the Hausdorff distance of the two. Closed forms: the cloud is a tube of d = 2
+// along x from 0 to 59.9 (tube_cloud).
+TEST(CliScan, CompareMeasuresBothWays) {
+  const auto dir = fresh_dir("scan_compare");
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "c.xyz") << tube_cloud();
+  struct Case {
+    Point a, b;
+    double design_from_scan, scan_from_design;  // the two maxima, closed form
+  };
+  const std::vector<Case> cases{{{0, 0, 0}, {40, 0, 0}, 0.0, 19.9},  // 19.9 laid beyond the design
+                                {{0, 0.5, 0}, {59.9, 0.5, 0}, 0.5, 0.5}};
+  // The scan's own error (RMS ~0.001 d) and its ends (short by up to ~0.07 d) allow:
+  const double slack = 0.2;
+  for (const Case& c : cases) {
+    std::ofstream(dir / "r.xml") << straight_route(c.a, c.b);
+    const auto r = loom("scan " + (dir / "c.xyz").string() + " --quiet --compare " + (dir / "r.xml").string() +
+                        " --cable C1 --out " + (dir / "s").string());
+    ASSERT_EQ(r.status, 0) << r.out;
+    const auto j = nlohmann::json::parse(slurp(dir / "s" / "report.json"));
+    const auto& dev = j.at("deviation");
+    EXPECT_NEAR(dev.at("max").get<double>(), c.design_from_scan, slack) << dev.dump();
+    EXPECT_NEAR(dev.at("max_scan_to_design").get<double>(), c.scan_from_design, slack) << dev.dump();
+    EXPECT_DOUBLE_EQ(dev.at("hausdorff").get<double>(),
+                     std::max(dev.at("max").get<double>(), dev.at("max_scan_to_design").get<double>()));
   }
 }
 
