@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "common/run_loom.hpp"
+
 #include <array>
 #include <cerrno>
 #include <cmath>
@@ -20,23 +22,10 @@
 
 namespace {
 
-struct Run {
-  int status = -1;
-  std::string out;
-};
+using Run = loom::testing::LoomRun;
 
 /// Runs `loom ARGS` (stderr merged into stdout) and returns exit status and output.
-Run loom(const std::string& args) {
-  Run r;
-  const std::string cmd = std::string(LOOM_EXE) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), p)) r.out += buf.data();
-  const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
+Run loom(const std::string& args) { return loom::testing::run_loom(args); }
 
 const std::string kExamples = std::string(LOOM_SOURCE_DIR) + "/examples";
 

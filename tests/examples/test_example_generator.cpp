@@ -16,6 +16,8 @@
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
 
+#include "common/brute_geometry.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -54,36 +56,9 @@ struct TempDir {
 
 // --- brute-force geometry oracles ---------------------------------------------------------
 
-/// Closest point on triangle abc to p (Ericson, Real-Time Collision Detection §5.1.5).
-Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const Vec3 bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
-  const Vec3 cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-  const double denom = 1.0 / (va + vb + vc);
-  return a + ab * (vb * denom) + ac * (vc * denom);
-}
 
 /// Unsigned distance from p to the surface of a mesh (every triangle).
-double surface_distance(const loom::Mesh& m, const Vec3& p) {
-  double best = std::numeric_limits<double>::infinity();
-  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
-    const auto c = m.corners(t);
-    best = std::min(best, (closest_on_triangle(p, c[0], c[1], c[2]) - p).norm());
-  }
-  return best;
-}
+double surface_distance(const loom::Mesh& m, const Vec3& p) { return loom::test_oracle::mesh_distance(m, p); }
 
 /// Distance from p to an AABB (0 inside): a lower bound of the distance to its contents.
 double box_distance(const loom::AABB& b, const Vec3& p) {
@@ -92,18 +67,7 @@ double box_distance(const loom::AABB& b, const Vec3& p) {
 }
 
 /// Generalised winding number of a closed mesh around p (≈1 inside, ≈0 outside).
-double winding_number(const loom::Mesh& m, const Vec3& p) {
-  double sum = 0.0;
-  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
-    const auto c = m.corners(t);
-    const Vec3 a = c[0] - p, b = c[1] - p, d = c[2] - p;
-    const double la = a.norm(), lb = b.norm(), ld = d.norm();
-    const double num = a.dot(b.cross(d));
-    const double den = la * lb * ld + a.dot(b) * ld + b.dot(d) * la + d.dot(a) * lb;
-    sum += 2.0 * std::atan2(num, den);
-  }
-  return sum / (4.0 * M_PI);
-}
+double winding_number(const loom::Mesh& m, const Vec3& p) { return loom::test_oracle::mesh_winding_number(m, p); }
 
 /// Nearest hit distance of the ray o + t·dir (t > 0) with any triangle, or +inf.
 double ray_hit(const loom::Mesh& m, const Vec3& o, const Vec3& dir) {

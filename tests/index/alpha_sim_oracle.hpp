@@ -14,63 +14,16 @@
 #include <utility>
 #include <vector>
 
+#include "common/brute_geometry.hpp"
+
 namespace loom::alpha_sim_oracle {
 
-/// Closest point to p on triangle abc (Ericson, Real-Time Collision Detection §5.1.5).
-inline Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const Vec3 bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
-  const Vec3 cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-  const double den = va + vb + vc;
-  if (!(std::abs(den) > 0)) {  // zero-area triangle: nearest of its three edges
-    Vec3 best = a;
-    for (auto [s, e] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
-      const Vec3 d = e - s;
-      const double l2 = d.squaredNorm();
-      const double t = l2 > 0 ? std::clamp((p - s).dot(d) / l2, 0.0, 1.0) : 0.0;
-      const Vec3 q = s + t * d;
-      if ((q - p).squaredNorm() < (best - p).squaredNorm()) best = q;
-    }
-    return best;
-  }
-  const double v = vb / den, w = vc / den;
-  return a + ab * v + ac * w;
-}
 
-inline double distance_to_mesh(const Vec3& p, const Mesh& m) {
-  double best = std::numeric_limits<double>::infinity();
-  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
-    const auto c = m.corners(t);
-    best = std::min(best, (closest_on_triangle(p, c[0], c[1], c[2]) - p).squaredNorm());
-  }
-  return std::sqrt(best);
-}
+/// Unsigned distance from p to the surface of m (brute force over every triangle).
+inline double distance_to_mesh(const Vec3& p, const Mesh& m) { return test_oracle::mesh_distance(m, p); }
 
-/// Generalized winding number of m about p (van Oosterom–Strackee solid angles / 4π).
-inline double winding_number(const Vec3& p, const Mesh& m) {
-  double sum = 0.0;
-  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
-    const auto c = m.corners(t);
-    const Vec3 a = c[0] - p, b = c[1] - p, d = c[2] - p;
-    const double la = a.norm(), lb = b.norm(), ld = d.norm();
-    const double num = a.dot(b.cross(d));
-    const double den = la * lb * ld + a.dot(b) * ld + b.dot(d) * la + d.dot(a) * lb;
-    sum += 2.0 * std::atan2(num, den);
-  }
-  return sum / (4.0 * M_PI);
-}
+/// Generalized winding number of m about p.
+inline double winding_number(const Vec3& p, const Mesh& m) { return test_oracle::mesh_winding_number(m, p); }
 
 /// Dense samples of every triangle of m: a barycentric grid of order `grid` (its corners and
 /// points along its edges included).

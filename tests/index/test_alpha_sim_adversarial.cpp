@@ -34,6 +34,8 @@
 #include <utility>
 #include <vector>
 
+#include "common/run_loom.hpp"
+
 using namespace loom;
 using namespace loom::alpha_sim_oracle;
 
@@ -538,22 +540,7 @@ TEST(AlphaSimAdversarial, ManyShellsAndRandomTurns) {
 
 namespace {
 
-struct CliRun {
-  int status = -1;
-  std::string out;
-};
-
-CliRun run_loom(const std::string& args) {
-  CliRun r;
-  const std::string cmd = std::string(LOOM_EXE) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), p)) r.out += buf.data();
-  const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
+using loom::testing::run_loom;
 
 std::string slurp(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -584,7 +571,7 @@ void check_cli(const std::string& test, const std::vector<std::pair<std::string,
   const auto dir = std::filesystem::temp_directory_path() / ("loom_alpha_adv_" + test);
   const auto scene = write_scene(dir, parts, dim_pre);
   const auto out = dir / "out";
-  const CliRun r = run_loom("simplify " + scene.string() + " --quiet --out " + out.string());
+  const loom::testing::LoomRun r = run_loom("simplify " + scene.string() + " --quiet --out " + out.string());
   ASSERT_EQ(r.status, 0) << r.out;
   const std::string text = slurp(out / "simplify.json");
   EXPECT_EQ(text.find("null"), std::string::npos) << text;

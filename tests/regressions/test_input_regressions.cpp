@@ -27,6 +27,7 @@
 #include "core/io/tessellation_cache.hpp"
 #include "routing/cable_geometry.hpp"
 #include "routing/point_cloud_io.hpp"
+#include "common/run_loom.hpp"
 
 namespace {
 
@@ -63,13 +64,8 @@ std::string input_error(F f) {
 
 /// Runs `loom ARGS` (stderr merged) and returns exit status and output.
 std::pair<int, std::string> loom(const std::string& args) {
-  std::string out;
-  FILE* p = popen((std::string(LOOM_EXE) + " " + args + " 2>&1").c_str(), "r");
-  if (!p) return {-1, out};
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+  auto r = loom::testing::run_loom(args);
+  return {r.status, std::move(r.out)};
 }
 
 const std::string kHarness = R"(<harness name="h" units="mm">

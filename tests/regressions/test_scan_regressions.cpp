@@ -14,6 +14,8 @@
 #include <filesystem>
 #include <string>
 
+#include "common/run_loom.hpp"
+
 namespace loom {
 namespace {
 using namespace scan_test;
@@ -172,13 +174,8 @@ TEST(ScanRegression, TwoSeparateCablesExitTwoNamingTheFile) {
   std::filesystem::create_directories(dir);
   const auto file = dir / "two.ply";
   write_point_cloud_ply(file, two_cables());
-  std::string out;
-  FILE* p = popen((std::string(LOOM_EXE) + " scan " + file.string() + " --quiet --out " + (dir / "out").string() + " 2>&1").c_str(), "r");
-  ASSERT_NE(p, nullptr);
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int st = pclose(p);
-  EXPECT_EQ(WIFEXITED(st) ? WEXITSTATUS(st) : -1, 2) << out;
+  const auto [status, out] = loom::testing::run_loom("scan " + file.string() + " --quiet --out " + (dir / "out").string());
+  EXPECT_EQ(status, 2) << out;
   EXPECT_NE(out.find("two.ply"), std::string::npos) << out;
   EXPECT_NE(out.find("more than one cable"), std::string::npos) << out;
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "report.json"));

@@ -11,6 +11,7 @@
 #include "core/harness.hpp"
 #include "core/harness_topology.hpp"
 #include "core/part.hpp"
+#include "common/brute_geometry.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -73,27 +74,7 @@ inline Spline derivative(const Spline& s) {
   return d;
 }
 
-/// Exact distance from p to triangle abc (closest point by Voronoi regions).
-inline double point_triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return (p - a).norm();
-  const Vec3 bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return (p - b).norm();
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (p - (a + d1 / (d1 - d3) * ab)).norm();
-  const Vec3 cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return (p - c).norm();
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + d2 / (d2 - d6) * ac)).norm();
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return (p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
-  const double den = 1.0 / (va + vb + vc);
-  return (p - (a + ab * (vb * den) + ac * (vc * den))).norm();
-}
+using loom::test_oracle::point_triangle_distance;
 
 /// Distance from p to a part: 0 inside a closed box part (its vertex box), else the
 /// smallest exact triangle distance.
