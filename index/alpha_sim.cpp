@@ -1383,7 +1383,10 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   if (first_non_finite_vertex(part.mesh) >= 0)
     throw std::invalid_argument("alpha-sim: part '" + part.name + "' has a non-finite vertex");
 
-  // Too thin along a projection normal: the part is a sheet, extrusions would be flat.
+  // Too thin along a projection normal: the part is a sheet, extrusions would be flat. Thin
+  // along every normal, it is smaller than the cable scale, not a sheet: the reason says so.
+  const double thin = opt.thin_factor * opt.dim_pre;
+  std::vector<double> extents;
   for (const auto& s : specs) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (const auto& f : part.mesh.triangles)
@@ -1392,12 +1395,18 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
         lo = std::min(lo, d);
         hi = std::max(hi, d);
       }
-    if (hi - lo < opt.thin_factor * opt.dim_pre) {
-      keep_original(out, part, AlphaSimStatus::Thin,
-                    "extent along the " + s.name + " normal is " + full_precision(hi - lo) +
-                        " < " + full_precision(opt.thin_factor * opt.dim_pre) + " (a sheet): original kept");
-      return finish();
-    }
+    extents.push_back(hi - lo);
+  }
+  const auto thinnest = std::min_element(extents.begin(), extents.end());
+  if (thinnest != extents.end() && *thinnest < thin) {
+    const bool small = std::all_of(extents.begin(), extents.end(), [&](double e) { return e < thin; });
+    const std::string& plane = specs[static_cast<std::size_t>(thinnest - extents.begin())].name;
+    keep_original(out, part, AlphaSimStatus::Thin,
+                  small ? "extent along every projection normal is below " + full_precision(thin) +
+                              " (the part is smaller than the cable scale, nothing to simplify): original kept"
+                        : "extent along the " + plane + " normal is " + full_precision(*thinnest) + " < " +
+                              full_precision(thin) + " (a sheet): original kept");
+    return finish();
   }
 
   // The sample count is known before sampling: refuse what would not fit in memory.
@@ -1771,7 +1780,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     keep_original(out, part, AlphaSimStatus::Failed,
                   "rounding the simplified mesh to float32 (binary STL) moved a vertex by " +
                       full_precision(r.float_rounding) + " > the " + full_precision(rounding_reserve) +
-                      " of the containment tolerance kept for it (the part lies far from the origin): original kept");
+                      " of the containment tolerance kept for it (the part lies far from the origin for its size): original kept");
     return finish();
   }
   r.closed_after = watertight;
