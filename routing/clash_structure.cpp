@@ -484,21 +484,22 @@ class StructureTracer {
               obs.end());
   }
 
-  /// Arc length of the attachment's port: the cable's start or its end.
-  static double port_s(const PartAttachment& at) { return at.s_begin <= 0.0 ? at.s_begin : at.s_end; }
+  /// True if the attachment's port is the cable's first (its range starts at s = 0), false
+  /// for its last.
+  static bool port_at_start(const PartAttachment& at) { return at.s_begin <= 0.0; }
 
   /// Where the lift off a port on a face ends: the first tolerance of the exit, over which
   /// the axis may touch the part it leaves (the port is on its surface, up to rounding and
   /// the tolerance). NaN for a part holding its port (no lift: the exit leaves the part).
   double lift_end(const PartAttachment& at) const {
     if (holds_port(at, ctx_.tol)) return std::numeric_limits<double>::quiet_NaN();
-    return at.s_begin <= 0.0 ? at.s_begin + ctx_.tol : at.s_end - ctx_.tol;
+    return port_at_start(at) ? at.s_begin + ctx_.tol : at.s_end - ctx_.tol;
   }
 
   /// True if the step [sa, sb] lies past the lift off the attachment's port.
   bool exit_lifted(const PartAttachment& at, double sa, double sb) const {
     const double slack = kTouchRel * (1.0 + L_);
-    return port_s(at) == at.s_begin ? sa >= lift_end(at) - slack : sb <= lift_end(at) + slack;
+    return port_at_start(at) ? sa >= lift_end(at) - slack : sb <= lift_end(at) + slack;
   }
 
   bool is_inside(int part) const {

@@ -58,8 +58,7 @@ constexpr double kBridgeLength = 2.5;
 /// a gap of length g in a cable bent to radius R turns by g / 2R from the ends' tangents;
 /// 80° is a gap of 0.9 R·π, beyond which a gap cannot be told from two cables lying side by
 /// side, whose bridge joins their ends across (≥ 90°).
-constexpr double kPiScan = 3.14159265358979323846;
-constexpr double kMaxBridgeTurn = 80.0 * kPiScan / 180.0;
+constexpr double kMaxBridgeTurn = 80.0 * M_PI / 180.0;
 constexpr double kBridgeTangentLength = 2.0;
 /// A given diameter may differ from the one the cloud's cross-sections fit by this fraction
 /// of it (nominal against measured sheath); beyond, the given one is refused.
@@ -309,8 +308,8 @@ class BlockFitter {
     std::size_t total = 0;
     for (std::size_t i = 0; i < n_; ++i) {
       if (w_[i] <= 0.0) continue;
-      const double ang = std::atan2(nrm_[i].dot(e2), nrm_[i].dot(e1)) + kPiScan;  // 0 .. 2π
-      const auto k = std::min<std::size_t>(kArcSectors - 1, static_cast<std::size_t>(ang / (2.0 * kPiScan) * kArcSectors));
+      const double ang = std::atan2(nrm_[i].dot(e2), nrm_[i].dot(e1)) + M_PI;  // 0 .. 2π
+      const auto k = std::min<std::size_t>(kArcSectors - 1, static_cast<std::size_t>(ang / (2.0 * M_PI) * kArcSectors));
       ++count[k];
       ++total;
     }
@@ -782,7 +781,7 @@ bool build_chain(const std::vector<Vec3>& pts, const std::vector<Vec3>& sub, con
       if (dir) turn = std::max(turn, std::acos(std::clamp(dir->dot(across.normalized()), -1.0, 1.0)));
     if (turn > kMaxBridgeTurn) {
       why = "the cloud holds separate pieces that do not continue each other (a gap of " +
-            std::to_string(across.norm()) + " between them turns by " + std::to_string(turn * 180.0 / kPiScan) +
+            std::to_string(across.norm()) + " between them turns by " + std::to_string(turn * 180.0 / M_PI) +
             " degrees): more than one cable, or a cable and another object";
       return false;
     }
