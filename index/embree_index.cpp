@@ -701,25 +701,35 @@ void EmbreeIndex::inside_scan(const Vec3& p, bool first_only, std::vector<int>& 
   }
   FlushDenormals ftz;
   const Vec3 pc = p - centre_;
-  const double back = 4.0 * float_pad(p, 0.0);
-  std::vector<int> votes_in(cand.size(), 0);
-  int valid_rays = 0;
+  std::vector<int> votes_in(cand.size(), 0), valid(cand.size(), 0);
+  std::vector<int> ahead(cand.size(), 0), behind(cand.size(), 0);
+  std::vector<char> grazed(cand.size(), 0);
   std::vector<std::pair<unsigned, unsigned>> hits;
-  std::vector<int> crossings(cand.size(), 0);
-  for (int k = 0; k < kMaxInsideDirs && valid_rays < opt_.inside_rays; ++k) {
-    const Vec3 u = kInsideDirs[k].normalized();
-    // Start the float ray `back` behind p so that a crossing right at p, which float
-    // rounding of the origin could hide, is still collected; the double test below
-    // decides on which side of p each crossing lies.
-    const Vec3 org = pc - back * u;
-    // Only crossings of the candidates count, and p lies in each candidate's box: the ray
-    // can stop where it leaves the last of them instead of crossing the whole scene.
-    double exit = 0.0;
+  // A candidate still short of its rays (the ones the winding number decides need none).
+  auto wanting = [&]() {
     for (std::size_t i = 0; i < cand.size(); ++i)
-      if (!by_winding[i]) exit = std::max(exit, box_exit_distance(parts_[cand[i]].bounds, p, u));
+      if (!by_winding[i] && valid[i] < opt_.inside_rays) return true;
+    return false;
+  };
+  for (int k = 0; k < kMaxInsideDirs && wanting(); ++k) {
+    const Vec3 u = kInsideDirs[k].normalized();
+    // The ray runs along the whole line through p within the candidates' boxes, both
+    // ways: a closed part crosses a line an even number of times, so an odd count shows a
+    // crossing Embree's float test missed. Embree may report neither of two triangles
+    // when the ray passes within its rounding of their common edge (embree issue #387),
+    // and a crossing nobody reports cannot be seen as grazing. p lies in each candidate's
+    // box, so the line leaves the last of them within `exit` ahead and `back` behind.
+    double exit = 0.0, back = 0.0;
+    for (std::size_t i = 0; i < cand.size(); ++i)
+      if (!by_winding[i]) {
+        exit = std::max(exit, box_exit_distance(parts_[cand[i]].bounds, p, u));
+        back = std::max(back, box_exit_distance(parts_[cand[i]].bounds, p, -u));
+      }
     // Float rounding of the ray test, across the ray, anywhere along it (the bound that
-    // pads every culling radius).
-    const double margin = float_pad(p, exit);
+    // pads every culling radius); the ray starts that much farther back and ends farther on.
+    const double margin = float_pad(p, std::max(exit, back));
+    back += 4.0 * margin;
+    const Vec3 org = pc - back * u;
     hits.clear();
     CollectContext cc;
     rtcInitIntersectContext(&cc.ctx);
@@ -733,7 +743,7 @@ void EmbreeIndex::inside_scan(const Vec3& p, bool first_only, std::vector<int>& 
     rh.ray.dir_y = static_cast<float>(u.y());
     rh.ray.dir_z = static_cast<float>(u.z());
     rh.ray.tnear = 0.0f;
-    rh.ray.tfar = to_float_up(back + exit + 4.0 * float_pad(p, exit));
+    rh.ray.tfar = to_float_up(back + exit + 4.0 * margin);
     rh.ray.time = 0.0f;
     rh.ray.mask = 0xFFFFFFFFu;
     rh.ray.id = 0;
@@ -743,30 +753,32 @@ void EmbreeIndex::inside_scan(const Vec3& p, bool first_only, std::vector<int>& 
     rtcIntersect1(impl_->scene, &cc.ctx, &rh);
     std::sort(hits.begin(), hits.end());
     hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
-    std::fill(crossings.begin(), crossings.end(), 0);
-    bool grazing = false;
+    std::fill(ahead.begin(), ahead.end(), 0);
+    std::fill(behind.begin(), behind.end(), 0);
+    std::fill(grazed.begin(), grazed.end(), 0);
     for (const auto& h : hits) {
       const auto it = std::find(cand.begin(), cand.end(), h.first);
       if (it == cand.end() || by_winding[it - cand.begin()]) continue;
+      const std::size_t i = static_cast<std::size_t>(it - cand.begin());
       const auto c = parts_[h.first].corners(h.second);
       const LineCrossing x = line_crossing(p, u, c[0], c[1], c[2], margin);
-      if (x.status == LineCrossing::Grazing) {
-        grazing = true;  // the ray passes by an edge or vertex, or lies in the plane
-        break;
-      }
-      if (x.status == LineCrossing::Through && x.t == 0.0) {
-        grazing = true;  // p on the surface
-        break;
-      }
-      if (x.status == LineCrossing::Through && x.t > 0.0) ++crossings[it - cand.begin()];
+      // Grazing: the ray passes by an edge or vertex, or lies in the plane; t = 0: p on the surface.
+      if (x.status == LineCrossing::Grazing || (x.status == LineCrossing::Through && x.t == 0.0)) grazed[i] = 1;
+      else if (x.status == LineCrossing::Through) ++(x.t > 0.0 ? ahead[i] : behind[i]);
     }
-    if (grazing) continue;
-    ++valid_rays;
-    for (std::size_t i = 0; i < cand.size(); ++i) votes_in[i] += crossings[i] % 2;
+    // Each candidate counts the ray only if it crossed that part cleanly and an even number
+    // of times: another part's edge near the ray says nothing about this one.
+    for (std::size_t i = 0; i < cand.size(); ++i) {
+      if (by_winding[i] || grazed[i] || (ahead[i] + behind[i]) % 2 != 0) continue;
+      ++valid[i];
+      votes_in[i] += ahead[i] % 2;
+    }
   }
   // In candidate order, as every answer here: first_only stops at the first part that holds p.
+  // A candidate no ray crossed cleanly (p on its surface, or a part open in spite of its
+  // flag) is decided by the winding number.
   for (std::size_t i = 0; i < cand.size(); ++i) {
-    const bool in = by_winding[i] || valid_rays == 0 ? winding_inside(cand[i]) : 2 * votes_in[i] > valid_rays;
+    const bool in = by_winding[i] || valid[i] == 0 ? winding_inside(cand[i]) : 2 * votes_in[i] > valid[i];
     if (in && holds(i)) return;
   }
 }

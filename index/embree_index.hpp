@@ -7,11 +7,13 @@
 /// only culls, with its search radius padded by a bound on the float rounding, so
 /// distances are exact up to double rounding. Inside the callback a triangle is first
 /// rejected by its box (a lower bound, so still exact), and its zero-area flag, stored at
-/// build, spares the exact kernel its degeneracy test. Inside tests cast several rays (majority
-/// vote) and count crossings of closed parts, each decided in double; a ray whose crossing
-/// lies within the float rounding of Embree's ray test of an edge or vertex (where Embree
-/// may report it on the neighbouring triangle, or on neither) is discarded, and if every
-/// ray is — or the part is too small for float rays at its distance from the centre — the
+/// build, spares the exact kernel its degeneracy test. Inside tests cast several lines
+/// (majority vote) through each candidate closed part's whole box and count its crossings,
+/// each decided in double; for that part a line is discarded if a crossing lies within the
+/// float rounding of Embree's ray test of an edge or vertex (Embree may report it on the
+/// neighbouring triangle, or on neither) or if the count is odd (a closed part crosses a
+/// line an even number of times: a crossing nobody reported, or a hole); if every line is
+/// — or the part is too small for float rays at its distance from the centre — the
 /// generalized winding number decides, in double (a point on the surface is not inside).
 
 #include "core/part.hpp"
@@ -32,9 +34,10 @@ struct EmbreeOptions {
   /// -1 = automatic: medium, low from 500k triangles on (~3x faster build, ~30% slower
   /// closest queries: the right trade when one build serves one audit).
   int build_quality = -1;
-  /// Rays cast for an inside test; the answer is the majority of the rays that do not
-  /// graze an edge or vertex (odd, ≥ 1). One is exact on a watertight mesh; the majority
-  /// guards real meshes with holes.
+  /// Lines cast per candidate part for an inside test; the answer is the majority of the
+  /// lines that cross the part cleanly (no edge or vertex grazed, an even count; odd, ≥ 1).
+  /// One is exact on a watertight mesh unless Embree misses two crossings on one line; the
+  /// majority guards that and real meshes with holes.
   int inside_rays = 3;
 };
 
