@@ -20,7 +20,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <limits>
 #include <memory>
 #include <string>
 
@@ -89,9 +88,7 @@ void print_summary(const AuditReport& rep, const std::filesystem::path& report_p
 }
 
 int run_audit_command(const AuditFlags& f) {
-  auto targets = view_output_files(f.out);
-  targets.push_back(std::filesystem::path(f.out) / "report.json");
-  OutputSet outputs(f.out, targets);  // every target checked before any work; all replaced together
+  // The flags first: a usage error creates no output directory.
   AuditOptions opt;
   if (f.method == "certified") {
     opt.check.method = ClashMethod::Certified;
@@ -106,12 +103,24 @@ int run_audit_command(const AuditFlags& f) {
     opt.check.method = ClashMethod::Discrete;
     opt.check.use_index = false;
   }
+  // Each method has its own accuracy setting; the other's would be ignored without a word.
+  // (A given value is > 0: the options' checks refuse 0, their "not given" value.)
+  if (f.tolerance > 0.0 && opt.check.method == ClashMethod::Discrete)
+    throw InputError({"", 0, "--tolerance"}, "applies to the certified method only; the discrete method" +
+                                                 std::string(f.no_index ? " (--no-index)" : "") +
+                                                 " is not certified and samples at --spacing");
+  if (f.spacing > 0.0 && opt.check.method == ClashMethod::Certified)
+    throw InputError({"", 0, "--spacing"}, "applies to the discrete method only (--method discrete or --no-index); "
+                                           "the certified method places its samples to meet --tolerance");
   opt.check.spacing = f.spacing;
   opt.check.tolerance = f.tolerance;
   opt.check.threads = f.threads;
   if (!f.routes.empty()) opt.routes = f.routes;
   RenderOptions render;
   parse_render_size(f.render_size, "--render-size", render);
+  auto targets = view_output_files(f.out);
+  targets.push_back(std::filesystem::path(f.out) / "report.json");
+  OutputSet outputs(f.out, targets);  // every target checked before any work; all replaced together
   ProgressBar bar(stderr, f.quiet || f.json);
   opt.progress = bar.fn();
   render.progress = bar.fn();
@@ -145,7 +154,7 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--tolerance", f->tolerance, "Certified accuracy (default: smallest cable radius / 100)")
       ->check(finite_number(0.0, false));
   cmd->add_option("--threads", f->threads, "Worker threads (default: all cores)")
-      ->check(whole_number(1, std::numeric_limits<int>::max()));
+      ->check(whole_number(1, kMaxThreads));
   cmd->add_option("--out", f->out, "Output directory for report.json")->check(non_empty_path())->capture_default_str();
   cmd->add_option("--render-size", f->render_size, "Size of render.png, WIDTHxHEIGHT")->capture_default_str();
   cmd->add_flag("--json", f->json, "Print the report as JSON instead of the summary");

@@ -8,6 +8,7 @@
 #include "core/io/scene_load.hpp"
 #include "core/progress.hpp"
 #include "core/units.hpp"
+#include "routing/audit.hpp"
 #include "routing/render.hpp"
 
 #include <CLI/CLI.hpp>
@@ -65,7 +66,7 @@ int run_render(const RenderFlags& f) {
   lo.progress = bar.fn();
   opt.progress = bar.fn();
   Scene scene = load_scene(f.scene, lo);
-  if (!f.routes.empty()) apply_routes(scene, f.routes);
+  if (!f.routes.empty()) apply_matching_routes(scene, f.routes);
   nlohmann::json report = nlohmann::json::object();
   if (!f.report.empty()) {
     std::ifstream in(f.report);

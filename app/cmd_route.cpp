@@ -64,11 +64,11 @@ void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
 }  // namespace
 
 int run_route(const std::string& scene_path, const RouteCommandOptions& o) {
+  RenderOptions render;  // a bad size is a usage error: no output directory is made
+  if (!o.render_size.empty()) parse_render_size(o.render_size, "--render-size", render);
   auto targets = route_output_files(o.out);
   for (auto& p : view_output_files(o.out)) targets.push_back(std::move(p));
   OutputSet outputs(o.out, targets);  // every target checked before any work; all replaced together
-  RenderOptions render;
-  if (!o.render_size.empty()) parse_render_size(o.render_size, "--render-size", render);
   ProgressBar bar(stderr, o.quiet || o.json);
   render.progress = bar.fn();
   SceneLoadOptions lo;
@@ -111,7 +111,7 @@ void add_route_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--seed", o->seed, "Random seed (default: scene [routing])")
       ->check(whole_number(0, std::numeric_limits<std::uint32_t>::max()));
   cmd->add_option("--threads", o->threads, "Audit threads (default: all cores)")
-      ->check(whole_number(1, std::numeric_limits<int>::max()));
+      ->check(whole_number(1, kMaxThreads));
   cmd->add_option("--render-size", o->render_size, "Size of render.png, WIDTHxHEIGHT")->capture_default_str();
   cmd->add_flag("--simplify", o->simplify, "Plan among α-simplified parts instead of the exact ones (α-SIM, DESIGN §6)");
   cmd->add_flag("--json", o->json, "Print the report as JSON");

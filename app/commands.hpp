@@ -11,6 +11,11 @@ class App;
 
 namespace loom::app {
 
+/// Most worker threads `--threads` takes (route, audit). Far above any machine's cores, and
+/// far below the task-arena size at which TBB itself crashes: `--threads 100000` (a TBB
+/// arena of 10⁵ slots) ended in a segmentation fault inside tbb::task_arena::terminate.
+constexpr int kMaxThreads = 1024;
+
 void add_info_command(CLI::App& app, int& exit_code);
 /// `loom simplify`: α-SIM per part → DIR/<part>.stl + DIR/simplify.json (issue 4).
 void add_simplify_command(CLI::App& app, int& exit_code);

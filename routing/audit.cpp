@@ -214,13 +214,78 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
   return rep;
 }
 
+namespace {
+
+/// "file:line" of a harness element, for messages that point at a second file.
+std::string file_line(const Harness& h, int line) {
+  return h.source_file + (line > 0 ? ":" + std::to_string(line) : std::string());
+}
+
+/// The two ports of a cable as an unordered pair (either end may come first in a file).
+std::pair<std::string, std::string> port_pair(const Cable& c) {
+  return std::minmax(c.ports[0], c.ports[1]);
+}
+
+/// Refuses a requested certified tolerance at or above the thinnest cable's radius: a
+/// certified audit may miss contacts shallower than the tolerance, and at r a centerline
+/// lying on a part's surface (clearance −r) is one of them.
+void check_requested_tolerance(const Harness& h, const ClashRequest& req) {
+  if (req.method != ClashMethod::Certified || !(req.tolerance > 0.0) || h.cables.empty()) return;
+  const auto thinnest = std::min_element(h.cables.begin(), h.cables.end(), [](const Cable& a, const Cable& b) {
+    return a.radius() < b.radius();
+  });
+  if (req.tolerance < thinnest->radius()) return;
+  throw InputError({"", 0, "--tolerance"},
+                   full_precision(req.tolerance) + " is not below the radius " + full_precision(thinnest->radius()) +
+                       " of the thinnest cable '" + thinnest->id +
+                       "': a certified audit to it could miss that cable lying on a part's surface; give a "
+                       "tolerance below the radius (default: radius / 100)");
+}
+
+}  // namespace
+
+void check_routes_match(const Harness& designed, const Harness& routes) {
+  const std::string& file = routes.source_file;
+  for (const Cable& c : routes.cables) {
+    const SourceLocation where{file, c.line, "cable '" + c.id + "'"};
+    const int d = designed.find_cable(c.id);
+    if (d < 0)
+      throw InputError(where, "not a cable of the scene's harness " + designed.source_file +
+                                  " (routes for another harness?)");
+    const Cable& want = designed.cables[static_cast<std::size_t>(d)];
+    const std::string scene_says = " in the scene's harness (" + file_line(designed, want.line) + ")";
+    if (port_pair(c) != port_pair(want))
+      throw InputError(where, "joins ports " + c.ports[0] + " and " + c.ports[1] + ", but " + want.ports[0] + " and " +
+                                  want.ports[1] + scene_says);
+    if (c.physical.diameter != want.physical.diameter)
+      throw InputError(where, "diameter " + full_precision(c.physical.diameter) + ", but " +
+                                  full_precision(want.physical.diameter) + scene_says);
+    if (c.physical.min_bend_radius != want.physical.min_bend_radius)
+      throw InputError(where, "min_bend_radius " + full_precision(c.physical.min_bend_radius) + ", but " +
+                                  full_precision(want.physical.min_bend_radius) + scene_says);
+  }
+  for (const Cable& want : designed.cables)
+    if (routes.find_cable(want.id) < 0)
+      throw InputError({file, 0, "harness '" + routes.name + "'"},
+                       "has no cable '" + want.id + "' of the scene's harness (" + file_line(designed, want.line) +
+                           "): it would go unchecked");
+}
+
+void apply_matching_routes(Scene& scene, const std::filesystem::path& routes) {
+  std::optional<Harness> designed;
+  if (scene.has_harness) designed = std::move(scene.harness);
+  apply_routes(scene, routes);
+  if (designed) check_routes_match(*designed, scene.harness);
+}
+
 AuditReport audit_scene_file(const std::filesystem::path& scene_file, const AuditOptions& opt, Scene* loaded) {
   const auto t0 = std::chrono::steady_clock::now();
   SceneLoadReport load_rep;
   SceneLoadOptions load_opt;
   load_opt.progress = opt.progress;
   Scene scene = load_scene(scene_file, load_opt, &load_rep);
-  if (opt.routes) apply_routes(scene, *opt.routes);
+  if (opt.routes) apply_matching_routes(scene, *opt.routes);
+  if (scene.has_harness) check_requested_tolerance(scene.harness, opt.check);
   const double load_ms = ms_since(t0);
   AuditReport rep = run_audit(scene, opt);
   rep.load_ms = load_ms;

@@ -76,13 +76,27 @@ std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCa
 std::vector<std::string> attach_ports(const Harness& h, const std::vector<Part>& parts, double routing_clearance,
                                       std::vector<CableInput>& inputs, const ObstacleIndex* index = nullptr);
 
+/// Checks that `routes` (read from a --routes file) routes `designed`, the scene's harness:
+/// the same cables by id, each joining the same two ports with the same diameter and
+/// minimum bend radius (ports and branch points may move: a what-if is a route too). A
+/// cable missing from the routes would go unchecked, and one the scene does not have would
+/// be checked against the wrong harness: each difference throws InputError naming the
+/// routes file, the line and the cable.
+void check_routes_match(const Harness& designed, const Harness& routes);
+
+/// apply_routes (the routes file replaces the scene's harness), then check_routes_match
+/// against the harness the scene had, if any: what `--routes FILE` does in every command.
+void apply_matching_routes(Scene& scene, const std::filesystem::path& routes);
+
 /// Audits a loaded scene (its parts and harness). Builds the index unless the request is
 /// the brute-force baseline (use_index = false, discrete). Throws InputError for an
 /// inconsistent harness.
 AuditReport run_audit(const Scene& scene, const AuditOptions& opt);
 
-/// Loads the scene file (timed as timing_ms.load), applies --routes, and audits it.
-/// Throws InputError (exit 2) for bad input. `loaded`, if given, receives the audited scene
+/// Loads the scene file (timed as timing_ms.load), applies --routes (apply_matching_routes),
+/// and audits it. Throws InputError (exit 2)
+/// for bad input, and for a requested certified tolerance that is not below the thinnest
+/// cable's radius (it could miss a cable lying on a part's surface). `loaded`, if given, receives the audited scene
 /// (parts and the harness actually checked), e.g. to draw it.
 AuditReport audit_scene_file(const std::filesystem::path& scene_file, const AuditOptions& opt,
                              Scene* loaded = nullptr);
