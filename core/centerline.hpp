@@ -90,7 +90,8 @@ class LazyTable {
 };
 }  // namespace detail
 
-/// A B-spline curve of degree p with a clamped knot vector.
+/// A B-spline curve of degree p. Built here its knot vector is clamped; one taken as given
+/// may have any non-decreasing knots (the curve lives on [knots[p], knots[n + 1]]).
 class Centerline {
  public:
   Centerline() = default;

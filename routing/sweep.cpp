@@ -357,6 +357,17 @@ namespace {
 
 using Tri = std::array<std::uint32_t, 3>;
 
+/// True if the tube folds between neighbouring rings a → b: some point of one ring lies
+/// behind the plane of the other (the facets between them cross). Over each ring the
+/// signed distance from the other's plane is smallest at radius·sin(turn) below its centre's,
+/// so for a step Δs around a bend of radius R this is R < r, whatever Δs; a kink or a
+/// reversal of the centerline folds at any radius.
+bool rings_fold(const SweepSection& a, const SweepSection& b) {
+  const Vec3 step = b.centre - a.centre;
+  const double sine = a.tangent.cross(b.tangent).norm();
+  return step.dot(a.tangent) < b.radius * sine || step.dot(b.tangent) < a.radius * sine;
+}
+
 /// Triangle mesh of out.sections' rings (n vertices each, odd rings rotated by π/n) with
 /// fan end caps, written over out.mesh (its storage reused). Sizes are known up front:
 /// vertices and triangles are written in place, indices by formula.
@@ -368,6 +379,14 @@ void mesh_sections(const SweepOptions& opt, double max_turn, SweepResult& out) {
   out.circumferential = n;
   out.rings = static_cast<int>(rings.size());
   out.max_frame_turn = max_turn;
+  out.folded = false;
+  out.fold_s = 0.0;
+  for (std::size_t i = 0; i + 1 < rings.size(); ++i)
+    if (rings_fold(rings[i], rings[i + 1])) {
+      out.folded = true;
+      out.fold_s = rings[i].s;
+      break;
+    }
   Mesh& m = out.mesh;
   const std::size_t nr = rings.size();
   const std::size_t un = static_cast<std::size_t>(n);
@@ -484,15 +503,37 @@ double canal_section_list(const Centerline& c, const std::function<double(double
   return sections(c, law, true, opt, "sweep_canal", rings);
 }
 
+/// True for a centerline of zero length (all its points one point, e.g. an exact <bspline>
+/// whose control points coincide). Its cable is the ball of radius r there (DESIGN §5), which
+/// sweep_junction meshes; rings along it would all coincide in a flat, zero-volume disc.
+bool zero_length(const Centerline& c) { return !c.empty() && c.length() == 0.0; }
+
+/// The ball of a zero-length cable, within the caller's triangle budget.
+void sweep_ball(const Centerline& c, double radius, const SweepOptions& opt, SweepResult& out) {
+  out = sweep_junction(c.position(c.u_min()), radius, opt);
+  if (out.mesh.triangles.size() > opt.max_triangles)
+    throw std::invalid_argument("sweep: the ball of a zero-length centerline would have " +
+                                std::to_string(out.mesh.triangles.size()) + " triangles, more than the " +
+                                std::to_string(opt.max_triangles) + " allowed");
+}
+
 }  // namespace
 
 void sweep_tube(const Centerline& c, double radius, const SweepOptions& opt, SweepResult& out) {
+  if (zero_length(c)) {
+    sweep_ball(c, radius, opt, out);
+    return;
+  }
   const double turn = tube_section_list(c, radius, opt, out.sections);
   mesh_sections(opt, turn, out);
 }
 
 void sweep_canal(const Centerline& c, const std::function<double(double)>& radius_of_s, const SweepOptions& opt,
                  SweepResult& out) {
+  if (zero_length(c) && radius_of_s) {
+    sweep_ball(c, radius_of_s(0.0), opt, out);
+    return;
+  }
   const double turn = canal_section_list(c, radius_of_s, opt, out.sections);
   mesh_sections(opt, turn, out);
 }

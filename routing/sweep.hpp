@@ -47,14 +47,23 @@ struct SweepResult {
   int circumferential = 0;  ///< vertices per ring
   int rings = 0;            ///< rings along the curve
   double max_frame_turn = 0.0;  ///< largest angle between adjacent frames (radians)
+  /// True if the tube folds over itself between two neighbouring rings: the centerline
+  /// bends there more tightly than the tube's radius (κ·r > 1 at the ring spacing; kinks
+  /// and folds of the centerline included), so part of one ring lies behind the plane of
+  /// the next and the facets between them cross, turned inside out. The mesh is still
+  /// closed; it is not a valid tube surface there.
+  bool folded = false;
+  double fold_s = 0.0;  ///< arc length of the ring where the first fold starts (0 if none)
   /// The cross-section of each ring, in order: ring i's vertices are
   /// mesh.vertices[i·circumferential, (i + 1)·circumferential) (empty for a junction).
   std::vector<SweepSection> sections;
 };
 
-/// Tube of constant radius r around the centerline.
+/// Tube of constant radius r around the centerline. A centerline of zero length (all its
+/// control points one point) gives the ball of radius r there, as sweep_junction does.
 SweepResult sweep_tube(const Centerline& c, double radius, const SweepOptions& opt = {});
-/// Canal surface of radius r(s), s = arc length from the start.
+/// Canal surface of radius r(s), s = arc length from the start (the ball of radius r(0)
+/// for a centerline of zero length).
 SweepResult sweep_canal(const Centerline& c, const std::function<double(double)>& radius_of_s,
                         const SweepOptions& opt = {});
 /// sweep_tube into `out`, which it overwrites (the same result as the returning form). The

@@ -71,7 +71,8 @@ double TubeValidityChecker::clearance(const ob::State* s) const {
   if (counters_ != nullptr) count(&counters_->clearance_queries);
   const Vec3 p = state_point(s);
   const ClosestHit hit = index_.closest(p, horizon_);
-  if (!hit.found()) return horizon_ - required_;
+  // Nothing within the horizon: clear up to it, unless the point lies deep inside a part.
+  if (!hit.found()) return index_.inside(p) ? -required_ : horizon_ - required_;
   if (hit.distance > required_ && index_.inside(p)) return -required_;
   return hit.distance - required_;
 }
