@@ -18,7 +18,8 @@ struct SegmentUse {
 
 /// Derived, validated view of a Harness. Construction throws InputError for every
 /// structural fault: unknown node ids, branch points with ≠ 3 connections, cycles,
-/// disconnected cables, duplicate segments.
+/// disconnected cables, duplicate segments, a given segment diameter below that of a cable
+/// the segment carries.
 class HarnessTopology {
  public:
   /// Validates `h` (which must outlive this object) and derives chains and bundles.

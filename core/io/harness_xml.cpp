@@ -8,8 +8,10 @@
 #include <pugixml.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -64,6 +66,88 @@ class LineMap {
  private:
   std::vector<std::ptrdiff_t> newlines_;
 };
+
+/// Longest entity or character reference looked at ("&#x10FFFF;" and every predefined
+/// entity fit); a longer one is not a reference pugixml or this reader knows.
+constexpr std::size_t kMaxReferenceLength = 16;
+
+/// What the harness reader accepts as references, for its messages.
+constexpr const char* kKnownReferences =
+    " (only &amp; &lt; &gt; &quot; &apos; and character references to XML characters; write a literal '&' as &amp;)";
+
+/// True for a code point that XML 1.0 allows in a document (its production `Char`).
+bool is_xml_char(unsigned long cp) {
+  return cp == 0x9 || cp == 0xA || cp == 0xD || (cp >= 0x20 && cp <= 0xD7FF) || (cp >= 0xE000 && cp <= 0xFFFD) ||
+         (cp >= 0x10000 && cp <= 0x10FFFF);
+}
+
+/// True for the body of a reference (between '&' and ';') that pugixml expands faithfully:
+/// one of the five predefined entities, or a character reference to an XML character.
+bool is_known_reference(const std::string& body) {
+  for (const char* e : {"amp", "lt", "gt", "quot", "apos"})
+    if (body == e) return true;
+  if (body.size() < 2 || body[0] != '#') return false;
+  const bool hex = body[1] == 'x';
+  const std::size_t first = hex ? 2 : 1;
+  if (first == body.size()) return false;
+  unsigned long cp = 0;
+  for (std::size_t i = first; i < body.size(); ++i) {
+    const auto c = static_cast<unsigned char>(body[i]);
+    if (hex ? !std::isxdigit(c) : !std::isdigit(c)) return false;
+    cp = cp * (hex ? 16 : 10) + static_cast<unsigned long>(std::isdigit(c) ? c - '0' : std::tolower(c) - 'a' + 10);
+    if (cp > 0x10FFFF) return false;
+  }
+  return is_xml_char(cp);
+}
+
+/// The first reference in `raw` (an attribute value or text as written, references not yet
+/// expanded) that pugixml would not expand as XML does, or "": an entity other than the five
+/// predefined ones stays as literal text, and `&#0;` cuts the value short.
+std::string first_unknown_reference(const char* raw) {
+  for (const char* amp = std::strchr(raw, '&'); amp; amp = std::strchr(amp + 1, '&')) {
+    const char* semi = std::strchr(amp, ';');
+    const std::size_t len = semi ? static_cast<std::size_t>(semi - amp) + 1 : std::strlen(amp);
+    if (!semi || len > kMaxReferenceLength || !is_known_reference(std::string(amp + 1, semi)))
+      return std::string(amp, std::min(len, kMaxReferenceLength));
+  }
+  return {};
+}
+
+/// Refuses markup that pugixml parses differently from XML, naming its line: a document type
+/// declaration, which pugixml skips (its entities and attribute defaults would be lost; a
+/// "billion laughs" file is harmless only because of that), and references it does not expand
+/// as XML does (first_unknown_reference). `text` must be well-formed for pugixml; it is read a
+/// second time with references left as written, so that any declared encoding is honoured.
+void check_markup(const std::string& text, const std::string& file) {
+  pugi::xml_document raw;
+  const auto res =
+      raw.load_buffer(text.data(), text.size(), (pugi::parse_default | pugi::parse_doctype) & ~pugi::parse_escapes);
+  const LineMap lines(text);
+  if (!res)  // only a document type declaration is parsed more strictly the second time
+    throw InputError({file, lines.line(res.offset), ""}, std::string("malformed XML: ") + res.description());
+  // Depth-first without recursion: the nesting is the file's to choose.
+  for (pugi::xml_node n = raw.first_child(); n;) {
+    const auto here = [&](const std::string& element, const std::string& reason) {
+      throw InputError({file, lines.line(n.offset_debug()), element}, reason);
+    };
+    if (n.type() == pugi::node_doctype)
+      here("", "a document type declaration (<!DOCTYPE ...>) is not supported: its entities and attribute "
+               "defaults would be ignored");
+    for (auto a : n.attributes())
+      if (const std::string ref = first_unknown_reference(a.value()); !ref.empty())
+        here("<" + std::string(n.name()) + ">",
+             "attribute '" + std::string(a.name()) + "': unsupported reference '" + ref + "'" + kKnownReferences);
+    if (n.type() == pugi::node_pcdata)
+      if (const std::string ref = first_unknown_reference(n.value()); !ref.empty())
+        here("", "unsupported reference '" + ref + "' in text" + kKnownReferences);
+    if (n.first_child()) {
+      n = n.first_child();
+      continue;
+    }
+    while (n && !n.next_sibling()) n = n.parent();
+    if (n) n = n.next_sibling();
+  }
+}
 
 class Reader {
  public:
@@ -122,6 +206,9 @@ class Reader {
   /// which are UTF-8; pugixml has already converted a declared or BOM-marked encoding).
   void only_attributes(const pugi::xml_node& n, std::initializer_list<const char*> allowed) const {
     for (auto a : n.attributes()) {
+      // pugixml keeps both of `id="C1" id="C2"` and lookups see only the first.
+      for (auto b = n.first_attribute(); b != a; b = b.next_attribute())
+        if (std::string(b.name()) == a.name()) fail(n, std::string("duplicate attribute '") + a.name() + "'");
       bool ok = false;
       for (const char* k : allowed) ok = ok || std::string(a.name()) == k;
       if (!ok) fail(n, std::string("unknown attribute '") + a.name() + "'");
@@ -130,6 +217,14 @@ class Reader {
       if (bad != std::string::npos)
         fail(n, std::string("attribute '") + a.name() + "' is not valid UTF-8 (byte " + std::to_string(bad) +
                     " of its value; declare the file's encoding in <?xml ... encoding=\"...\"?>)");
+      // XML allows no control characters but tab, newline and return; pugixml reads them, and
+      // the writer would put them back as references that no XML reader (this one included) takes.
+      for (std::size_t i = 0; i < v.size(); ++i) {
+        const auto c = static_cast<unsigned char>(v[i]);
+        if (c < 0x20 && !is_xml_char(c))
+          fail(n, std::string("attribute '") + a.name() + "' holds control character " + std::to_string(c) +
+                      " (byte " + std::to_string(i) + " of its value), which XML does not allow");
+      }
     }
   }
 
@@ -142,6 +237,10 @@ class Reader {
     h.source_file = file_;
     pugi::xml_node root = doc.document_element();
     if (!root) throw InputError({file_, 1, ""}, "no root element");
+    // pugixml reads a document with more elements after the root; a harness file holds one
+    // root, and a second would be ignored.
+    for (auto n = root.next_sibling(); n; n = n.next_sibling())
+      if (n.type() == pugi::node_element) fail(n, "a second root element: a harness file holds one <harness> root");
     h.name = root.attribute("name") ? root.attribute("name").value() : root.name();
     if (auto u = root.attribute("units")) {
       auto unit = parse_unit(u.value());
@@ -204,6 +303,8 @@ class Reader {
           have_phys = true;
           only_attributes(sub, {"type", "color", "colour", "diameter", "min_bend_radius"});
           cab.physical.type = sub.attribute("type").value();
+          if (sub.attribute("color") && sub.attribute("colour"))
+            fail(sub, "both 'color' and 'colour' given: one would be ignored");
           cab.physical.color = sub.attribute("color") ? sub.attribute("color").value() : sub.attribute("colour").value();
           cab.physical.diameter = number(sub, "diameter");
           if (!(cab.physical.diameter > 0.0))
@@ -313,9 +414,11 @@ class Reader {
         p.line = line(c);
         p.position = point(c);
         Vec3 d{number(c, "dx"), number(c, "dy"), number(c, "dz")};
-        const double len = d.norm();
-        if (!(len > 1e-12)) fail(c, "exit direction (dx, dy, dz) has zero length");
-        p.direction = d / len;
+        // Scaled by its largest component first: (1e-200, 0, 0) is a direction, though its
+        // squared length underflows to zero.
+        const double largest = d.cwiseAbs().maxCoeff();
+        if (!(largest > 0.0)) fail(c, "exit direction (dx, dy, dz) has zero length");
+        p.direction = (d / largest).normalized();
         h.ports.push_back(std::move(p));
       } else if (n == "branch") {
         only_attributes(c, {"id", "x", "y", "z"});
@@ -385,6 +488,7 @@ Harness parse_harness_xml(const std::string& text, const std::string& name_for_e
     LineMap lm(text);
     throw InputError({name_for_errors, lm.line(res.offset), ""}, std::string("malformed XML: ") + res.description());
   }
+  check_markup(text, name_for_errors);
   Reader r(text, name_for_errors);
   Harness h = r.read(doc);
   HarnessTopology topo(h);  // validates ids, branch degree, cycles, connectivity

@@ -9,7 +9,13 @@ namespace loom {
 
 void require_input_file(const std::filesystem::path& path, const std::string& what) {
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError({path.string(), 0, ""}, what + " not found");
+  if (!std::filesystem::exists(path, ec)) {
+    // exists() is false with an error too: a symbolic link loop, a directory that may not be
+    // searched. "not found" would send the user looking for a file that is there.
+    if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory)
+      throw InputError({path.string(), 0, ""}, "cannot access " + what + ": " + ec.message());
+    throw InputError({path.string(), 0, ""}, what + " not found");
+  }
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError({path.string(), 0, ""}, "not a regular file");
   std::ifstream probe(path, std::ios::binary);
   if (!probe) throw InputError({path.string(), 0, ""}, "cannot read " + what);

@@ -8,7 +8,8 @@ namespace loom {
 
 /// Throws InputError naming `path` unless it is an existing regular file that opens for
 /// reading: "<what> not found", "not a regular file" (a directory reads as nothing, a device
-/// such as /dev/zero or a pipe never ends), or "cannot read <what>". `what` names the kind
+/// such as /dev/zero or a pipe never ends), "cannot access <what>: <why>" (a symbolic link
+/// loop, say), or "cannot read <what>". `what` names the kind
 /// of file ("scene file", "harness file", ...).
 void require_input_file(const std::filesystem::path& path, const std::string& what);
 

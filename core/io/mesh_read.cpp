@@ -4,6 +4,7 @@
 #include "core/io/input_file.hpp"
 #include "core/io/mesh_file_checks.hpp"
 
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -39,10 +40,29 @@
 #include <algorithm>
 #include <cctype>
 #include <map>
+#include <set>
+#include <system_error>
 
 namespace loom {
 
 namespace {
+
+/// Assimp's file system restricted to regular files. Assimp opens the files a mesh refers to
+/// itself (an OBJ's mtllib, a glTF buffer or image uri, a DAE image); a FIFO there blocks the
+/// read forever and a device never ends, so to Assimp such a path does not exist.
+class RegularFilesOnly : public Assimp::DefaultIOSystem {
+ public:
+  bool Exists(const char* file) const override { return regular(file) && DefaultIOSystem::Exists(file); }
+  Assimp::IOStream* Open(const char* file, const char* mode = "rb") override {
+    return regular(file) ? DefaultIOSystem::Open(file, mode) : nullptr;
+  }
+
+ private:
+  static bool regular(const char* file) {
+    std::error_code ec;
+    return file && std::filesystem::is_regular_file(file, ec);
+  }
+};
 
 void finish_mesh(Mesh& m, const std::filesystem::path& path, const std::string& what) {
   const long bad = first_non_finite_vertex(m);
@@ -69,6 +89,7 @@ Mesh read_mesh_file(const std::filesystem::path& path) {
                                                  "' (meshes: .stl .obj .ply .off .gltf .glb .dae; CAD: .step .stp .iges .igs)");
   check_mesh_file_structure(path);  // declared counts and nesting Assimp would trust
   Assimp::Importer importer;
+  importer.SetIOHandler(new RegularFilesOnly);  // the importer owns and deletes it
   // Points and lines are dropped; node transforms are baked in so one mesh results.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   // ValidateDataStructure runs before the other steps: a face index beyond the vertices (which
@@ -257,13 +278,17 @@ std::vector<NamedMesh> read_cad_file_occ(const std::filesystem::path& path, cons
     out.push_back(std::move(nm));
     return out;
   }
-  std::map<std::string, int> seen;
+  // Names given so far: a repeated product gets the first free "#k" suffix, free also of
+  // products whose own names end so ("bolt", "bolt", "bolt#2" must give three names).
+  std::set<std::string> used;
+  std::map<std::string, int> next_suffix;  // per product name: the first k not yet tried
   for (const auto& l : leaves) {
     BRepMesh_IncrementalMesh mesher(l.shape, lin_mm, false, ang, true);
     NamedMesh nm;
-    std::string base = l.name.empty() ? "solid" : l.name;
-    const int k = ++seen[base];
-    nm.name = k == 1 ? base : base + "#" + std::to_string(k);
+    const std::string base = l.name.empty() ? "solid" : l.name;
+    nm.name = base;
+    int& k = next_suffix.try_emplace(base, 2).first->second;
+    while (!used.insert(nm.name).second) nm.name = base + "#" + std::to_string(k++);
     nm.brep_faces = append_triangulation(l.shape, scale, nm.mesh);
     finish_mesh(nm.mesh, path, nm.name);
     if (nm.mesh.empty()) continue;  // e.g. a wire-frame or empty product: nothing to collide with

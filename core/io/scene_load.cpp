@@ -62,6 +62,10 @@ class TomlReader {
     if (!n) return std::nullopt;
     auto s = n->as_string();
     if (!s) fail(n, where + "." + key, "expected a string");
+    // TOML's "\u0000" is a valid escape, but a NUL ends every name handed to the OS and C
+    // libraries: file = "a.obj\u0000.stl" passed the .stl check and then read a.obj.
+    if (s->get().find('\0') != std::string::npos)
+      fail(n, where + "." + key, "must not contain a NUL character (\\u0000)");
     return s->get();
   }
 
@@ -168,7 +172,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
   if (const toml::table* ht = r.section(doc, "harness")) {
     r.only_keys(*ht, "harness", {"file"});
     auto hf = r.string(*ht, "harness", "file");
-    if (!hf) r.fail(ht->get("file") ? ht->get("file") : nullptr, "harness.file", "missing harness file name");
+    if (!hf) r.fail(ht, "harness.file", "missing harness file name");
     if (hf->empty()) r.fail(ht->get("file"), "harness.file", "empty file name");
     try {
       scene.harness = read_harness_xml(resolve(base, *hf));
@@ -255,7 +259,10 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
       r.only_keys(*pt, where, {"name", "file", "transform", "role", "clearance", "compound"});
       auto file_rel = r.string(*pt, where, "file");
       if (!file_rel) r.fail(&node, where, "missing 'file'");
-      const std::string pname = r.string(*pt, where, "name").value_or(std::filesystem::path(*file_rel).stem().string());
+      const std::optional<std::string> given_name = r.string(*pt, where, "name");
+      // A part's name identifies it in every report (and names its simplify output).
+      if (given_name && given_name->empty()) r.fail(pt->get("name"), where + ".name", "must not be empty");
+      const std::string pname = given_name.value_or(std::filesystem::path(*file_rel).stem().string());
       const std::string pwhere = "part '" + pname + "'";
       PartRole role = PartRole::Structure;
       if (auto ro = r.string(*pt, where, "role")) {

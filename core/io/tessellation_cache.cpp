@@ -1,6 +1,7 @@
 #include "core/io/tessellation_cache.hpp"
 
 #include "core/io/atomic_file.hpp"
+#include "core/io/input_file.hpp"
 
 #include <algorithm>
 #include <cstdint>
@@ -11,7 +12,9 @@
 namespace loom {
 
 namespace {
-constexpr char kMagic[8] = {'L', 'O', 'O', 'M', 'T', 'C', '0', '1'};
+/// Format and naming version of an entry. 02: repeated product names get the first free "#k"
+/// (01 could give two pieces one name, which the scene then refused; such entries are misses).
+constexpr char kMagic[8] = {'L', 'O', 'O', 'M', 'T', 'C', '0', '2'};
 
 std::uint64_t fnv1a(const void* data, std::size_t n, std::uint64_t h = 1469598103934665603ull) {
   const auto* p = static_cast<const unsigned char*>(data);
@@ -117,9 +120,11 @@ std::string tessellation_cache_key(const std::filesystem::path& file, const Tess
 
 std::vector<NamedMesh> read_cad_file_cached(const std::filesystem::path& path, const TessellationParams& tp,
                                             bool split, bool* hit) {
+  // Before the key hashes its bytes: a FIFO never gives any, a device such as /dev/zero never ends.
+  require_input_file(path, "file");
   const auto dir = tessellation_cache_dir();
   std::vector<NamedMesh> out;
-  if (dir.empty() || !std::filesystem::exists(path)) {
+  if (dir.empty()) {
     if (hit) *hit = false;
     return read_cad_file(path, tp, split);
   }

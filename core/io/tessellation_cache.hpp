@@ -19,7 +19,8 @@ std::filesystem::path tessellation_cache_dir();
 std::string tessellation_cache_key(const std::filesystem::path& file, const TessellationParams& tp, bool split);
 
 /// read_cad_file() through the cache: a hit returns the stored meshes, a miss tessellates
-/// and stores. `hit` (if given) tells which happened.
+/// and stores. `hit` (if given) tells which happened. A path that is not a readable regular
+/// file is an InputError before anything is hashed (require_input_file).
 std::vector<NamedMesh> read_cad_file_cached(const std::filesystem::path& path, const TessellationParams& tp,
                                             bool split, bool* hit = nullptr);
 

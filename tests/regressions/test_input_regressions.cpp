@@ -15,8 +15,10 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <set>
 #include <string>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include "core/error.hpp"
@@ -333,6 +335,169 @@ TEST(Regression, RenderReportOfTheWrongShapeWasTakenOrNamedNothing) {
     EXPECT_EQ(status, 2) << out;
     EXPECT_NE(out.find(message), std::string::npos) << out;
   }
+}
+
+// --- input adversarial review (2026-11-27, second sweep) -----------------------------------
+
+// A STEP part that is a FIFO, or a link to /dev/zero, hung `loom info` for ever: the
+// tessellation cache hashed the file's bytes for its key before the reader checked that it
+// was a regular file (a FIFO blocks the open, /dev/zero never ends).
+TEST(Regression, CadCacheHashedADeviceBeforeCheckingIt) {
+  const fs::path d = scratch();
+  setenv("LOOM_CACHE_DIR", (d / "cache").c_str(), 1);
+  fs::create_symlink("/dev/zero", d / "zero.step");
+  ASSERT_EQ(mkfifo((d / "pipe.step").c_str(), 0600), 0);
+  for (const char* name : {"zero.step", "pipe.step"}) {
+    const std::string e = input_error([&] { loom::read_cad_file_cached(d / name, loom::TessellationParams{}, true); });
+    EXPECT_NE(e.find(name + std::string(": not a regular file")), std::string::npos) << e;
+  }
+  unsetenv("LOOM_CACHE_DIR");
+}
+
+// Assimp opens the files a mesh refers to itself: a glTF buffer uri naming a FIFO blocked
+// `loom info` for ever (an OBJ's mtllib naming one too). Only regular files are opened now;
+// the glTF is refused naming the reference, the OBJ loads without its materials.
+TEST(Regression, MeshReferenceToAFifoHung) {
+  const fs::path d = scratch();
+  ASSERT_EQ(mkfifo((d / "pipe.bin").c_str(), 0600), 0);
+  write(d / "m.gltf", R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
+"buffers":[{"uri":"pipe.bin","byteLength":36}],
+"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":36}],
+"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","max":[1,1,0],"min":[0,0,0]}]})");
+  const std::string e = input_error([&] { loom::read_mesh_file(d / "m.gltf"); });
+  EXPECT_NE(e.find("m.gltf: cannot read mesh: GLTF: could not open referenced file \"pipe.bin\""), std::string::npos)
+      << e;
+  write(d / "m.obj", "mtllib pipe.bin\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  EXPECT_EQ(loom::read_mesh_file(d / "m.obj").triangle_count(), 1u);
+}
+
+// pugixml reads elements after the root: a second <harness> (say two files concatenated)
+// was ignored without a word.
+TEST(Regression, HarnessSecondRootElementWasIgnored) {
+  const std::string e = input_error([&] { loom::parse_harness_xml(kHarness + "<harness name=\"h2\"/>\n", "h.xml"); });
+  EXPECT_NE(e.find("h.xml:12: <harness>: a second root element"), std::string::npos) << e;
+}
+
+// pugixml keeps both attributes of `<cable id="C1" id="C2">` and a lookup finds the first:
+// the second value was dropped without a word.
+TEST(Regression, HarnessDuplicateAttributeWasIgnored) {
+  const std::string text = replaced(kHarness, R"(diameter="2")", R"(diameter="2" diameter="20")");
+  const std::string e = input_error([&] { loom::parse_harness_xml(text, "h.xml"); });
+  EXPECT_NE(e.find("h.xml:4: <physical>: duplicate attribute 'diameter'"), std::string::npos) << e;
+}
+
+// pugixml skips a DOCTYPE and leaves references it does not know as text: an entity declared
+// in it (a "billion laughs" file among them) gave the cable the id "&lol9;", and `&#0;` cut
+// "C&#0;1" to "C". Both are refused, naming the line; the predefined entities and character
+// references to XML characters still read as XML says.
+TEST(Regression, HarnessDtdAndUnknownReferencesWereReadAsText) {
+  std::string dtd = "<?xml version=\"1.0\"?>\n<!DOCTYPE h [\n<!ENTITY lol \"lol\">\n";
+  for (int k = 1; k <= 9; ++k) {
+    dtd += "<!ENTITY lol" + std::to_string(k) + " \"";
+    for (int i = 0; i < 10; ++i) dtd += "&lol" + (k == 1 ? std::string() : std::to_string(k - 1)) + ";";
+    dtd += "\">\n";
+  }
+  dtd += "]>\n";
+  std::string e = input_error(
+      [&] { loom::parse_harness_xml(dtd + replaced(kHarness, R"(id="C1")", R"(id="&lol9;")"), "h.xml"); });
+  EXPECT_NE(e.find("h.xml:2: a document type declaration (<!DOCTYPE ...>) is not supported"), std::string::npos) << e;
+  e = input_error([&] { loom::parse_harness_xml(replaced(kHarness, R"(id="C1")", R"(id="&lol9;")"), "h.xml"); });
+  EXPECT_NE(e.find("h.xml:3: <cable>: attribute 'id': unsupported reference '&lol9;'"), std::string::npos) << e;
+  e = input_error([&] { loom::parse_harness_xml(replaced(kHarness, R"(id="C1")", R"(id="C&#0;1")"), "h.xml"); });
+  EXPECT_NE(e.find("h.xml:3: <cable>: attribute 'id': unsupported reference '&#0;'"), std::string::npos) << e;
+  e = input_error([&] { loom::parse_harness_xml(replaced(kHarness, R"(color="red")", R"(color="R&D")"), "h.xml"); });
+  EXPECT_NE(e.find("h.xml:4: <physical>: attribute 'color': unsupported reference '&D'"), std::string::npos) << e;
+  const loom::Harness ok = loom::parse_harness_xml(
+      replaced(kHarness, R"(color="red")", R"(color="R&amp;D &lt;&gt;&quot;&apos; &#65;&#x1F600;")"), "h.xml");
+  EXPECT_EQ(ok.cables[0].physical.color, "R&D <>\"' A\xF0\x9F\x98\x80");
+}
+
+// A port direction such as (1e-200, 0, 0) was refused as "zero length": its squared length
+// underflows. A direction is zero only if every component is.
+TEST(Regression, TinyPortDirectionWasCalledZero) {
+  const loom::Harness h =
+      loom::parse_harness_xml(replaced(kHarness, R"(dx="1" dy="0" dz="0")", R"(dx="1e-200" dy="0" dz="-1e-200")"), "h.xml");
+  EXPECT_NEAR(h.ports[0].direction.x(), std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(h.ports[0].direction.z(), -std::sqrt(0.5), 1e-15);
+}
+
+// A symbolic link loop was reported as "scene file not found", sending the user to look for a
+// file that is there.
+TEST(Regression, SymlinkLoopWasReportedAsMissing) {
+  const fs::path d = scratch();
+  fs::create_symlink(d / "b.toml", d / "a.toml");
+  fs::create_symlink(d / "a.toml", d / "b.toml");
+  const std::string e = input_error([&] { loom::load_scene(d / "a.toml"); });
+  EXPECT_NE(e.find("a.toml: cannot access scene file: Too many levels of symbolic links"), std::string::npos) << e;
+}
+
+// `name = ""` in a [[part]] was taken: clashes were reported against part "" and its simplify
+// output became "part.stl".
+TEST(Regression, EmptyPartNameWasAccepted) {
+  const fs::path d = scratch();
+  write(d / "m.ply", kPlyTriangle + "3 0 1 2\n");
+  write(d / "s.toml", "[scene]\nname = 's'\n[[part]]\nname = ''\nfile = 'm.ply'\n");
+  const std::string e = input_error([&] { loom::load_scene(d / "s.toml"); });
+  EXPECT_NE(e.find("s.toml:4: part[1].name: must not be empty"), std::string::npos) << e;
+}
+
+// `[harness]` without `file` named no line of the scene.
+TEST(Regression, HarnessTableWithoutFileNamedNoLine) {
+  const fs::path d = scratch();
+  write(d / "s.toml", "[scene]\nname = 's'\n\n[harness]\n");
+  const std::string e = input_error([&] { loom::load_scene(d / "s.toml"); });
+  EXPECT_NE(e.find("s.toml:4: harness.file: missing harness file name"), std::string::npos) << e;
+}
+
+// A STEP assembly whose product names look like loom's own suffixes ("bolt" placed six times,
+// and a product named "bolt#2") gave two pieces the name "bolt#2": the scene then refused a
+// valid file ("duplicate part name 'as1/bolt#2'"), every run, since the cache kept the names.
+TEST(Regression, StepProductNamedLikeASuffixClashed) {
+  const fs::path as1 = fs::path(LOOM_SHARED_DATA) / "stepcode/as1-oc-214.stp";
+  if (!fs::exists(as1)) GTEST_SKIP() << "shared data not present: " << as1;
+  const fs::path d = scratch();
+  const std::string text = replaced(slurp(as1), "PRODUCT('l-bracket','l-bracket'", "PRODUCT('bolt#2','bolt#2'");
+  write(d / "as1.stp", text);
+  loom::TessellationParams tp;
+  tp.linear_deflection = 0.5;
+  const auto pieces = loom::read_cad_file(d / "as1.stp", tp, true);
+  std::set<std::string> names;
+  for (const auto& p : pieces) names.insert(p.name);
+  EXPECT_EQ(pieces.size(), 18u);
+  EXPECT_EQ(names.size(), pieces.size());
+  EXPECT_EQ(names.count("bolt#2"), 1u);
+}
+
+// `<physical color="red" colour="blue">` took "red" and dropped "blue" without a word.
+TEST(Regression, ColorAndColourTogetherDroppedOne) {
+  const std::string text = replaced(kHarness, R"(color="red")", R"(color="red" colour="blue")");
+  const std::string e = input_error([&] { loom::parse_harness_xml(text, "h.xml"); });
+  EXPECT_NE(e.find("h.xml:4: <physical>: both 'color' and 'colour' given"), std::string::npos) << e;
+}
+
+// A segment given diameter="0.2" while carrying a 2 mm cable was taken: the router planned
+// a tube a tenth of the cable's width (typically a unit slip in the file).
+TEST(Regression, SegmentThinnerThanItsCableWasTaken) {
+  const std::string text =
+      replaced(kHarness, R"(<segment from="J1" to="J2"/>)", R"(<segment from="J1" to="J2" diameter="0.2"/>)");
+  const std::string e = input_error([&] { loom::parse_harness_xml(text, "h.xml"); });
+  EXPECT_NE(e.find("h.xml:9: segment J1 -> J2: diameter 0.20000000000000001 is less than the diameter 2 of cable 'C1'"),
+            std::string::npos)
+      << e;
+  // Equal to the cable's is valid.
+  EXPECT_NO_THROW(loom::parse_harness_xml(
+      replaced(kHarness, R"(<segment from="J1" to="J2"/>)", R"(<segment from="J1" to="J2" diameter="2"/>)"), "h.xml"));
+}
+
+// TOML's "\u0000" escape put a NUL into a string: file = "m.ply\u0000.stl" passed the .stl
+// extension check and then opened "m.ply" (every OS call stops at the NUL).
+TEST(Regression, TomlNulInAFileNameReadAnotherFile) {
+  const fs::path d = scratch();
+  write(d / "m.ply", kPlyTriangle + "3 0 1 2\n");
+  write(d / "s.toml", "[scene]\nname = 's'\n[[part]]\nfile = \"m.ply\\u0000.stl\"\n");
+  const std::string e = input_error([&] { loom::load_scene(d / "s.toml"); });
+  EXPECT_NE(e.find("s.toml:4: part[1].file: must not contain a NUL character"), std::string::npos) << e;
 }
 
 }  // namespace
