@@ -56,8 +56,17 @@ struct AuditReport {
 
   /// True when any clash or violation was found.
   bool found_problems() const { return !result.clashes.empty() || !result.violations.empty(); }
-  /// DESIGN §4 exit status of a completed audit: 0 clean, 1 clashes or violations.
-  int exit_code() const { return found_problems() ? 1 : 0; }
+  /// True when some harness cable could not be checked (a segment of its chain has no
+  /// curve yet, e.g. an unplaced branch point): see `cables[i].reason`.
+  bool any_unchecked() const {
+    for (const auto& c : cables)
+      if (!c.routed) return true;
+    return false;
+  }
+  /// DESIGN §4 exit status of a completed audit: 0 clean, 1 clashes or violations, 3 some
+  /// cable has no route to check (as `route` says of a cable it could not route: an audit
+  /// that left cables unchecked is not clean, whatever it found on the others).
+  int exit_code() const { return any_unchecked() ? 3 : found_problems() ? 1 : 0; }
 };
 
 /// The cables of a harness as the checker sees them (routed ones only): centerlines, radii,

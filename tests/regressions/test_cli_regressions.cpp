@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <utility>
 #include <vector>
@@ -177,3 +178,35 @@ TEST(CliRegression, BadRenderSizeMakesNoOutputDirectory) {
 }
 
 }  // namespace
+
+// An audit of a harness whose branch point has no position yet checked none of its cables,
+// said so in report.json ("routed": false, a reason) and exited 0, "ran and found nothing":
+// a CI gate on the exit status passed a harness nobody had checked. Cables left unchecked
+// now give exit 3, as `route` gives for cables it could not route (DESIGN §4).
+TEST(CliRegression, AnAuditThatLeftCablesUncheckedWasExitZero) {
+  const fs::path dir = scratch("unchecked");
+  write_scene(dir, {});
+  std::ofstream(dir / "harness.xml") << R"(<?xml version="1.0"?>
+<harness name="u" units="mm">
+  <attributes>
+    <cable id="A"><electrical><port id="J1"/><port id="J2"/></electrical><physical diameter="2" min_bend_radius="10"/></cable>
+    <cable id="B"><electrical><port id="J1"/><port id="J3"/></electrical><physical diameter="2" min_bend_radius="10"/></cable>
+  </attributes>
+  <structure>
+    <port id="J1" x="-20" y="5" z="30" dx="1" dy="0" dz="0"/>
+    <port id="J2" x="30" y="5" z="30" dx="-1" dy="0" dz="0"/>
+    <port id="J3" x="30" y="5" z="60" dx="-1" dy="0" dz="0"/>
+    <branch id="B1"><segment to="J1"/><segment to="J2"/><segment to="J3"/></branch>
+  </structure>
+</harness>
+)";
+  for (const std::string method : {"certified", "discrete"}) {
+    const auto r = run_loom("audit " + (dir / "scene.toml").string() + " --method " + method +
+                            " --render-size 80x60 --quiet --out " + (dir / "out").string());
+    EXPECT_EQ(r.status, 3) << method << "\n" << r.out;
+    std::ifstream in(dir / "out" / "report.json");
+    const std::string report((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(report.find("\"routed\": false"), std::string::npos) << report;
+  }
+  fs::remove_all(dir);
+}
