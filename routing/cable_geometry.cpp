@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <stdexcept>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -105,14 +106,21 @@ Centerline as_cubic(const Centerline& c) {
 /// position); an exact <bspline> that stops short of its node does not make a curve.
 constexpr double kJoinGapRel = 1e-9;
 
+/// How far apart two points that should coincide may lie, given the box of the control
+/// points they come from: kJoinGapRel of the box's extent and of its distance from the
+/// origin (coordinates 10⁶ from it round by ~10⁻¹⁰ each when written and read).
+double meeting_tolerance(const AABB& box) {
+  return kJoinGapRel * (box.diagonal() + std::max(box.min.cwiseAbs().maxCoeff(), box.max.cwiseAbs().maxCoeff()));
+}
+
 /// Joins two clamped cubics end to start (C0 at the joint, knot multiplicity 3 there).
-/// Throws std::invalid_argument if they do not meet (within kJoinGapRel).
+/// Throws std::invalid_argument if they do not meet (within meeting_tolerance).
 Centerline join(const Centerline& a, const Centerline& b) {
   const Vec3 end = a.control_points().back(), start = b.control_points().front();
   AABB box;
   for (const Centerline* c : {&a, &b})
     for (const Vec3& q : c->control_points()) box.extend(q);
-  if ((end - start).norm() > kJoinGapRel * box.diagonal())
+  if ((end - start).norm() > meeting_tolerance(box))
     throw std::invalid_argument("consecutive segments do not meet: one ends at " + full_precision(end) +
                                 ", the next starts at " + full_precision(start) + " (gap " +
                                 full_precision((end - start).norm()) + ")");
@@ -139,8 +147,26 @@ Centerline join(const Centerline& a, const Centerline& b) {
 
 std::optional<Centerline> segment_centerline(const Harness& h, int segment) {
   const Segment& s = h.segments.at(static_cast<std::size_t>(segment));
-  if (s.bspline) return Centerline(s.bspline->degree, s.bspline->knots, s.bspline->control_points);
   const auto a = h.node_position(s.from), b = h.node_position(s.to);
+  if (s.bspline) {
+    Centerline c(s.bspline->degree, s.bspline->knots, s.bspline->control_points);
+    // The exact curve is the segment: it must leave its from-node and reach its to-node
+    // where the file puts them (an unplaced branch point takes the curve's end). A curve
+    // that stops short would be audited as if it were connected.
+    AABB box;
+    for (const Vec3& q : c.control_points()) box.extend(q);
+    for (const auto& [node, at, u] : {std::tuple(s.from, a, c.u_min()), std::tuple(s.to, b, c.u_max())}) {
+      if (!at) continue;
+      box.extend(*at);
+      const Vec3 end = c.position(u);
+      if ((end - *at).norm() > meeting_tolerance(box))
+        throw std::invalid_argument("the <bspline> of segment " + s.from + " -> " + s.to + " " +
+                                    (u == c.u_min() ? "starts" : "ends") + " at " + full_precision(end) +
+                                    ", not at " + node + " " + full_precision(*at) + " (gap " +
+                                    full_precision((end - *at).norm()) + ")");
+    }
+    return c;
+  }
   if (!a || !b) return std::nullopt;
   std::vector<Vec3> pts{*a};
   pts.insert(pts.end(), s.path.begin(), s.path.end());

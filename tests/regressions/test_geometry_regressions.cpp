@@ -182,6 +182,8 @@ TEST(GeometryRegression, CableThroughAnUnclampedExactSplineFollowsItsSegments) {
 // point, whatever the gap: an exact <bspline> stopping 5 mm short of its branch point was
 // silently bent over to meet the previous piece, so the cable's audited curve was not the
 // file's segment. Now a gap beyond rounding is a clear error naming the harness and cable.
+// (The branch point has no position here: with one, the curve's end is checked against it
+// first, GeometryRegression.ExactSplineAwayFromItsPortsIsAClearError.)
 TEST(GeometryRegression, CableWhoseSegmentsDoNotMeetIsAClearError) {
   const char* xml = R"(<harness name="H" units="mm">
   <attributes>
@@ -192,11 +194,13 @@ TEST(GeometryRegression, CableWhoseSegmentsDoNotMeetIsAClearError) {
     <port id="A" x="0" y="0" z="0" dx="1" dy="0" dz="0"/>
     <port id="B" x="200" y="0" z="0" dx="-1" dy="0" dz="0"/>
     <port id="D" x="100" y="-100" z="0" dx="0" dy="1" dz="0"/>
-    <branch id="J" x="100" y="10" z="0">
+    <branch id="J">
       <segment to="A"><bspline degree="3" knots="0 0 0 0 1 1 1 1">
         <cp x="95" y="10" z="0"/><cp x="60" y="8" z="0"/><cp x="30" y="2" z="0"/><cp x="0" y="0" z="0"/>
       </bspline></segment>
-      <segment to="B"><path interp="polyline"><pt x="150" y="10" z="0"/></path></segment>
+      <segment to="B"><bspline degree="1" knots="0 0 1 1">
+        <cp x="100" y="10" z="0"/><cp x="200" y="0" z="0"/>
+      </bspline></segment>
       <segment to="D"/>
     </branch>
   </structure>
@@ -236,4 +240,45 @@ TEST(GeometryRegression, ZeroLengthCableSweepsToItsBall) {
   // The same for the canal form.
   const loom::SweepResult canal = loom::sweep_canal(c, [r](double) { return r; }, {tol, true});
   EXPECT_GE(canal.mesh.signed_volume(), ball * (1 - 1e-12));
+}
+
+// Bug: an exact <bspline> was taken as the segment wherever it lay: one 495 mm away from
+// both its ports was audited (exit 0, "clean") as the cable between them. A segment's
+// exact curve must now start at its from-node and end at its to-node where the file places
+// them (within rounding); otherwise the harness is refused naming the file, cable, segment,
+// node and gap.
+TEST(GeometryRegression, ExactSplineAwayFromItsPortsIsAClearError) {
+  const char* xml = R"(<harness name="H" units="mm">
+  <attributes>
+    <cable id="C1"><electrical><port id="A"/><port id="B"/></electrical>
+      <physical type="t" color="c" diameter="2" min_bend_radius="10"/></cable>
+  </attributes>
+  <structure>
+    <port id="A" x="0" y="0" z="0" dx="1" dy="0" dz="0"/>
+    <port id="B" x="200" y="0" z="0" dx="-1" dy="0" dz="0"/>
+    <segment from="A" to="B"><bspline degree="3" knots="0 0 0 0 1 1 1 1">
+      <cp x="0" y="495" z="0"/><cp x="60" y="495" z="0"/><cp x="140" y="495" z="0"/><cp x="200" y="495" z="0"/>
+    </bspline></segment>
+  </structure>
+</harness>
+)";
+  const loom::Harness h = loom::parse_harness_xml(xml, "h.xml");
+  const loom::HarnessTopology topo(h);
+  try {
+    const std::optional<Centerline> c = loom::cable_centerline(topo, 0);
+    FAIL() << "took a curve 495 mm from its ports, length " << (c ? c->length() : 0.0);
+  } catch (const loom::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("h.xml:3"), std::string::npos) << what;
+    EXPECT_NE(what.find("C1"), std::string::npos) << what;
+    EXPECT_NE(what.find("segment A -> B starts at (0, 495, 0), not at A (0, 0, 0) (gap 495)"), std::string::npos) << what;
+  }
+  // A curve ending at its ports is the segment (rounding of a written file allowed).
+  std::string ok = xml;
+  const std::string far = R"(<cp x="0" y="495" z="0"/><cp x="60" y="495" z="0"/><cp x="140" y="495" z="0"/><cp x="200" y="495" z="0"/>)";
+  ok.replace(ok.find(far), far.size(),
+             R"(<cp x="0" y="1e-13" z="0"/><cp x="60" y="40" z="0"/><cp x="140" y="40" z="0"/><cp x="200" y="0" z="0"/>)");
+  const loom::Harness h2 = loom::parse_harness_xml(ok, "h.xml");
+  const loom::HarnessTopology topo2(h2);
+  EXPECT_NO_THROW(loom::cable_centerline(topo2, 0));
 }
