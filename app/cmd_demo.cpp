@@ -1,4 +1,4 @@
-// `loom demo [--out DIR] [--render-size WxH] [--quiet]`: the main job on the bundled
+// `loom demo [--out DIR] [--render-size WxH] [--iterations K] [--quiet]`: the main job on the bundled
 // wing-section example.
 #include "app/commands.hpp"
 #include "app/option_checks.hpp"
@@ -29,16 +29,19 @@ void add_demo_command(CLI::App& app, int& exit_code) {
   auto out = std::make_shared<std::string>("loom-demo");
   auto quiet = std::make_shared<bool>(false);
   auto render_size = std::make_shared<std::string>(default_render_size());
+  auto iterations = std::make_shared<long long>(-1);  // < 0: the scene's
   cmd->add_option("--out", *out, "Output directory")->check(non_empty_path())->capture_default_str();
   cmd->add_option("--render-size", *render_size, "Size of render.png, WIDTHxHEIGHT")->capture_default_str();
+  add_iterations_option(*cmd, *iterations);
   cmd->add_flag("--quiet", *quiet, "Print nothing (exit status only)");
-  cmd->callback([out, quiet, render_size, &exit_code]() {
+  cmd->callback([out, quiet, render_size, iterations, &exit_code]() {
     // The main job on the bundled wing section: what is there, then route + exact audit.
     const std::string scene = demo_scene_path();
     RouteCommandOptions o;
     o.out = *out;
     o.quiet = *quiet;
     o.render_size = *render_size;
+    o.iterations = *iterations;
     RenderOptions size_check;
     parse_render_size(o.render_size, "--render-size", size_check);  // a bad size fails before any work
     if (!*quiet) {

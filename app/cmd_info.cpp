@@ -89,7 +89,8 @@ nlohmann::json info_json(const Scene& scene, const SceneLoadReport& rep) {
                     {{"clearance", setting_json(scene.routing.clearance)},
                      {"planner", scene.routing.planner},
                      {"time_limit", setting_json(scene.routing.time_limit)},
-                     {"seed", scene.routing.seed}}},
+                     {"seed", scene.routing.seed},
+                     {"iterations", setting_json(scene.routing.iterations)}}},
                    {"simplify", {{"dim_pre", setting_json(scene.simplify.dim_pre)}}},
                    {"tessellation",
                     {{"linear_deflection", setting_json(scene.tessellation.linear_deflection)},
@@ -146,6 +147,7 @@ void print_text(const Scene& scene, const SceneLoadReport& rep) {
   };
   line("routing.clearance", scene.routing.clearance);
   line("routing.time_limit [s]", scene.routing.time_limit);
+  line("routing.iterations", scene.routing.iterations);
   line("simplify.dim_pre", scene.simplify.dim_pre);
   line("tessellation.linear_deflection", scene.tessellation.linear_deflection);
   line("tessellation.angular_deg", scene.tessellation.angular_deflection_deg);

@@ -8,6 +8,7 @@
 #include "core/io/atomic_file.hpp"
 #include "core/io/output_set.hpp"
 #include "core/io/scene_load.hpp"
+#include "core/scene.hpp"
 #include "core/progress.hpp"
 #include "routing/render.hpp"
 #include "routing/report_json.hpp"
@@ -31,10 +32,10 @@ void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
   const auto& a = rep.audit;
   std::set<std::string> unrouted;
   for (const auto& u : rep.unrouted) unrouted.insert(u.cable);
-  std::printf("route %s: %zu/%zu cables routed (%s, seed %u), clearance %.4g %s\n", a.scene.c_str(),
+  const std::string budget = rep.iterations > 0 ? ", " + std::to_string(rep.iterations) + " iterations" : "";
+  std::printf("route %s: %zu/%zu cables routed (%s, seed %u%s), clearance %.4g %s\n", a.scene.c_str(),
               rep.routed.cables.size() - unrouted.size(), rep.routed.cables.size(), rep.planner.c_str(), rep.seed,
-              rep.clearance,
-              a.units.c_str());
+              budget.c_str(), rep.clearance, a.units.c_str());
   std::printf("  time: load %.0f ms, simplify %.0f ms, index %.0f ms, plan %.0f ms, spline %.0f ms, audit %.0f ms, "
               "repair %.0f ms, total %.0f ms\n",
               rep.timing.load, rep.timing.simplify, rep.timing.index, rep.timing.plan, rep.timing.spline,
@@ -58,10 +59,21 @@ void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
     std::printf("  %s %s at s=%.1f: %.3f (limit %.3f)\n", violation_kind_name(v.kind), a.check_ids[v.cable].c_str(),
                 v.s, v.value, v.limit);
   }
+  // Without a budget every run differs: said once in report.json; the rest is worth a line.
+  for (const auto& n : rep.unreproducible)
+    if (rep.iterations > 0) std::printf("  not reproducible: %s\n", n.c_str());
   std::printf("  wrote %s/{routed.xml, report.json, cables.ply}\n", out.string().c_str());
 }
 
 }  // namespace
+
+void add_iterations_option(CLI::App& cmd, long long& iterations) {
+  cmd.add_option("--iterations", iterations,
+                 "Planner iterations per segment (default: scene [routing], else none). With it, the same "
+                 "--seed gives the same routed.xml, unless the time limit ends a plan first (reported) or the "
+                 "planner is prm/prmstar (threaded: never reproducible). Bend re-plans get 2x, 4x")
+      ->check(whole_number(1, kMaxPlanIterations));
+}
 
 int run_route(const std::string& scene_path, const RouteCommandOptions& o) {
   RenderOptions render;  // a bad size is a usage error: no output directory is made
@@ -80,6 +92,7 @@ int run_route(const std::string& scene_path, const RouteCommandOptions& o) {
   ro.planner = o.planner;
   ro.time_limit = o.time_limit;
   ro.seed = o.seed;
+  ro.iterations = o.iterations;
   ro.threads = o.threads;
   ro.simplify = o.simplify;
   ro.progress = bar.fn();
@@ -110,6 +123,7 @@ void add_route_command(CLI::App& app, int& exit_code) {
       ->check(finite_number(0.0, true));
   cmd->add_option("--seed", o->seed, "Random seed (default: scene [routing])")
       ->check(whole_number(0, std::numeric_limits<std::uint32_t>::max()));
+  add_iterations_option(*cmd, o->iterations);
   cmd->add_option("--threads", o->threads, "Audit threads (default: all cores)")
       ->check(whole_number(1, kMaxThreads));
   cmd->add_option("--render-size", o->render_size, "Size of render.png, WIDTHxHEIGHT")->capture_default_str();

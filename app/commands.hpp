@@ -33,12 +33,16 @@ struct RouteCommandOptions {
   std::string planner;       ///< empty: the scene's
   double time_limit = -1.0;  ///< < 0: the scene's
   long seed = -1;            ///< < 0: the scene's
+  long long iterations = -1; ///< planner iterations per segment; < 0: the scene's
   int threads = 0;
   bool simplify = false;     ///< plan among α-simplified parts
   bool json = false;
   bool quiet = false;
 };
 void add_route_command(CLI::App& app, int& exit_code);
+/// Adds `--iterations K` (1..kMaxPlanIterations, checked as a usage error) to `cmd`, storing
+/// it in `iterations` (route, demo).
+void add_iterations_option(CLI::App& cmd, long long& iterations);
 /// `loom route`: routes, audits and writes the outputs; returns the DESIGN §4 exit status.
 int run_route(const std::string& scene, const RouteCommandOptions& options);
 

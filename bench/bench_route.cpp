@@ -48,6 +48,7 @@ Run route_once(const Scene& scene, const std::string& planner, double budget,
   o.planner = planner;
   o.time_limit = budget;
   o.seed = kSeed;
+  o.iterations = 0;  // the budget measured here is time: ignore the scene's iteration budget
   o.planning_parts = planning_parts;
   const RouteReport rep = route_scene(scene, o);
   Run r;

@@ -18,12 +18,22 @@ struct Setting {
   std::string source;  ///< "scene file" or the derivation rule, e.g. "smallest cable radius / 10"
 };
 
+/// Largest iteration budget per plan ([routing] iterations, `loom route --iterations`). Far
+/// above what any time limit lets a planner reach (a planner iteration costs microseconds to
+/// milliseconds here): a larger budget could only be ended by the time limit, which is what
+/// the budget is there to avoid.
+constexpr long long kMaxPlanIterations = 100'000'000;
+
 /// [routing] of the scene file.
 struct RoutingSettings {
   Setting clearance;       ///< required gap between cable surface and structure
   std::string planner = "informedrrtstar";
   Setting time_limit;      ///< seconds per cable or bundle
   unsigned seed = 1;
+  /// Planner iterations per cable or bundle, 1..kMaxPlanIterations; 0 = none (the planners
+  /// stop on the time limit or on time-based convergence, so runs differ). With a budget,
+  /// a seeded route is reproducible unless the time limit ends a plan first.
+  Setting iterations;
 };
 
 /// [simplify] of the scene file (α-SIM level of detail).

@@ -382,11 +382,16 @@ PortSpec validated_port(const PortSpec& p, const char* which) {
 
 // --- termination ------------------------------------------------------------------------
 
-/// Iteration cap and cost convergence, evaluated from any planner thread.
+/// Iteration cap, wall-clock deadline and cost convergence, evaluated from any planner
+/// thread. The iteration cap is tested first: a run whose budget and deadline run out on the
+/// same evaluation ended on its (deterministic) iteration budget.
 class Convergence {
  public:
-  Convergence(double window_s, double epsilon, std::uint64_t max_iterations)
-      : window_s_(window_s), eps_(epsilon), max_iter_(max_iterations) {}
+  Convergence(double time_limit_s, double window_s, double epsilon, std::uint64_t max_iterations)
+      : deadline_(Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(time_limit_s))),
+        window_s_(window_s),
+        eps_(epsilon),
+        max_iter_(max_iterations) {}
 
   void report(double cost) {
     std::lock_guard<std::mutex> lock(m_);
@@ -397,16 +402,31 @@ class Convergence {
 
   bool should_stop() {
     if (max_iter_ > 0 && ++iterations_ >= max_iter_) return true;
+    if (max_iter_ == 0) ++iterations_;
+    if (Clock::now() >= deadline_) {
+      timed_out_ = true;
+      return true;
+    }
     if (window_s_ <= 0.0) return false;
     std::lock_guard<std::mutex> lock(m_);
     return have_ && std::chrono::duration<double>(Clock::now() - last_improvement_).count() >= window_s_;
   }
 
+  /// Evaluations of the termination condition so far (at most the iteration budget).
+  std::uint64_t iterations() const {
+    const std::uint64_t n = iterations_.load();
+    return max_iter_ > 0 ? std::min(n, max_iter_) : n;
+  }
+  /// True if the wall-clock deadline stopped the run.
+  bool timed_out() const { return timed_out_.load(); }
+
  private:
   std::mutex m_;
+  Clock::time_point deadline_;
   double window_s_, eps_;
   std::uint64_t max_iter_;
   std::atomic<std::uint64_t> iterations_{0};
+  std::atomic<bool> timed_out_{false};
   bool have_ = false;
   double best_ = std::numeric_limits<double>::infinity();
   Clock::time_point last_improvement_;
@@ -418,6 +438,8 @@ struct RunOutcome {
   bool solved = false;
   std::vector<Vec3> path;  ///< planner states, stub end to stub end
   double ms = 0.0;
+  std::uint64_t iterations = 0;  ///< evaluations of the termination condition
+  bool timed_out = false;        ///< the wall-clock time limit stopped the planner
 };
 
 /// Solves start→goal with `planner` (already bound to ctx.si) under the time/iteration/
@@ -442,7 +464,7 @@ RunOutcome run_planner(TubeContext& ctx, const ob::PlannerPtr& planner, bool opt
   pdef->setOptimizationObjective(ctx.objective);
 
   const bool converge = optimizing && settings.convergence_epsilon > 0.0 && settings.max_iterations == 0;
-  auto conv = std::make_shared<Convergence>(converge ? settings.convergence_window * time_limit : 0.0,
+  auto conv = std::make_shared<Convergence>(time_limit, converge ? settings.convergence_window * time_limit : 0.0,
                                             settings.convergence_epsilon, settings.max_iterations);
   pdef->setIntermediateSolutionCallback(
       [conv](const ob::Planner*, const std::vector<const ob::State*>&, const ob::Cost c) {
@@ -451,11 +473,11 @@ RunOutcome run_planner(TubeContext& ctx, const ob::PlannerPtr& planner, bool opt
   planner->setProblemDefinition(pdef);
   if (!planner->isSetup()) planner->setup();
 
-  const ob::PlannerTerminationCondition ptc = ob::plannerOrTerminationCondition(
-      ob::timedPlannerTerminationCondition(time_limit),
-      ob::PlannerTerminationCondition([conv] { return conv->should_stop(); }));
+  const ob::PlannerTerminationCondition ptc([conv] { return conv->should_stop(); });
   planner->solve(ptc);
   out.ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  out.iterations = conv->iterations();
+  out.timed_out = conv->timed_out();
 
   if (!pdef->hasExactSolution()) return out;
   const auto path = std::dynamic_pointer_cast<og::PathGeometric>(pdef->getSolutionPath());
@@ -634,6 +656,8 @@ void plan_between_stubs(const ObstacleIndex& index, TubeContext& ctx, const ob::
     const RunOutcome run = run_planner(ctx, planner, optimizing, start_end, goal_end, time_limit, settings);
     r.plan_ms = run.ms;
     r.raw_states = run.path.size();
+    r.iterations = run.iterations;
+    r.time_limited = run.timed_out;
     if (run.solved) {
       const auto t1 = Clock::now();
       interior = simplify_to_key_points(index, ctx, run.path, settings.seed);
@@ -660,6 +684,7 @@ void plan_between_stubs(const ObstacleIndex& index, TubeContext& ctx, const ob::
     } else {
       run = run_planner(*thin_ctx, thin_planner, false, start_end, goal_end,
                         settings.diagnosis_fraction * time_limit, thin_settings);
+      r.time_limited = r.time_limited || run.timed_out;
     }
     if (run.solved) {
       double best = std::numeric_limits<double>::infinity();
@@ -768,6 +793,11 @@ std::vector<std::string> planner_names() {
 }
 
 bool planner_is_optimizing(const std::string& name) { return find_planner(name).optimizing; }
+
+bool planner_is_threaded(const std::string& name) {
+  find_planner(name);  // unknown names throw
+  return name == "prm" || name == "prmstar";
+}
 
 double derived_stub_length(double radius, double min_bend_radius) {
   return std::max(min_bend_radius, kStubDiameters * 2.0 * radius);

@@ -15,7 +15,10 @@
 /// condition: its first solution (rrtconnect, rrt, lazyprm) or PlanSettings::max_iterations
 /// (tested: rrtstar, informedrrtstar, sorrtstar, bitstar, lazyprmstar). Runs ending on the
 /// wall-clock budget or on cost convergence (measured in time) may stop after a different
-/// number of iterations. PRM and PRM* grow their roadmap in a second thread: not reproducible.
+/// number of iterations; PlanResult::time_limited says when the time limit ended a run (the
+/// termination condition tests the iteration budget before the clock, so a run whose budget
+/// and time end together counts as ended by its budget). PRM and PRM* grow their roadmap in
+/// a second thread: not reproducible.
 /// Generators OMPL keeps internally (e.g. BIT*'s) draw from OMPL's process seed, which
 /// seed_ompl_once sets once, before any OMPL generator exists, from the first plan's seed.
 
@@ -137,6 +140,14 @@ struct PlanResult {
   double simplify_ms = 0.0;     ///< time simplifying and reducing to key points
   double diagnose_ms = 0.0;     ///< time spent diagnosing a failure
   std::uint64_t motion_checks = 0;  ///< exact capsule checks made by the planner
+  /// Evaluations of the termination condition by the planner run (at most max_iterations
+  /// when that is set).
+  std::uint64_t iterations = 0;
+  /// True if the wall-clock time limit stopped the planner run (or the thin-path diagnosis
+  /// after a failure) before its iteration budget, first solution or cost threshold did:
+  /// such a plan is not reproducible, another run may stop after a different number of
+  /// iterations.
+  bool time_limited = false;
   /// True if status == Solved.
   bool solved() const { return status == PlanStatus::Solved; }
 };
@@ -146,6 +157,11 @@ std::vector<std::string> planner_names();
 /// True if the named planner optimises the objective (runs until convergence/budget).
 /// Throws std::invalid_argument for an unknown name.
 bool planner_is_optimizing(const std::string& name);
+
+/// True if the named planner grows its roadmap in a second thread (PRM, PRM*): its runs are
+/// not reproducible, not even with max_iterations (the threads share the iteration count).
+/// Throws std::invalid_argument for an unknown name.
+bool planner_is_threaded(const std::string& name);
 
 /// Straight stub length for a tube: max(min_bend_radius, kStubDiameters·2·radius) — the tube
 /// leaves the connector straight for at least its diameter, and for one bend radius so that

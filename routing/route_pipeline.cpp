@@ -184,6 +184,8 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
   rep.planner = opt.planner.empty() ? scene.routing.planner : opt.planner;
   rep.seed = opt.seed >= 0 ? static_cast<unsigned>(opt.seed) : scene.routing.seed;
   const double time_limit = opt.time_limit >= 0 ? opt.time_limit : scene.routing.time_limit.value;
+  rep.iterations = opt.iterations >= 0 ? static_cast<std::uint64_t>(opt.iterations)
+                                       : static_cast<std::uint64_t>(scene.routing.iterations.value);
   rep.clearance = scene.routing.clearance.value;
   double part_extra = 0.0;
   for (const auto& p : scene.parts) part_extra = std::max(part_extra, p.clearance);
@@ -327,6 +329,7 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
     req.planner = rep.planner;
     req.seed = rep.seed + static_cast<unsigned>(s);
     req.time_limit = time_limit;
+    req.max_iterations = rep.iterations;
     req.start = {a_stub, (b_stub - a_stub).norm() > 0 ? Vec3((b_stub - a_stub).normalized()) : Vec3::UnitX()};
     req.goal = {b_stub, (a_stub - b_stub).norm() > 0 ? Vec3((a_stub - b_stub).normalized()) : Vec3::UnitX()};
     PlanResult blocked;
@@ -388,12 +391,14 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
       plan.key_points = {a_stub, b_stub};
     } else {
       plan = plan_path(plan_index, req);
+      info.time_limited = plan.time_limited;
       if (!plan.solved() && part_extra > 0.0) {
         // Per-part extra clearance is applied to every part while planning (conservative);
         // if that closes every corridor, plan with the routing clearance and let the audit
         // report where a part's own extra clearance is not met.
         req.clearance = rep.clearance;
         PlanResult retry = plan_path(plan_index, req);
+        info.time_limited = info.time_limited || retry.time_limited;
         if (retry.solved()) {
           plan = retry;
           rep.notes.push_back("segment " + seg.from + " -> " + seg.to +
@@ -504,9 +509,13 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
       PlanRequest req = g.request;
       req.seed = g.request.seed + 7919u * static_cast<unsigned>(attempt);
       req.time_limit = g.request.time_limit * std::pow(2.0, attempt);
+      req.max_iterations = g.request.max_iterations << attempt;  // twice the budget, as the time
       t0 = Clock::now();
       const PlanResult plan = plan_path(plan_index, req);
       rep.timing.plan += ms_since(t0);
+      // Whether the re-plan is kept depends on its result: a timed-out one makes the segment
+      // irreproducible either way.
+      info_of(s).time_limited = info_of(s).time_limited || plan.time_limited;
       if (!plan.solved()) continue;
       const SegmentGeometry saved = g;
       const SegmentRouteInfo saved_info = info_of(s);
@@ -515,7 +524,9 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
       if (bend_failed(s)) {
         g = saved;
         build_curve(s);
+        const bool timed = info_of(s).time_limited;
         info_of(s) = saved_info;
+        info_of(s).time_limited = timed;
       } else {
         info_of(s).plan = plan;
         info_of(s).replans = attempt;
@@ -588,6 +599,26 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
   }
   rep.timing.repair = ms_since(t0);
   for (const auto& f : failed_segments) rep.notes.push_back("segment " + f + " could not be routed");
+  // 7. Reproducibility: say why another run with the same seed may give other routes.
+  if (rep.iterations == 0)
+    rep.unreproducible.push_back("no iteration budget: the planners stop on the time limit and on time-based "
+                                 "convergence, so another run may give other routes (set --iterations or "
+                                 "[routing] iterations)");
+  else if (planner_is_threaded(rep.planner))
+    rep.unreproducible.push_back("planner " + rep.planner +
+                                 " grows its roadmap in a second thread: its routes are not reproducible, "
+                                 "even with an iteration budget");
+  if (rep.iterations > 0)
+    for (const auto& info : rep.segments)
+      if (info.time_limited) {
+        const Segment& sg = h.segments[info.segment];
+        rep.unreproducible.push_back("segment " + sg.from + " -> " + sg.to + ": the time limit (" +
+                                     full_precision(time_limit) + " s per plan) ended planning before " +
+                                     std::to_string(rep.iterations) +
+                                     " iterations: its route is not reproducible (raise the time limit or lower "
+                                     "the iterations)");
+      }
+  for (const auto& n : rep.unreproducible) rep.notes.push_back(n);
   rep.timing.total = ms_since(t_total);
   return rep;
 }

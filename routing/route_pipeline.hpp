@@ -10,6 +10,7 @@
 #include "routing/audit.hpp"
 #include "routing/path_planner.hpp"
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -22,6 +23,13 @@ struct RouteOptions {
   std::string planner;       ///< empty: scene.routing.planner
   double time_limit = -1.0;  ///< seconds per segment; < 0: scene.routing.time_limit
   long seed = -1;            ///< < 0: scene.routing.seed
+  /// Planner iterations per segment (PlanSettings::max_iterations); < 0: scene.routing.
+  /// iterations; 0: none. Every plan of the run gets it: the per-part clearance retry the
+  /// same, the k-th bend re-plan 2^k times it (as its time limit). With a budget, a seeded
+  /// run gives the same routes every time unless the time limit ends a plan first
+  /// (SegmentRouteInfo::time_limited, noted in the report) or the planner is threaded
+  /// (planner_is_threaded: PRM, PRM*).
+  long long iterations = -1;
   int threads = 0;           ///< audit threads (≤ 0: all cores)
   /// Plan among α-simplified obstacles (false: the exact parts). Off by default: on the
   /// bundled wing section α-SIM costs ~0.25 s (with its containment check and lost-space
@@ -51,6 +59,9 @@ struct SegmentRouteInfo {
   int repair_rounds = 0;      ///< densification rounds after the audit
   int replans = 0;            ///< re-plans that were kept because the bend repair failed
   std::string bend_status;    ///< outcome of the bend-radius repair
+  /// True if the time limit ended any plan of this segment (first plan, clearance retry or
+  /// bend re-plan) before its iteration budget: this segment's route is not reproducible.
+  bool time_limited = false;
 };
 
 /// Why a cable has no route.
@@ -75,6 +86,10 @@ struct RouteReport {
   RouteTimings timing;
   std::string planner;
   unsigned seed = 0;
+  std::uint64_t iterations = 0;          ///< planner iterations per segment (0: none)
+  /// Why this run may not be reproducible: one line per cause (no iteration budget, a
+  /// threaded planner, each segment whose plan the time limit ended). Also in `notes`.
+  std::vector<std::string> unreproducible;
   double clearance = 0.0;                ///< required clearance used
   std::vector<std::string> notes;
   /// DESIGN §4: 3 if a cable could not be routed, else 1 if clashes/violations remain, else 0.

@@ -41,6 +41,8 @@ json route_report_json(const RouteReport& rep) {
   json j = audit_report_json(rep.audit);
   j["planner"] = rep.planner;
   j["seed"] = rep.seed;
+  j["iterations"] = rep.iterations;  // 0: none
+  j["reproducible"] = rep.unreproducible.empty();
   j["clearance"] = rep.clearance;
   // Per cable: the audit's figures plus how it was routed.
   std::map<std::string, double> plan_ms;
@@ -80,6 +82,8 @@ json route_report_json(const RouteReport& rep) {
       if (!info.plan.message.empty()) o["message"] = info.plan.message;
       if (info.plan.blocked_at) o["blocked_at"] = {info.plan.blocked_at->x(), info.plan.blocked_at->y(), info.plan.blocked_at->z()};
       o["plan_ms"] = info.plan.time_ms;
+      o["iterations"] = info.plan.iterations;
+      o["time_limited"] = info.time_limited;
       if (info.plan.solved()) {
         o["planned_length"] = info.plan.length;
         o["planned_min_clearance"] = finite_or(info.plan.min_clearance, 0.0);

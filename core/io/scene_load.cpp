@@ -197,8 +197,9 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
   scene.routing.clearance = {dmin > 0 ? dmin : 1.0 * mm,
                              dmin > 0 ? "default: smallest cable diameter" : "default: 1 mm (no cables)"};
   scene.routing.time_limit = {1.0, "default: 1 s per cable or bundle"};
+  scene.routing.iterations = {0.0, "default: none (stop on time and convergence)"};
   if (const toml::table* rt = r.section(doc, "routing")) {
-    r.only_keys(*rt, "routing", {"clearance", "planner", "time_limit", "seed"});
+    r.only_keys(*rt, "routing", {"clearance", "planner", "time_limit", "seed", "iterations"});
     if (auto v = r.number(*rt, "routing", "clearance")) {
       if (*v < 0) r.fail(rt->get("clearance"), "routing.clearance", "must not be negative");
       scene.routing.clearance = {*v, "scene file"};
@@ -215,6 +216,14 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
                "must be an integer in 0.." + std::to_string(std::numeric_limits<std::uint32_t>::max()) + ", got " +
                    full_precision(*v));
       scene.routing.seed = static_cast<unsigned>(*v);
+    }
+    if (auto v = r.number(*rt, "routing", "iterations")) {
+      // A whole number of planner iterations; 0 would read as "none", which leaving the key
+      // out already says.
+      if (*v < 1 || *v != std::floor(*v) || *v > static_cast<double>(kMaxPlanIterations))
+        r.fail(rt->get("iterations"), "routing.iterations",
+               "must be an integer in 1.." + std::to_string(kMaxPlanIterations) + ", got " + full_precision(*v));
+      scene.routing.iterations = {*v, "scene file"};
     }
   }
   // [simplify]
