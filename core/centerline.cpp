@@ -754,12 +754,10 @@ double Centerline::locate_fold(double a, double b) const {
   return 0.5 * (a + b);
 }
 
-BendExtremum Centerline::min_bend_radius() const {
-  BendExtremum best;
-  best.radius = std::numeric_limits<double>::infinity();
-  if (cps_.empty()) return best;
-  double best_k = 0.0;
-  double best_u = u_min();
+std::vector<Centerline::BendPoint> Centerline::bend_profile() const {
+  std::vector<BendPoint> out;
+  if (cps_.empty()) return out;
+  const double inf = std::numeric_limits<double>::infinity();
   // Kinks: tangent direction jumps across interior knots (possible for degree 1 or with
   // multiple knots) have zero bend radius.
   for (std::size_t k = 1; k + 1 < span_u_.size(); ++k) {
@@ -767,15 +765,10 @@ BendExtremum Centerline::min_bend_radius() const {
     Vec3 l[2], r[2];
     evaluate(u, 1, l, true);
     evaluate(u, 1, r, false);
-    if (l[1].norm() > 0.0 && r[1].norm() > 0.0) {
-      if (angle_between(l[1], r[1]) > kKinkAngle) {
-        best.radius = 0.0;
-        best.u = u;
-        best.s = arc_length_at(u);
-        return best;
-      }
-    }
+    if (l[1].norm() > 0.0 && r[1].norm() > 0.0 && angle_between(l[1], r[1]) > kKinkAngle)
+      out.push_back({u, inf, BendPoint::Kink});
   }
+  const std::size_t kinks = out.size();  // out[0, kinks): the kinks, in u order
   Vec3 t_prev = Vec3::Zero();  // last non-zero tangent of the dense search, and its u
   double u_prev = u_min();
   for (std::size_t k = 0; k < span_index_.size(); ++k) {
@@ -787,38 +780,30 @@ BendExtremum Centerline::min_bend_radius() const {
       return curvature_from(d[1], d[2]);
     };
     const int N = degree_ == 1 ? 1 : kBendSamplesPerSpan;
-    int imax = 0;
-    double kmax = -1.0;
     double samples[kBendSamplesPerSpan + 1];
     for (int i = 0; i <= N; ++i) {
       const double ui = a + (b - a) * i / N;
       Vec3 d[3];
       evaluate_on_span(span, ui, 2, d);
-      const double kv = curvature_from(d[1], d[2]);
-      samples[i] = kv;
-      if (kv > kmax) {
-        kmax = kv;
-        imax = i;
-      }
+      samples[i] = curvature_from(d[1], d[2]);
+      out.push_back({ui, samples[i], BendPoint::Sample});
       // A fold (cusp, C' = 0 with the tangent reversing) has zero bend radius but no finite
       // curvature sample shows it: look for a large tangent turn between samples and
       // bisect it down to a point.
       if (!(d[1].norm() > kStationaryRelSpeed * typical_speed_)) continue;  // no direction here
-      if (t_prev.norm() > 0.0 && angle_between(t_prev, d[1]) > kFoldSampleAngle) {
+      // A kink between the two samples turns the tangent too: it is that kink, not a fold.
+      if (t_prev.norm() > 0.0 && angle_between(t_prev, d[1]) > kFoldSampleAngle &&
+          std::none_of(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(kinks), [&](const BendPoint& q) {
+            return q.u >= u_prev && q.u <= ui;
+          })) {
         const double uc = locate_fold(u_prev, ui);
-        if (!std::isnan(uc)) {
-          best.radius = 0.0;
-          best.u = uc;
-          best.s = arc_length_at(uc);
-          return best;
-        }
+        if (!std::isnan(uc)) out.push_back({uc, inf, BendPoint::Fold});
       }
       t_prev = d[1];
       u_prev = ui;
     }
     // Golden-section refinement of every sampled local maximum on its neighbouring interval.
     const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-    double u_at = a + (b - a) * imax / N;
     for (int i = 0; i <= N; ++i) {
       const double ki = samples[i];
       if ((i > 0 && samples[i - 1] > ki) || (i < N && samples[i + 1] > ki) || ki <= 0.0) continue;
@@ -840,26 +825,63 @@ BendExtremum Centerline::min_bend_radius() const {
           f2 = kappa(x2);
         }
       }
-      if (f1 > kmax) {
-        kmax = f1;
-        u_at = x1;
-      }
-      if (f2 > kmax) {
-        kmax = f2;
-        u_at = x2;
-      }
-    }
-    if (kmax > best_k) {
-      best_k = kmax;
-      best_u = u_at;
+      out.push_back({x1, f1, BendPoint::Peak});
+      out.push_back({x2, f2, BendPoint::Peak});
     }
   }
-  if (best_k > 0.0) {
-    best.radius = 1.0 / best_k;
-    best.u = best_u;
-    best.s = arc_length_at(best_u);
+  // In u order; at equal u the scan's order (kinks, samples, folds and peaks as found).
+  std::stable_sort(out.begin(), out.end(), [](const BendPoint& x, const BendPoint& y) { return x.u < y.u; });
+  return out;
+}
+
+BendExtremum Centerline::min_bend_radius() const {
+  BendExtremum best;
+  best.radius = std::numeric_limits<double>::infinity();
+  const std::vector<BendPoint> profile = bend_profile();
+  // A kink is the minimum wherever it lies (the first one), then the first fold, then the
+  // sharpest smooth point (the first of equals).
+  const BendPoint* at = nullptr;
+  for (auto kind : {BendPoint::Kink, BendPoint::Fold})
+    for (const BendPoint& b : profile)
+      if (!at && b.kind == kind) at = &b;
+  if (at) {
+    best.radius = 0.0;
+  } else {
+    for (const BendPoint& b : profile)
+      if (b.kappa > 0.0 && (!at || b.kappa > at->kappa)) at = &b;
+    if (!at) return best;
+    best.radius = 1.0 / at->kappa;
   }
+  best.u = at->u;
+  best.s = arc_length_at(at->u);
   return best;
+}
+
+std::vector<BendExtremum> Centerline::bend_stretches_below(double limit) const {
+  std::vector<BendExtremum> out;
+  if (!(limit > 0.0)) return out;
+  const double k_limit = 1.0 / limit;
+  const BendPoint* tightest = nullptr;  // of the stretch being walked, if any
+  auto close = [&]() {
+    if (!tightest) return;
+    BendExtremum e;
+    e.radius = std::isinf(tightest->kappa) ? 0.0 : 1.0 / tightest->kappa;
+    e.u = tightest->u;
+    e.s = arc_length_at(tightest->u);
+    out.push_back(e);
+    tightest = nullptr;
+  };
+  const std::vector<BendPoint> profile = bend_profile();
+  for (const BendPoint& b : profile) {
+    if (!(b.kappa > k_limit)) {
+      // A sample at or below the limit ends the stretch; refined peaks and kinks lie on it.
+      if (b.kind == BendPoint::Sample) close();
+      continue;
+    }
+    if (!tightest || b.kappa > tightest->kappa) tightest = &b;
+  }
+  close();
+  return out;
 }
 
 }  // namespace loom

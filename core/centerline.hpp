@@ -160,6 +160,13 @@ class Centerline {
   /// kink (tangent jump at a knot, e.g. polyline corners) or a fold (C' = 0 with the
   /// tangent reversing); infinity for a straight curve.
   BendExtremum min_bend_radius() const;
+  /// Every contiguous stretch of the curve bending tighter than `limit` (bend radius <
+  /// limit, scene units), each at its tightest point, in order along the curve: a cable
+  /// with two tight corners has two. Stretches are told apart by the dense samples of the
+  /// search (kBendSamplesPerSpan per knot span): two peaks whose dip above the limit no
+  /// sample catches are one stretch, at the tighter. Kinks and folds are stretches of
+  /// radius 0. Empty if limit ≤ 0 or nothing bends that tightly.
+  std::vector<BendExtremum> bend_stretches_below(double limit) const;
 
   /// Writes C⁽ᵏ⁾(u) for k = 0..nder (nder ≤ 3) into out[0..nder]; u is clamped to the
   /// domain. With left_limit, at an interior knot the span to the left is used (one-sided
@@ -202,6 +209,15 @@ class Centerline {
   void evaluate_on_span(int piece, double u, int nder, Vec3* out) const;
   double curvature_from(const Vec3& d1, const Vec3& d2) const;
   double locate_fold(double a, double b) const;
+  /// One point of the bend search: curvature κ at u (infinity at a kink or fold).
+  struct BendPoint {
+    double u = 0.0;
+    double kappa = 0.0;
+    enum Kind { Sample, Peak, Kink, Fold } kind = Sample;
+  };
+  /// The bend search in u order: every dense sample, the golden-section refinement of each
+  /// sampled local maximum, tangent kinks at interior knots and folds.
+  std::vector<BendPoint> bend_profile() const;
   double span_length(int span, double a, double b) const;
   double solve_length_in_span(std::size_t k, double u0, double s0, double target) const;
 };

@@ -34,11 +34,11 @@ constexpr double kChordShareOfTolerance = 0.5;
 constexpr double kMaxChordsPerCable = 1e7;
 
 /// The smallest bend radius of cable c (per bend piece where it has them) into `sum`, and a
-/// bend-radius violation into `out` where it is below the cable's minimum.
+/// bend-radius violation into `out` for every stretch bending tighter than the cable's
+/// minimum (Centerline::bend_stretches_below), at its tightest point.
 void check_bend(const Context& ctx, std::size_t c, CableCheckSummary& sum, std::vector<Violation>& out) {
   const CableInput& in = ctx.cables[c];
   BendExtremum b = in.bend_pieces.empty() ? in.curve.min_bend_radius() : BendExtremum{};
-  Vec3 where = in.bend_pieces.empty() ? in.curve.position(b.u) : Vec3::Zero();
   if (!in.bend_pieces.empty()) {
     b.radius = std::numeric_limits<double>::infinity();
     for (const auto& [s0, piece] : in.bend_pieces) {
@@ -46,22 +46,28 @@ void check_bend(const Context& ctx, std::size_t c, CableCheckSummary& sum, std::
       if (pb.radius < b.radius) {
         b = pb;
         b.s += s0;
-        where = piece.position(pb.u);
       }
     }
   }
   sum.min_bend_radius = b.radius;
   sum.min_bend_s = b.s;
-  if (ctx.req.check_bend && in.min_bend_radius > 0.0 && b.radius < in.min_bend_radius) {
-    Violation v;
-    v.kind = ViolationKind::BendRadius;
-    v.cable = static_cast<int>(c);
-    v.value = b.radius;
-    v.limit = in.min_bend_radius;
-    v.s = b.s;
-    v.point = where;
-    out.push_back(v);
-  }
+  if (!(ctx.req.check_bend && in.min_bend_radius > 0.0 && b.radius < in.min_bend_radius)) return;
+  // One violation per stretch bending tighter than the minimum, at its tightest point (as
+  // one clash per contact stretch): a route with two tight corners needs both mended.
+  auto add = [&](const Centerline& curve, double s0) {
+    for (const BendExtremum& e : curve.bend_stretches_below(in.min_bend_radius)) {
+      Violation v;
+      v.kind = ViolationKind::BendRadius;
+      v.cable = static_cast<int>(c);
+      v.value = e.radius;
+      v.limit = in.min_bend_radius;
+      v.s = s0 + e.s;
+      v.point = curve.position(e.u);
+      out.push_back(v);
+    }
+  };
+  if (in.bend_pieces.empty()) add(in.curve, 0.0);
+  for (const auto& [s0, piece] : in.bend_pieces) add(piece, s0);
 }
 
 }  // namespace

@@ -613,3 +613,89 @@ RC_GTEST_PROP(CenterlineProperty, HullBoundsHoldOnDenseSamples, ()) {
     }
   }
 }
+
+// Every stretch bending tighter than a limit, each at its tightest point, against a
+// brute-force walk of 2·10⁵ curvature samples: the same stretches (in order), each
+// stretch's radius within 1e-6 of the brute-force minimum over it (refined around it), and
+// the tightest of them is min_bend_radius().
+TEST(Centerline, BendStretchesBelowALimitAgreeWithBruteForce) {
+  // An S: two quarter arcs of radius 5 joined by a straight run, and a straight exit.
+  std::vector<Vec3> pts;
+  for (int i = 0; i <= 12; ++i) {
+    const double a = M_PI / 2 * i / 12;
+    pts.emplace_back(5 * std::sin(a), 5 - 5 * std::cos(a), 0);  // (0,0) → (5,5), turning left
+  }
+  for (int i = 1; i <= 6; ++i) pts.emplace_back(5, 5 + 5.0 * i, 0);  // straight up to (5, 35)
+  for (int i = 1; i <= 12; ++i) {
+    const double a = M_PI / 2 * i / 12;
+    pts.emplace_back(10 - 5 * std::cos(a), 35 + 5 * std::sin(a), 0);  // turning right to (10, 40)
+  }
+  for (int i = 1; i <= 6; ++i) pts.emplace_back(10 + 5.0 * i, 40, 0);
+  const Centerline c = Centerline::interpolate(pts);
+  for (double limit : {3.5, 4.0, 6.0, 50.0}) {
+    const std::vector<loom::BendExtremum> got = c.bend_stretches_below(limit);
+    // Brute force: stretches of consecutive samples with κ > 1/limit, and their minimum radius.
+    struct Stretch {
+      double u0, u1, radius;
+    };
+    std::vector<Stretch> want;
+    const int N = 200000;
+    bool in = false;
+    for (int k = 0; k <= N; ++k) {
+      const double u = c.u_min() + (c.u_max() - c.u_min()) * k / N;
+      const double kap = c.curvature(u);
+      if (kap > 1.0 / limit) {
+        if (!in) want.push_back({u, u, std::numeric_limits<double>::infinity()});
+        in = true;
+        want.back().u1 = u;
+        want.back().radius = std::min(want.back().radius, 1.0 / kap);
+      } else {
+        in = false;
+      }
+    }
+    ASSERT_EQ(got.size(), want.size()) << "limit " << limit;
+    // Narrow curvature peaks fall between the samples: refine each stretch's brute-force
+    // minimum on a fine grid around its best sample and around the reported point.
+    const double h = (c.u_max() - c.u_min()) / N;
+    for (std::size_t i = 0; i < got.size(); ++i) {
+      double best_u = want[i].u0;
+      for (int k = 0; k <= N; ++k) {
+        const double u = c.u_min() + (c.u_max() - c.u_min()) * k / N;
+        if (u < want[i].u0 || u > want[i].u1) continue;
+        if (1.0 / c.curvature(u) <= want[i].radius) best_u = u;
+      }
+      for (double centre : {best_u, got[i].u})
+        for (int k = -20000; k <= 20000; ++k) {
+          const double u = std::clamp(centre + 2.0 * h * k / 20000.0, c.u_min(), c.u_max());
+          const double kap = c.curvature(u);
+          if (kap > 0) want[i].radius = std::min(want[i].radius, 1.0 / kap);
+        }
+    }
+    for (std::size_t i = 0; i < got.size(); ++i) {
+      EXPECT_GE(got[i].u, want[i].u0 - 1e-3) << "limit " << limit << " stretch " << i;
+      EXPECT_LE(got[i].u, want[i].u1 + 1e-3) << "limit " << limit << " stretch " << i;
+      EXPECT_LE(got[i].radius, want[i].radius * (1 + 1e-9)) << "limit " << limit << " stretch " << i;
+      EXPECT_GE(got[i].radius, want[i].radius * (1 - 1e-6)) << "limit " << limit << " stretch " << i;
+      EXPECT_NEAR(got[i].s, c.arc_length_at(got[i].u), 1e-9 * c.length());
+    }
+    if (!got.empty()) {
+      const auto tightest = std::min_element(got.begin(), got.end(), [](const auto& a, const auto& b) {
+        return a.radius < b.radius;
+      });
+      EXPECT_EQ(tightest->radius, c.min_bend_radius().radius) << "limit " << limit;
+    }
+  }
+  // The two arcs (radius ~5, ~3.9 where the interpolant meets the straight run) are two
+  // stretches below 6; nothing is below 3.5.
+  EXPECT_EQ(c.bend_stretches_below(6.0).size(), 2u);
+  EXPECT_TRUE(c.bend_stretches_below(3.5).empty());
+  // A polyline's corners are stretches of radius 0, one per corner, at the corners.
+  const Centerline poly = Centerline::polyline({Vec3(0, 0, 0), Vec3(10, 0, 0), Vec3(10, 10, 0), Vec3(0, 10, 0), Vec3(0, 20, 0)});
+  const auto corners = poly.bend_stretches_below(1.0);
+  ASSERT_EQ(corners.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(corners[i].radius, 0.0);
+    EXPECT_NEAR(corners[i].s, 10.0 * static_cast<double>(i + 1), 1e-9);
+  }
+  EXPECT_TRUE(poly.bend_stretches_below(0.0).empty());
+}

@@ -621,3 +621,20 @@ TEST(Regression, EmbreeInsideRayMissedACrossingAtASharedEdge) {
     EXPECT_EQ(wrong, 0) << rays << " rays";
   }
 }
+
+// A cable with two tight corners far apart got one bend-radius violation, at the tighter
+// (the report's "one entry per contiguous stretch" held for clashes only): mending it and
+// auditing again showed the second. A polyline with corners at s = 10 and s = 60 (radius 0,
+// minimum 5) now gives a violation at each.
+TEST(Regression, OnlyTheTightestBendOfACableWasReported) {
+  const std::vector<loom::Part> parts{loom::testmesh::box_part("box", Vec3(0, 0, -100), Vec3(10, 10, -90))};
+  loom::CableInput c =
+      regression_cable("C", {Vec3(0, 0, 0), Vec3(10, 0, 0), Vec3(10, 50, 0), Vec3(60, 50, 0)}, 1.0);
+  c.min_bend_radius = 5.0;
+  const loom::ClashResult res = regression_audit({c}, parts, 0.01);
+  const std::string in = "polyline (0,0,0) (10,0,0) (10,50,0) (60,50,0), r 1, min bend radius 5";
+  ASSERT_EQ(res.violations.size(), 2u) << in;
+  EXPECT_NEAR(res.violations[0].s, 10.0, 1e-9) << in;
+  EXPECT_NEAR(res.violations[1].s, 60.0, 1e-9) << in;
+  for (const auto& v : res.violations) EXPECT_EQ(v.value, 0.0) << in;
+}
