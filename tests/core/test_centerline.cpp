@@ -10,6 +10,8 @@
 #include <TColStd_HArray1OfReal.hxx>
 #include <TColgp_HArray1OfPnt.hxx>
 
+#include "../common/occt_curve.hpp"
+
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
 
@@ -25,6 +27,8 @@ using loom::KnotMethod;
 using loom::Vec3;
 
 namespace {
+
+using loom::test_oracle::to_occt;
 
 std::vector<Vec3> random_walk(std::mt19937& rng, int n, double step) {
   std::uniform_real_distribution<double> d(-1.0, 1.0);
@@ -42,31 +46,6 @@ double scale_of(const std::vector<Vec3>& p) {
   return b.diagonal();
 }
 
-/// The same curve as an OpenCASCADE Geom_BSplineCurve (knots with multiplicities).
-Handle(Geom_BSplineCurve) to_occt(const Centerline& c) {
-  std::vector<double> k;
-  std::vector<int> m;
-  for (double u : c.knots()) {
-    if (!k.empty() && u == k.back())
-      ++m.back();
-    else {
-      k.push_back(u);
-      m.push_back(1);
-    }
-  }
-  TColgp_Array1OfPnt poles(1, static_cast<int>(c.control_points().size()));
-  for (int i = 0; i < poles.Length(); ++i) {
-    const Vec3& p = c.control_points()[i];
-    poles.SetValue(i + 1, gp_Pnt(p.x(), p.y(), p.z()));
-  }
-  TColStd_Array1OfReal knots(1, static_cast<int>(k.size()));
-  TColStd_Array1OfInteger mults(1, static_cast<int>(k.size()));
-  for (std::size_t i = 0; i < k.size(); ++i) {
-    knots.SetValue(static_cast<int>(i) + 1, k[i]);
-    mults.SetValue(static_cast<int>(i) + 1, m[i]);
-  }
-  return new Geom_BSplineCurve(poles, knots, mults, c.degree());
-}
 
 Vec3 v3(const gp_Pnt& p) { return Vec3(p.X(), p.Y(), p.Z()); }
 Vec3 v3(const gp_Vec& p) { return Vec3(p.X(), p.Y(), p.Z()); }

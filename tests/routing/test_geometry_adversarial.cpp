@@ -18,6 +18,8 @@
 #include <TColStd_HArray1OfReal.hxx>
 #include <TColgp_HArray1OfPnt.hxx>
 
+#include "../common/occt_curve.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -32,6 +34,8 @@ using loom::KnotMethod;
 using loom::Vec3;
 
 namespace {
+
+using loom::test_oracle::to_occt;
 
 Vec3 v3(const gp_Pnt& p) { return Vec3(p.X(), p.Y(), p.Z()); }
 gp_Vec gv(const Vec3& v) { return gp_Vec(v.x(), v.y(), v.z()); }
@@ -58,31 +62,6 @@ Handle(Geom_BSplineCurve) occt_interpolant(const std::vector<Vec3>& pts, const C
   return gi.Curve();
 }
 
-/// The same curve as an OpenCASCADE Geom_BSplineCurve (knots with multiplicities).
-Handle(Geom_BSplineCurve) to_occt(const Centerline& c) {
-  std::vector<double> k;
-  std::vector<int> m;
-  for (double u : c.knots()) {
-    if (!k.empty() && u == k.back())
-      ++m.back();
-    else {
-      k.push_back(u);
-      m.push_back(1);
-    }
-  }
-  TColgp_Array1OfPnt poles(1, static_cast<int>(c.control_points().size()));
-  for (int i = 0; i < poles.Length(); ++i) {
-    const Vec3& p = c.control_points()[static_cast<std::size_t>(i)];
-    poles.SetValue(i + 1, gp_Pnt(p.x(), p.y(), p.z()));
-  }
-  TColStd_Array1OfReal knots(1, static_cast<int>(k.size()));
-  TColStd_Array1OfInteger mults(1, static_cast<int>(k.size()));
-  for (std::size_t i = 0; i < k.size(); ++i) {
-    knots.SetValue(static_cast<int>(i) + 1, k[i]);
-    mults.SetValue(static_cast<int>(i) + 1, m[i]);
-  }
-  return new Geom_BSplineCurve(poles, knots, mults, c.degree());
-}
 
 /// Curvature at u from finite differences of positions in long double: C' and C'' of the
 /// Lagrange cubic through four positions spread over u's knot interval (exact for a cubic
