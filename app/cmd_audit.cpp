@@ -9,10 +9,10 @@
 #include "core/io/atomic_file.hpp"
 #include "core/io/output_set.hpp"
 #include "core/progress.hpp"
-#include "routing/audit.hpp"
-#include "routing/render.hpp"
-#include "routing/report_json.hpp"
-#include "routing/view_html.hpp"
+#include "routing/audit/audit.hpp"
+#include "routing/view/render.hpp"
+#include "routing/audit/report_json.hpp"
+#include "routing/view/view_html.hpp"
 
 #include <CLI/CLI.hpp>
 

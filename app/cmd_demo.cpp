@@ -3,7 +3,7 @@
 #include "app/commands.hpp"
 #include "app/option_checks.hpp"
 
-#include "routing/render.hpp"
+#include "routing/view/render.hpp"
 
 #include <CLI/CLI.hpp>
 

@@ -4,7 +4,7 @@
 #include "core/harness_topology.hpp"
 #include "core/io/scene_load.hpp"
 #include "core/progress.hpp"
-#include "routing/report_json.hpp"
+#include "routing/audit/report_json.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>

@@ -8,8 +8,8 @@
 #include "core/io/scene_load.hpp"
 #include "core/progress.hpp"
 #include "core/units.hpp"
-#include "routing/audit.hpp"
-#include "routing/render.hpp"
+#include "routing/audit/audit.hpp"
+#include "routing/view/render.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>

@@ -10,10 +10,10 @@
 #include "core/io/scene_load.hpp"
 #include "core/scene.hpp"
 #include "core/progress.hpp"
-#include "routing/render.hpp"
-#include "routing/report_json.hpp"
-#include "routing/route_report.hpp"
-#include "routing/view_html.hpp"
+#include "routing/view/render.hpp"
+#include "routing/audit/report_json.hpp"
+#include "routing/route/route_report.hpp"
+#include "routing/view/view_html.hpp"
 
 #include <CLI/CLI.hpp>
 

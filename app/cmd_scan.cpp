@@ -10,11 +10,11 @@
 #include "core/io/output_set.hpp"
 #include "core/io/harness_xml.hpp"
 #include "core/io/mesh_write.hpp"
-#include "routing/cable_geometry.hpp"
-#include "routing/point_cloud_io.hpp"
-#include "routing/report_json.hpp"
-#include "routing/scan_centerline.hpp"
-#include "routing/sweep.hpp"
+#include "routing/curve/cable_geometry.hpp"
+#include "routing/scan/point_cloud_io.hpp"
+#include "routing/audit/report_json.hpp"
+#include "routing/scan/scan_centerline.hpp"
+#include "routing/curve/sweep.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>

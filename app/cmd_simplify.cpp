@@ -9,8 +9,8 @@
 #include "core/io/mesh_write.hpp"
 #include "core/io/scene_load.hpp"
 #include "core/progress.hpp"
-#include "index/alpha_sim.hpp"
-#include "routing/report_json.hpp"
+#include "index/simplify/alpha_sim.hpp"
+#include "routing/audit/report_json.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>

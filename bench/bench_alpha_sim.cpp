@@ -20,9 +20,9 @@
 #include "core/io/mesh_read.hpp"
 #include "core/io/scene_load.hpp"
 #include "core/units.hpp"
-#include "index/alpha_sim.hpp"
+#include "index/simplify/alpha_sim.hpp"
 #include "index/embree_index.hpp"
-#include "routing/path_planner.hpp"
+#include "routing/route/path_planner.hpp"
 
 #include <sys/resource.h>
 #include <tbb/global_control.h>

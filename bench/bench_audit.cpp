@@ -15,7 +15,7 @@
 //   bench_audit --assembly TRIS_PER_PART [MAX_COPIES]   (the assembly series alone, printed)
 #include "bench/forwarding_index.hpp"
 #include "index/embree_index.hpp"
-#include "routing/clash_check.hpp"
+#include "routing/audit/clash_check.hpp"
 
 #include <algorithm>
 #include <chrono>

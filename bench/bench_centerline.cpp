@@ -10,8 +10,8 @@
 // Each thread sweeps its cables into one SweepResult whose storage it reuses (as a batch
 // writer would); the single-cable figures are also given with a new mesh per cable.
 #include "core/centerline.hpp"
-#include "routing/fairing.hpp"
-#include "routing/sweep.hpp"
+#include "routing/curve/fairing.hpp"
+#include "routing/curve/sweep.hpp"
 
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>

@@ -10,7 +10,7 @@
 #include "core/mesh.hpp"
 #include "core/part.hpp"
 #include "index/embree_index.hpp"
-#include "routing/path_planner.hpp"
+#include "routing/route/path_planner.hpp"
 
 #include <algorithm>
 #include <array>

@@ -8,8 +8,8 @@
 //
 // Usage: bench_route [--quick] [--scene PATH]   (--quick: two planners, two budgets)
 #include "core/io/scene_load.hpp"
-#include "index/alpha_sim.hpp"
-#include "routing/route_pipeline.hpp"
+#include "index/simplify/alpha_sim.hpp"
+#include "routing/route/route_pipeline.hpp"
 
 #include <algorithm>
 #include <chrono>

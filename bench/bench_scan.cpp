@@ -5,7 +5,7 @@
 //   scan_noise   centerline RMS error (× d) against noise σ (× d), graph vs axis method
 //   scan_blocks  block count against time and error (block length 0.5 d … 16 d)
 // Times are wall clock (median of repeats) plus process CPU time, since the machine is shared.
-#include "routing/scan_centerline.hpp"
+#include "routing/scan/scan_centerline.hpp"
 
 #include <tbb/global_control.h>
 

@@ -17,6 +17,8 @@ find_package(nlohmann_json 3 REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(spdlog REQUIRED)
 find_package(CGAL REQUIRED)
+find_package(nanoflann REQUIRED)
+find_package(PNG REQUIRED)
 
 function(loom_wrap name)
   cmake_parse_arguments(W "" "" "INCLUDES;LIBS" ${ARGN})

@@ -4,8 +4,8 @@
 #include "index/brute_force_index.hpp"
 #include "index/fcl_index.hpp"
 #include "index/triangle_distance.hpp"
-#include "index_conformance.hpp"
-#include "index_test_meshes.hpp"
+#include "index/index_conformance.hpp"
+#include "index/index_test_meshes.hpp"
 
 #include "core/error.hpp"
 

@@ -3,7 +3,7 @@
 // with brute force on a small scene.
 #include "index/brute_force_index.hpp"
 #include "index/scene_indices.hpp"
-#include "index_test_meshes.hpp"
+#include "index/index_test_meshes.hpp"
 
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>

@@ -4,8 +4,8 @@
 // OctoMap's key range, degenerate scenes, and rapidcheck properties.
 #include "index/brute_force_index.hpp"
 #include "index/voxel_map.hpp"
-#include "index_conformance.hpp"
-#include "index_test_meshes.hpp"
+#include "index/index_conformance.hpp"
+#include "index/index_test_meshes.hpp"
 
 #include "core/error.hpp"
 

@@ -3,7 +3,7 @@
 // is independent of loom's indices.
 #include "core/io/mesh_read.hpp"
 #include "core/io/mesh_write.hpp"
-#include "index/alpha_sim.hpp"
+#include "index/simplify/alpha_sim.hpp"
 
 #include "../index/alpha_sim_oracle.hpp"
 

@@ -7,9 +7,9 @@
 #include "core/mesh.hpp"
 #include "core/part.hpp"
 #include "index/brute_force_index.hpp"
-#include "routing/cable_geometry.hpp"
-#include "routing/sweep.hpp"
-#include "routing/tube_validity.hpp"
+#include "routing/curve/cable_geometry.hpp"
+#include "routing/curve/sweep.hpp"
+#include "routing/route/tube_validity.hpp"
 
 #include <ompl/base/spaces/RealVectorStateSpace.h>
 

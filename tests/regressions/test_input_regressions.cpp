@@ -27,8 +27,8 @@
 #include "core/io/mesh_read.hpp"
 #include "core/io/scene_load.hpp"
 #include "core/io/tessellation_cache.hpp"
-#include "routing/cable_geometry.hpp"
-#include "routing/point_cloud_io.hpp"
+#include "routing/curve/cable_geometry.hpp"
+#include "routing/scan/point_cloud_io.hpp"
 #include "common/run_loom.hpp"
 
 namespace {

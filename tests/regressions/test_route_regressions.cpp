@@ -1,10 +1,10 @@
 // One test per routing bug found by the adversarial review of `loom route`
 // (tests/routing/test_route_adversarial.cpp), inputs written out in full.
 #include "index/index_test_meshes.hpp"
-#include "routing/render.hpp"
-#include "routing/route_pipeline.hpp"
-#include "routing/route_report.hpp"
-#include "routing/view_html.hpp"
+#include "routing/view/render.hpp"
+#include "routing/route/route_pipeline.hpp"
+#include "routing/route/route_report.hpp"
+#include "routing/view/view_html.hpp"
 
 #include "core/io/harness_xml.hpp"
 

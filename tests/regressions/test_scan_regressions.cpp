@@ -1,9 +1,9 @@
 // Scan regressions: one test per bug found by the adversarial review of `loom scan`
 // (routing/scan_centerline), inputs generated from fixed seeds (tests/routing/scan_oracle.hpp).
 // Each test failed before its fix.
-#include "routing/point_cloud_io.hpp"
-#include "routing/scan_centerline.hpp"
-#include "routing/scan_oracle.hpp"
+#include "routing/scan/point_cloud_io.hpp"
+#include "routing/scan/scan_centerline.hpp"
+#include "routing/scan/scan_oracle.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,0 +1,296 @@
+// The audit pipeline: scene → index → checks → AuditReport (DESIGN §4).
+#include "routing/audit/audit.hpp"
+
+#include "core/error.hpp"
+#include "core/harness_topology.hpp"
+#include "core/io/harness_xml.hpp"
+#include "core/io/scene_load.hpp"
+#include "index/box_tree.hpp"
+#include "index/brute_force_index.hpp"
+#include "index/embree_index.hpp"
+#include "routing/curve/cable_geometry.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <stdexcept>
+
+namespace loom {
+
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Node ids at the ends of a segment use, in the cable's direction of travel.
+std::pair<std::string, std::string> use_nodes(const Harness& h, const SegmentUse& u) {
+  const Segment& s = h.segments[static_cast<std::size_t>(u.segment)];
+  return u.reversed ? std::make_pair(s.to, s.from) : std::make_pair(s.from, s.to);
+}
+
+/// Relative widening of the port's query box over the largest per-part reach (rounding only).
+constexpr double kReachRoundingRel = 1e-12;
+
+}  // namespace
+
+std::vector<std::string> attach_ports(const Harness& h, const std::vector<Part>& parts, double routing_clearance,
+                                      std::vector<CableInput>& inputs, const ObstacleIndex* index) {
+  // Part boxes once per audit (from the index when it keeps them: no pass over every
+  // triangle), and the part containing each port once per port (many cables share a port).
+  std::vector<AABB> boxes(parts.size());
+  double max_part_clearance = 0.0;
+  for (std::size_t q = 0; q < parts.size(); ++q) {
+    const auto kept = index ? index->part_bounds(static_cast<int>(q)) : std::nullopt;
+    boxes[q] = kept ? *kept : parts[q].mesh.bounds();
+    max_part_clearance = std::max(max_part_clearance, parts[q].clearance);
+  }
+  // The parts near a port through a BVH over their boxes, not a pass over every part per
+  // cable end (assemblies have thousands of parts, harnesses thousands of cable ends).
+  const BoxTree part_tree(boxes);
+  std::vector<std::uint32_t> near_port;
+  std::map<int, std::vector<int>> containing;  // port -> the closed parts holding it, when asked
+  auto port_inside = [&](int port, int part) {
+    auto it = containing.find(port);
+    if (it == containing.end()) {
+      it = containing.emplace(port, std::vector<int>{}).first;
+      index->inside_parts(h.ports[port].position, it->second);  // only asked with an index
+    }
+    return std::find(it->second.begin(), it->second.end(), part) != it->second.end();
+  };
+  std::set<std::pair<std::string, std::string>> said;
+  std::vector<std::string> notes;
+  for (CableInput& in : inputs) {
+    const int c = h.find_cable(in.id);
+    if (c < 0) continue;
+    const double len = in.curve.length();
+    // The port's straight exit (what the router gives it), at most half the cable.
+    const double exit = std::min(derived_stub_length(in.radius, in.min_bend_radius), 0.5 * len);
+    for (int end = 0; end < 2; ++end) {
+      const int p = h.find_port(h.cables[c].ports[end]);
+      if (p < 0) continue;
+      const Vec3 at = h.ports[p].position;
+      if (!at.allFinite()) continue;  // an unplaced port sits on no part
+      AABB port_box;
+      port_box.extend(at);
+      // A little wider than any part's reach, so that rounding cannot drop a box the exact
+      // test below keeps.
+      const double max_reach = (in.radius + routing_clearance + max_part_clearance) * (1.0 + kReachRoundingRel) +
+                               kReachRoundingRel * at.cwiseAbs().maxCoeff();
+      part_tree.overlapping(port_box.inflated(max_reach), near_port);
+      for (const std::uint32_t q : near_port) {
+        if (parts[q].role == PartRole::KeepOut) continue;  // never excused
+        const double reach = in.radius + routing_clearance + parts[q].clearance;
+        if (!boxes[q].inflated(reach).contains(at)) continue;
+        // The port's depth inside the part (0 outside or on it; `reach` for deeper): the
+        // checker excuses the centerline inside the part only where the part holds the port.
+        bool inside = false;
+        ClosestHit nearest;
+        if (index) {
+          inside = port_inside(p, static_cast<int>(q));
+          nearest = index->closest_on_part(at, static_cast<int>(q), reach);
+        } else {  // the brute-force baseline has no index: measure this one part directly
+          const BruteForceIndex one({parts[q]});
+          inside = one.inside(at);
+          nearest = one.closest(at, reach);
+        }
+        if (!inside && !nearest.found()) continue;
+        const double depth = inside ? (nearest.found() ? nearest.distance : reach) : 0.0;
+        in.attachments.push_back({static_cast<int>(q), end == 0 ? 0.0 : len - exit, end == 0 ? exit : len,
+                                  h.ports[p].id, depth});
+        if (said.insert({h.ports[p].id, parts[q].name}).second)
+          notes.push_back("port " + h.ports[p].id + " sits on part '" + parts[q].name +
+                          "': cables are not checked against it over their straight exit from the port");
+      }
+    }
+  }
+  return notes;
+}
+
+std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCable>& cables) {
+  HarnessTopology topo(h);
+  SegmentCurves curves(topo);
+  std::vector<CableInput> out;
+  cables.clear();
+  for (std::size_t c = 0; c < h.cables.size(); ++c) {
+    AuditCable ac;
+    ac.id = h.cables[c].id;
+    // A route that does not make a curve throws InputError naming the file and cable.
+    std::optional<Centerline> curve = curves.cable(static_cast<int>(c));
+    if (!curve) {
+      ac.routed = false;
+      ac.reason = "a segment of its route has an unplaced end (branch point without position)";
+      cables.push_back(ac);
+      continue;
+    }
+    CableInput in;
+    in.id = h.cables[c].id;
+    in.curve = std::move(*curve);
+    in.radius = h.cables[c].radius();
+    in.min_bend_radius = h.cables[c].physical.min_bend_radius;
+    double s = 0.0;
+    const auto& chain = topo.cable_chain(static_cast<int>(c));
+    for (std::size_t k = 0; k < chain.size(); ++k) {
+      const SegmentUse& u = chain[k];
+      const auto seg = segment_centerline(h, u.segment);
+      const double len = seg ? seg->length() : 0.0;
+      // Only bundle segments excuse contacts (a single-cable segment is never shared).
+      if (topo.is_bundle(u.segment)) in.segments.push_back({u.segment, s, s + len});
+      s += len;
+      const auto nodes = use_nodes(h, u);
+      for (const std::string& n : {nodes.first, nodes.second}) {
+        if (std::any_of(in.junctions.begin(), in.junctions.end(), [&](const CableJunction& j) { return j.node == n; }))
+          continue;
+        const auto pos = h.node_position(n);
+        if (!pos) continue;
+        double rad = 0.0;
+        for (int inc : topo.incident_segments(n)) rad = std::max(rad, topo.segment_diameter(inc));
+        // At a branch point cables run bundled along the breakout before they separate
+        // (the router leaves it straight for breakout_length); allow contact over twice
+        // that, the run-out of two tubes diverging at their minimum bend radius.
+        if (h.find_branch(n) >= 0) rad = std::max(rad, 2.0 * breakout_length(topo, n));
+        in.junctions.push_back({n, *pos, rad});
+      }
+    }
+    for (auto& piece : curves.pieces(static_cast<int>(c))) in.bend_pieces.emplace_back(piece.s0, std::move(piece.curve));
+    ac.routed = true;
+    ac.check_index = static_cast<int>(out.size());
+    cables.push_back(ac);
+    out.push_back(std::move(in));
+  }
+  return out;
+}
+
+AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
+  AuditReport rep;
+  rep.scene = scene.name;
+  rep.units = unit_name(scene.units);
+  rep.method = opt.check.method;
+  rep.use_index = opt.check.use_index;
+  rep.triangles = scene.triangle_count();
+  for (const auto& p : scene.parts) {
+    rep.part_names.push_back(p.name);
+    rep.part_keep_out.push_back(p.role == PartRole::KeepOut);
+  }
+  std::vector<CableInput> inputs;
+  if (scene.has_harness) inputs = audit_cable_inputs(scene.harness, rep.cables);
+  else rep.notes.push_back("the scene has no harness: nothing to audit");
+  for (const auto& c : inputs) rep.check_ids.push_back(c.id);
+  for (const auto& c : rep.cables)
+    if (!c.routed) rep.notes.push_back("cable '" + c.id + "' not checked: " + c.reason);
+
+  ClashRequest req = opt.check;
+  req.routing_clearance = scene.routing.clearance.value;
+  if (!req.progress) req.progress = opt.progress;
+  std::unique_ptr<ObstacleIndex> owned;
+  const ObstacleIndex* index = nullptr;
+  if (req.use_index || req.method == ClashMethod::Certified) {
+    if (opt.index) {
+      index = opt.index;
+    } else {
+      ProgressCounter built(opt.progress, "index", 1, "indices");
+      const auto t0 = std::chrono::steady_clock::now();
+      owned = std::make_unique<EmbreeIndex>(scene.parts);
+      rep.index_ms = ms_since(t0);
+      built.finish();
+      index = owned.get();
+    }
+    rep.index_name = index->name();
+    rep.index_accuracy = index->accuracy().description;
+  } else {
+    rep.index_name = "none";
+    rep.index_accuracy = "brute force over every triangle (double precision)";
+  }
+  if (scene.has_harness)
+    for (auto& n : attach_ports(scene.harness, scene.parts, req.routing_clearance, inputs, index)) rep.notes.push_back(n);
+  const auto t1 = std::chrono::steady_clock::now();
+  rep.result = check_clashes(inputs, scene.parts, index, req);
+  rep.check_ms = ms_since(t1);
+  rep.notes.insert(rep.notes.end(), rep.result.notes.begin(), rep.result.notes.end());
+  return rep;
+}
+
+namespace {
+
+/// "file:line" of a harness element, for messages that point at a second file.
+std::string file_line(const Harness& h, int line) {
+  return h.source_file + (line > 0 ? ":" + std::to_string(line) : std::string());
+}
+
+/// The two ports of a cable as an unordered pair (either end may come first in a file).
+std::pair<std::string, std::string> port_pair(const Cable& c) {
+  return std::minmax(c.ports[0], c.ports[1]);
+}
+
+/// Refuses a requested certified tolerance at or above the thinnest cable's radius: a
+/// certified audit may miss contacts shallower than the tolerance, and at r a centerline
+/// lying on a part's surface (clearance −r) is one of them.
+void check_requested_tolerance(const Harness& h, const ClashRequest& req) {
+  if (req.method != ClashMethod::Certified || !(req.tolerance > 0.0) || h.cables.empty()) return;
+  const auto thinnest = std::min_element(h.cables.begin(), h.cables.end(), [](const Cable& a, const Cable& b) {
+    return a.radius() < b.radius();
+  });
+  if (req.tolerance < thinnest->radius()) return;
+  throw InputError({"", 0, "--tolerance"},
+                   full_precision(req.tolerance) + " is not below the radius " + full_precision(thinnest->radius()) +
+                       " of the thinnest cable '" + thinnest->id +
+                       "': a certified audit to it could miss that cable lying on a part's surface; give a "
+                       "tolerance below the radius (default: radius / 100)");
+}
+
+}  // namespace
+
+void check_routes_match(const Harness& designed, const Harness& routes) {
+  const std::string& file = routes.source_file;
+  for (const Cable& c : routes.cables) {
+    const SourceLocation where{file, c.line, "cable '" + c.id + "'"};
+    const int d = designed.find_cable(c.id);
+    if (d < 0)
+      throw InputError(where, "not a cable of the scene's harness " + designed.source_file +
+                                  " (routes for another harness?)");
+    const Cable& want = designed.cables[static_cast<std::size_t>(d)];
+    const std::string scene_says = " in the scene's harness (" + file_line(designed, want.line) + ")";
+    if (port_pair(c) != port_pair(want))
+      throw InputError(where, "joins ports " + c.ports[0] + " and " + c.ports[1] + ", but " + want.ports[0] + " and " +
+                                  want.ports[1] + scene_says);
+    if (c.physical.diameter != want.physical.diameter)
+      throw InputError(where, "diameter " + full_precision(c.physical.diameter) + ", but " +
+                                  full_precision(want.physical.diameter) + scene_says);
+    if (c.physical.min_bend_radius != want.physical.min_bend_radius)
+      throw InputError(where, "min_bend_radius " + full_precision(c.physical.min_bend_radius) + ", but " +
+                                  full_precision(want.physical.min_bend_radius) + scene_says);
+  }
+  for (const Cable& want : designed.cables)
+    if (routes.find_cable(want.id) < 0)
+      throw InputError({file, 0, "harness '" + routes.name + "'"},
+                       "has no cable '" + want.id + "' of the scene's harness (" + file_line(designed, want.line) +
+                           "): it would go unchecked");
+}
+
+void apply_matching_routes(Scene& scene, const std::filesystem::path& routes) {
+  std::optional<Harness> designed;
+  if (scene.has_harness) designed = std::move(scene.harness);
+  apply_routes(scene, routes);
+  if (designed) check_routes_match(*designed, scene.harness);
+}
+
+AuditReport audit_scene_file(const std::filesystem::path& scene_file, const AuditOptions& opt, Scene* loaded) {
+  const auto t0 = std::chrono::steady_clock::now();
+  SceneLoadReport load_rep;
+  SceneLoadOptions load_opt;
+  load_opt.progress = opt.progress;
+  Scene scene = load_scene(scene_file, load_opt, &load_rep);
+  if (opt.routes) apply_matching_routes(scene, *opt.routes);
+  if (scene.has_harness) check_requested_tolerance(scene.harness, opt.check);
+  const double load_ms = ms_since(t0);
+  AuditReport rep = run_audit(scene, opt);
+  rep.load_ms = load_ms;
+  rep.notes.insert(rep.notes.begin(), load_rep.notes.begin(), load_rep.notes.end());
+  if (loaded) *loaded = std::move(scene);
+  return rep;
+}
+
+}  // namespace loom

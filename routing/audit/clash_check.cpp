@@ -1,0 +1,246 @@
+// Clash checking: the entry point (clash_check.hpp) — tolerances derived, the passes run
+// (clash_structure.cpp, clash_pairs.cpp, clash_discrete.cpp), results sorted — and the
+// bend check.
+#include "routing/audit/clash_check.hpp"
+
+#include "routing/audit/chord_plan.hpp"
+#include "routing/audit/clash_context.hpp"
+
+#include "core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace loom {
+
+using namespace audit;  // the passes' shared context (clash_context.hpp)
+
+namespace {
+
+/// Default tolerance as a fraction of the smallest cable radius (DESIGN §7).
+constexpr double kDefaultToleranceOfRadius = 0.01;
+/// The tolerance reported when there is no cable to derive it from (nothing is checked).
+constexpr double kNoCableTolerance = 0.01;
+/// Share of the tolerance left to the chords' distance from the curve; the rest covers the
+/// index's own error (structure: chord + index ≤ tol; cable–cable: 2 · chord ≤ tol).
+constexpr double kChordShareOfTolerance = 0.5;
+/// Most chords the certified audit accepts for one cable's deviation bound. A routed cable
+/// (bends of at least a few radii) needs a few thousand at the default tolerance, a
+/// 100 m cable at a 1 µm tolerance ~10⁶; beyond this the route wiggles on the scale of the
+/// tolerance (e.g. 200,000 key points 1 µm apart) and flattening it would not end.
+constexpr double kMaxChordsPerCable = 1e7;
+
+/// The smallest bend radius of cable c (per bend piece where it has them) into `sum`, and a
+/// bend-radius violation into `out` for every stretch bending tighter than the cable's
+/// minimum (Centerline::bend_stretches_below), at its tightest point.
+void check_bend(const Context& ctx, std::size_t c, CableCheckSummary& sum, std::vector<Violation>& out) {
+  const CableInput& in = ctx.cables[c];
+  BendExtremum b = in.bend_pieces.empty() ? in.curve.min_bend_radius() : BendExtremum{};
+  if (!in.bend_pieces.empty()) {
+    b.radius = std::numeric_limits<double>::infinity();
+    for (const auto& [s0, piece] : in.bend_pieces) {
+      const BendExtremum pb = piece.min_bend_radius();
+      if (pb.radius < b.radius) {
+        b = pb;
+        b.s += s0;
+      }
+    }
+  }
+  sum.min_bend_radius = b.radius;
+  sum.min_bend_s = b.s;
+  if (!(ctx.req.check_bend && in.min_bend_radius > 0.0 && b.radius < in.min_bend_radius)) return;
+  // One violation per stretch bending tighter than the minimum, at its tightest point (as
+  // one clash per contact stretch): a route with two tight corners needs both mended.
+  auto add = [&](const Centerline& curve, double s0) {
+    for (const BendExtremum& e : curve.bend_stretches_below(in.min_bend_radius)) {
+      Violation v;
+      v.kind = ViolationKind::BendRadius;
+      v.cable = static_cast<int>(c);
+      v.value = e.radius;
+      v.limit = in.min_bend_radius;
+      v.s = s0 + e.s;
+      v.point = curve.position(e.u);
+      out.push_back(v);
+    }
+  };
+  if (in.bend_pieces.empty()) add(in.curve, 0.0);
+  for (const auto& [s0, piece] : in.bend_pieces) add(piece, s0);
+}
+
+}  // namespace
+
+const char* clash_method_name(ClashMethod m) { return m == ClashMethod::Certified ? "certified" : "discrete"; }
+
+const char* clash_kind_name(ClashKind k) {
+  switch (k) {
+    case ClashKind::CableStructure: return "cable-structure";
+    case ClashKind::CableCable: return "cable-cable";
+    case ClashKind::Self: return "self";
+  }
+  return "?";
+}
+
+const char* violation_kind_name(ViolationKind k) {
+  return k == ViolationKind::BendRadius ? "bend-radius" : "clearance";
+}
+
+double default_clash_tolerance(const std::vector<CableInput>& cables, std::string* source) {
+  double rmin = kInf;
+  for (const auto& c : cables) rmin = std::min(rmin, c.radius);
+  if (!std::isfinite(rmin)) {
+    if (source) *source = "no cables to derive it from";
+    return kNoCableTolerance;
+  }
+  if (source) *source = "smallest cable radius / 100";
+  return kDefaultToleranceOfRadius * rmin;
+}
+
+ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vector<Part>& parts,
+                          const ObstacleIndex* index, const ClashRequest& request) {
+  for (const auto& c : cables) {
+    if (c.curve.empty()) throw std::invalid_argument("check_clashes: cable '" + c.id + "' has no centerline");
+    if (!(c.radius > 0.0) || !std::isfinite(c.radius))
+      throw std::invalid_argument("check_clashes: cable '" + c.id + "' has a non-positive radius");
+  }
+  const bool need_index = request.use_index || request.method == ClashMethod::Certified;
+  if (need_index && index == nullptr) throw std::invalid_argument("check_clashes: an index is required");
+  if (index != nullptr && index->part_count() != static_cast<int>(parts.size()))
+    throw std::invalid_argument("check_clashes: the index does not index the given parts");
+  if (!(request.distance_rel_error >= 0.0) || !std::isfinite(request.distance_rel_error))
+    throw std::invalid_argument("check_clashes: distance_rel_error must be finite and >= 0, got " +
+                                full_precision(request.distance_rel_error));
+
+  Context ctx{cables, parts, index, request, {}, 0.0, 0.0, 0.0, 0.0, {}, nullptr};
+  ClashResult res;
+  ctx.info.resize(parts.size());
+  for (std::size_t q = 0; q < parts.size(); ++q) {
+    // The index keeps each part's box: no pass over every triangle per audit.
+    const std::optional<AABB> kept = index ? index->part_bounds(static_cast<int>(q)) : std::nullopt;
+    ctx.info[q].box = kept ? *kept : parts[q].mesh.bounds();
+    ctx.info[q].required = std::max(0.0, request.routing_clearance + parts[q].clearance);
+    ctx.info[q].keep_out = parts[q].role == PartRole::KeepOut;
+    ctx.info[q].closed = parts[q].closed;
+    ctx.band = std::max(ctx.band, ctx.info[q].required);
+    if (!parts[q].closed) res.notes.push_back("part '" + parts[q].name + "' is open: surface checks only");
+  }
+  if (request.tolerance > 0.0) {
+    ctx.tol = request.tolerance;
+    res.tolerance_source = "request";
+  } else {
+    ctx.tol = default_clash_tolerance(cables, &res.tolerance_source);
+  }
+  if (index) ctx.abs_err = index->accuracy().abs_error;
+  if (request.method == ClashMethod::Certified && !(ctx.abs_err < 0.5 * ctx.tol))
+    // A tolerance at or below the index's rounding cannot be certified: say where the
+    // tolerance came from (--tolerance, or the thinnest cable) at full precision.
+    throw std::invalid_argument("clash tolerance " + full_precision(ctx.tol) + " (" +
+                                (res.tolerance_source == "request" ? std::string("as requested") : res.tolerance_source) +
+                                ") is not above twice the index's distance rounding " + full_precision(ctx.abs_err) +
+                                " (scene units): give --tolerance above " + full_precision(2.0 * ctx.abs_err) +
+                                " or check the cable diameters and the scene's units");
+  ctx.chord_error = kChordShareOfTolerance * (ctx.tol - ctx.abs_err);
+  if (request.method == ClashMethod::Certified)
+    for (const auto& c : cables) {
+      const double hmax = kMaxChordRadii * c.radius;
+      const double n = planned_chords(c.curve, ctx.chord_error, hmax, kShortSpanRadii * c.radius);
+      if (n <= kMaxChordsPerCable) continue;
+      // Say which bound asked for the chords: the longest chord (a route thousands of
+      // kilometres long is a units or key-point mistake) or the chord error (a wiggle).
+      const double by_length = c.curve.length() / hmax;
+      const std::string reason =
+          by_length >= 0.5 * n
+              ? "it is " + full_precision(c.curve.length()) + " long, " + full_precision(std::ceil(by_length)) +
+                    " chords of at most 2r = " + full_precision(hmax) + "; check its key points and units"
+              : "its curvature reaches the scale of the tolerance; smooth the route or raise --tolerance";
+      throw std::invalid_argument("check_clashes: cable '" + c.id + "' would need " + full_precision(n) +
+                                  " chords to stay within " + full_precision(ctx.chord_error) +
+                                  " of its curve (more than " + full_precision(kMaxChordsPerCable) + "): " + reason);
+    }
+  res.cables.resize(cables.size());
+  std::vector<std::vector<ClashEntry>> per_clash(cables.size());
+  std::vector<std::vector<Violation>> per_viol(cables.size());
+  ProgressCounter checked(request.progress, "audit", cables.size(), "cables");
+
+  if (request.method == ClashMethod::Certified) {
+    res.tolerance = ctx.tol;
+    res.chord_error = ctx.chord_error;
+    res.distance_rel_error = request.distance_rel_error;
+    if (request.check_structure && !parts.empty()) {
+      std::vector<AABB> boxes(parts.size());
+      for (std::size_t q = 0; q < parts.size(); ++q) boxes[q] = ctx.info[q].box;
+      // In the audit's arena: Embree's builder runs on TBB and must not exceed `threads`.
+      tbb::task_arena arena(request.threads > 0 ? request.threads : tbb::task_arena::automatic);
+      arena.execute([&] { ctx.part_tree = std::make_unique<BoxTree>(std::move(boxes)); });
+    }
+    parallel_indices(cables.size(), request.threads, [&](std::size_t c) {
+      CableCheckSummary& sum = res.cables[c];
+      sum.length = cables[c].curve.length();
+      if (request.check_structure && !parts.empty()) {
+        certified_structure(ctx, static_cast<int>(c), sum, per_clash[c], per_viol[c]);
+      } else {
+        sum.min_clearance = kInf;
+      }
+      check_bend(ctx, c, sum, per_viol[c]);
+      checked.add();
+    });
+  } else {
+    std::vector<DiscreteSamples> ds(cables.size());
+    res.spacing = request.spacing > 0.0 ? request.spacing : 0.0;
+    // A spacing far below the cable's length is a request mistake: name the cable and where
+    // the spacing came from before any sampling.
+    for (const auto& c : cables) {
+      const double l = request.spacing > 0.0 ? request.spacing : 2.0 * c.radius;
+      const double n = std::ceil(c.curve.length() / l);
+      if (n > Centerline::kMaxArcSamples)
+        throw std::invalid_argument("cable '" + c.id + "': sample spacing " + full_precision(l) +
+                                    (request.spacing > 0.0 ? " (--spacing)" : " (its diameter)") + " gives " +
+                                    full_precision(n) + " samples over its length " +
+                                    full_precision(c.curve.length()) + ", more than the " +
+                                    full_precision(Centerline::kMaxArcSamples) + " the discrete method takes");
+    }
+    parallel_indices(cables.size(), request.threads, [&](std::size_t c) {
+      const double l = request.spacing > 0.0 ? request.spacing : 2.0 * cables[c].radius;
+      const auto samples = cables[c].curve.sample_by_arc_length(l);
+      ds[c].spacing = samples.size() > 1 ? samples[1].first - samples[0].first : l;
+      for (const auto& sp : samples) {
+        ds[c].s.push_back(sp.first);
+        ds[c].p.push_back(sp.second);
+      }
+      ctx.counters.samples += as_i64(samples.size());
+      CableCheckSummary& sum = res.cables[c];
+      sum.length = cables[c].curve.length();
+      sum.min_clearance = kInf;
+      if (request.check_structure && !parts.empty()) {
+        StretchTracker tr(static_cast<int>(c), cables[c].radius, ctx.info, cables[c].attachments, {}, ctx.tol);
+        discrete_structure(ctx, static_cast<int>(c), ds[c], tr);
+        per_clash[c] = std::move(tr.clashes);
+        per_viol[c] = std::move(tr.violations);
+        sum.min_clearance = std::max(tr.min_key, -cables[c].radius);
+      }
+      check_bend(ctx, c, sum, per_viol[c]);
+      checked.add();
+    });
+    std::vector<ClashEntry> pair_out;
+    discrete_cable_pairs(ctx, ds, pair_out);
+    for (const auto& e : pair_out) per_clash[e.cable].push_back(e);
+  }
+  if (request.method == ClashMethod::Certified) {
+    std::vector<ClashEntry> pair_out;
+    certified_cable_pairs(ctx, pair_out);
+    for (const auto& e : pair_out) per_clash[e.cable].push_back(e);
+  }
+  for (std::size_t c = 0; c < cables.size(); ++c) {
+    std::sort(per_clash[c].begin(), per_clash[c].end(), [](const ClashEntry& a, const ClashEntry& b) { return a.s < b.s; });
+    std::sort(per_viol[c].begin(), per_viol[c].end(), [](const Violation& a, const Violation& b) { return a.s < b.s; });
+    res.clashes.insert(res.clashes.end(), per_clash[c].begin(), per_clash[c].end());
+    res.violations.insert(res.violations.end(), per_viol[c].begin(), per_viol[c].end());
+  }
+  res.counters = ctx.counters.snapshot();
+  checked.finish();
+  return res;
+}
+
+}  // namespace loom

@@ -1,0 +1,135 @@
+// report.json of `loom audit` (DESIGN §4).
+#include "routing/audit/report_json.hpp"
+
+#include "core/io/atomic_file.hpp"
+
+#include <cmath>
+
+namespace loom {
+
+namespace {
+
+using nlohmann::json;
+
+json vec_json(const Vec3& v) {
+  // Points come from finite geometry; a non-finite coordinate would be a bug upstream, but
+  // the report never carries one: clamp to 0 and the caller's note says so.
+  return json::array({std::isfinite(v.x()) ? v.x() : 0.0, std::isfinite(v.y()) ? v.y() : 0.0,
+                      std::isfinite(v.z()) ? v.z() : 0.0});
+}
+
+/// Sets j[key] = v when finite; otherwise leaves it out and sets j[key + "_note"] = why.
+void put(json& j, const std::string& key, double v, const std::string& why) {
+  if (std::isfinite(v))
+    j[key] = v;
+  else
+    j[key + "_note"] = why;
+}
+
+}  // namespace
+
+json audit_report_json(const AuditReport& rep) {
+  const ClashResult& r = rep.result;
+  json j;
+  j["scene"] = rep.scene;
+  j["units"] = rep.units;
+  j["method"] = clash_method_name(rep.method);
+  if (rep.method == ClashMethod::Certified) {
+    put(j, "tolerance", r.tolerance, "tolerance could not be derived");
+    j["tolerance_source"] = r.tolerance_source;
+    j["chord_error"] = r.chord_error;
+    j["free_space_rel_error"] = r.distance_rel_error;
+  } else {
+    j["tolerance_note"] = "discrete method: sampled, not certified (obstacles between samples can be missed)";
+    if (r.spacing > 0.0) j["spacing"] = r.spacing;
+    else j["spacing_note"] = "each cable sampled at its diameter 2r (the paper's rule)";
+  }
+  j["index"] = rep.index_name;
+  j["index_accuracy"] = rep.index_accuracy;
+
+  json clashes = json::array();
+  for (const ClashEntry& e : r.clashes) {
+    json c;
+    c["kind"] = clash_kind_name(e.kind);
+    c["cable"] = rep.check_ids.at(static_cast<std::size_t>(e.cable));
+    if (e.kind == ClashKind::CableStructure) {
+      c["part"] = rep.part_names.at(static_cast<std::size_t>(e.part));
+      c["keep_out"] = e.keep_out;
+      c["inside"] = e.inside;
+    } else if (e.kind == ClashKind::CableCable) {
+      c["other"] = rep.check_ids.at(static_cast<std::size_t>(e.other));
+    }
+    put(c, "clearance", e.clearance, "unbounded");
+    c["point"] = vec_json(e.point);
+    c["s"] = e.s;
+    if (e.kind != ClashKind::CableStructure) c["s_other"] = e.s_other;
+    c["s_begin"] = e.s_begin;
+    c["s_end"] = e.s_end;
+    clashes.push_back(c);
+  }
+  j["clashes"] = clashes;
+
+  json violations = json::array();
+  for (const Violation& v : r.violations) {
+    json o;
+    o["kind"] = violation_kind_name(v.kind);
+    o["cable"] = rep.check_ids.at(static_cast<std::size_t>(v.cable));
+    if (v.kind == ViolationKind::BendRadius) {
+      o["radius"] = v.value;  // finite: smaller than a finite minimum
+      o["min"] = v.limit;
+    } else {
+      o["part"] = rep.part_names.at(static_cast<std::size_t>(v.part));
+      o["clearance"] = v.value;
+      o["required"] = v.limit;
+    }
+    o["s"] = v.s;
+    o["point"] = vec_json(v.point);
+    violations.push_back(o);
+  }
+  j["violations"] = violations;
+
+  json cables = json::array();
+  for (const AuditCable& c : rep.cables) {
+    json o;
+    o["id"] = c.id;
+    o["routed"] = c.routed;
+    if (c.routed) {
+      const CableCheckSummary& s = r.cables.at(static_cast<std::size_t>(c.check_index));
+      o["length"] = s.length;
+      put(o, "min_clearance", s.min_clearance, "no part within the audited distance of this cable");
+      if (std::isfinite(s.min_clearance)) o["min_clearance_exact"] = s.min_clearance_exact;
+      put(o, "min_bend_radius", s.min_bend_radius, "straight: no curvature anywhere");
+    } else {
+      o["reason"] = c.reason;
+    }
+    cables.push_back(o);
+  }
+  j["cables"] = cables;
+  j["timing_ms"] = {{"load", rep.load_ms}, {"index", rep.index_ms}, {"route", 0.0}, {"check", rep.check_ms}};
+  j["counters"] = {{"distance_queries", r.counters.distance_queries},
+                   {"inside_queries", r.counters.inside_queries},
+                   {"pair_tests", r.counters.pair_tests},
+                   {"samples", r.counters.samples}};
+  j["triangles"] = rep.triangles;
+  j["notes"] = rep.notes;
+  return j;
+}
+
+std::set<std::string> unrouted_cable_ids(const nlohmann::json& report) {
+  std::set<std::string> ids;
+  if (!report.is_object() || !report.contains("cables") || !report["cables"].is_array()) return ids;
+  for (const auto& c : report["cables"])
+    if (c.is_object() && c.contains("id") && c["id"].is_string() && c.contains("routed") && c["routed"] == false)
+      ids.insert(c["id"].get<std::string>());
+  return ids;
+}
+
+std::string json_text(const nlohmann::json& j, int indent) {
+  return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+void write_audit_report(const AuditReport& report, const std::filesystem::path& path) {
+  write_file_atomic(path, json_text(audit_report_json(report), 2) + "\n");
+}
+
+}  // namespace loom
