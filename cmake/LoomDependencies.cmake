@@ -14,11 +14,11 @@ find_package(assimp REQUIRED)
 find_package(pugixml REQUIRED)
 find_package(tomlplusplus REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
-find_package(CLI11 REQUIRED)
-find_package(spdlog REQUIRED)
 find_package(CGAL REQUIRED)
 find_package(nanoflann REQUIRED)
 find_package(PNG REQUIRED)
+find_library(LOOM_LZF_LIBRARY lzf REQUIRED)
+find_path(LOOM_LZF_INCLUDE_DIR liblzf/lzf.h REQUIRED)
 
 function(loom_wrap name)
   cmake_parse_arguments(W "" "" "INCLUDES;LIBS" ${ARGN})
@@ -34,6 +34,7 @@ endfunction()
 
 loom_wrap(octomap INCLUDES ${OCTOMAP_INCLUDE_DIRS} LIBS ${OCTOMAP_LIBRARIES})
 loom_wrap(edt3d INCLUDES ${DYNAMICEDT3D_INCLUDE_DIRS} LIBS ${DYNAMICEDT3D_LIBRARIES} ${OCTOMAP_LIBRARIES})
+loom_wrap(lzf INCLUDES ${LOOM_LZF_INCLUDE_DIR} LIBS ${LOOM_LZF_LIBRARY})
 loom_wrap(ompl INCLUDES ${OMPL_INCLUDE_DIRS} LIBS ${OMPL_LIBRARIES})
 # OpenCASCADE: the toolkits loom uses (STEP/IGES/XCAF in, meshing, Booleans, STEP out).
 loom_wrap(occt INCLUDES ${OpenCASCADE_INCLUDE_DIR}
@@ -41,6 +42,9 @@ loom_wrap(occt INCLUDES ${OpenCASCADE_INCLUDE_DIR}
        TKMesh TKBO TKBool TKFillet TKOffset TKXSBase TKSTEP TKSTEPBase TKSTEPAttr TKSTEP209
        TKIGES TKLCAF TKCAF TKCDF TKXCAF TKXDESTEP TKXDEIGES TKV3d TKService)
 
+if(LOOM_BUILD_APP)
+  find_package(CLI11 REQUIRED)
+endif()
 if(LOOM_BUILD_TESTS)
   find_package(GTest REQUIRED)
   find_package(rapidcheck REQUIRED)

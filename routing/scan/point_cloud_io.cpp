@@ -5,6 +5,8 @@
 #include "core/io/input_file.hpp"
 #include "core/io/mesh_file_checks.hpp"
 
+#include <liblzf/lzf.h>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -27,35 +29,6 @@ const char* to_string(PointCloudFormat f) {
     case PointCloudFormat::PcdBinaryCompressed: return "pcd-binary-compressed";
   }
   return "unknown";
-}
-
-std::size_t lzf_decompress(const std::uint8_t* in, std::size_t in_len, std::uint8_t* out,
-                           std::size_t out_len) {
-  std::size_t ip = 0, op = 0;
-  while (ip < in_len) {
-    const unsigned ctrl = in[ip++];
-    if (ctrl < 32) {  // literal run of ctrl + 1 bytes
-      const std::size_t len = ctrl + 1;
-      if (ip + len > in_len || op + len > out_len) return 0;
-      std::memcpy(out + op, in + ip, len);
-      ip += len;
-      op += len;
-    } else {  // back reference: length (ctrl >> 5) + 2, offset from the low 5 bits + next byte
-      std::size_t len = ctrl >> 5;
-      if (len == 7) {
-        if (ip >= in_len) return 0;
-        len += in[ip++];
-      }
-      len += 2;
-      if (ip >= in_len) return 0;
-      const std::size_t back = ((static_cast<std::size_t>(ctrl & 0x1f) << 8) | in[ip++]) + 1;
-      if (back > op || op + len > out_len) return 0;
-      const std::uint8_t* ref = out + op - back;
-      for (std::size_t k = 0; k < len; ++k) out[op + k] = ref[k];  // may overlap: byte by byte
-      op += len;
-    }
-  }
-  return op;
 }
 
 namespace {
@@ -589,7 +562,7 @@ PointCloud parse_pcd(const std::string& bytes, const std::string& file) {
                                                 "expand the " + std::to_string(csize) + " compressed bytes to (at most " +
                                                 std::to_string(kLzfMaxExpansion) + "x)");
     std::vector<std::uint8_t> buf(usize);
-    if (usize > 0 && lzf_decompress(d + start + 8, csize, buf.data(), buf.size()) != usize)
+    if (usize > 0 && lzf_decompress(d + start + 8, static_cast<unsigned>(csize), buf.data(), static_cast<unsigned>(buf.size())) != usize)
       fail_at_byte(file, start + 8, "DATA", "corrupt LZF compressed data");
     // Field-major layout: all values of field 0, then of field 1, ...
     std::vector<std::size_t> foff(fields.size());

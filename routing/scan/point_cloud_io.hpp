@@ -47,11 +47,6 @@ PointCloud read_point_cloud(const std::filesystem::path& path);
 /// extension is used for format detection like a path's).
 PointCloud parse_point_cloud(const std::string& bytes, const std::string& name_for_errors);
 
-/// LZF decompression (the format of PCD binary_compressed). Returns the number of bytes
-/// written to `out`, or 0 if the input is corrupt or would overflow `out_len`.
-std::size_t lzf_decompress(const std::uint8_t* in, std::size_t in_len, std::uint8_t* out,
-                           std::size_t out_len);
-
 /// Writes points as a PLY file (binary little endian, or ascii), atomically.
 void write_point_cloud_ply(const std::filesystem::path& path, const std::vector<Vec3>& points,
                            bool binary = true);
