@@ -10,7 +10,7 @@
 #include <TColStd_HArray1OfReal.hxx>
 #include <TColgp_HArray1OfPnt.hxx>
 
-#include "../common/occt_curve.hpp"
+#include "common/occt_curve.hpp"
 
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>

@@ -5,7 +5,7 @@
 #include "core/io/mesh_write.hpp"
 #include "index/simplify/alpha_sim.hpp"
 
-#include "../index/alpha_sim_oracle.hpp"
+#include "index/simplify/alpha_sim_oracle.hpp"
 
 #include <gtest/gtest.h>
 

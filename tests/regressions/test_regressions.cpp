@@ -29,8 +29,8 @@
 #include "routing/audit/clash_check.hpp"
 #include "routing/curve/sweep.hpp"
 
-#include "../common/brute_geometry.hpp"
-#include "../index/index_test_meshes.hpp"
+#include "common/brute_geometry.hpp"
+#include "index/index_test_meshes.hpp"
 
 namespace {
 
