@@ -4,6 +4,7 @@
 #include "core/harness_topology.hpp"
 #include "core/io/atomic_file.hpp"
 #include "core/io/input_file.hpp"
+#include "core/io/line_map.hpp"
 
 #include <pugixml.hpp>
 
@@ -50,22 +51,6 @@ std::size_t first_invalid_utf8(const std::string& s) {
   }
   return std::string::npos;
 }
-
-/// Maps pugixml byte offsets to 1-based line numbers.
-class LineMap {
- public:
-  explicit LineMap(const std::string& text) {
-    for (std::size_t i = 0; i < text.size(); ++i)
-      if (text[i] == '\n') newlines_.push_back(static_cast<std::ptrdiff_t>(i));
-  }
-  int line(std::ptrdiff_t offset) const {
-    if (offset < 0) return 0;
-    return static_cast<int>(std::lower_bound(newlines_.begin(), newlines_.end(), offset) - newlines_.begin()) + 1;
-  }
-
- private:
-  std::vector<std::ptrdiff_t> newlines_;
-};
 
 /// Longest entity or character reference looked at ("&#x10FFFF;" and every predefined
 /// entity fit); a longer one is not a reference pugixml or this reader knows.

@@ -1,9 +1,8 @@
 #include "core/io/mesh_file_checks.hpp"
 
 #include "core/error.hpp"
-
-#include <nlohmann/json.hpp>
-#include <pugixml.hpp>
+#include "core/io/input_file.hpp"
+#include "core/io/mesh_node_checks.hpp"
 
 #include <algorithm>
 #include <array>
@@ -22,22 +21,6 @@
 namespace loom {
 
 namespace {
-
-/// At most `limit` bytes from the start of the file.
-std::string head_of(const std::filesystem::path& path, std::size_t limit) {
-  std::ifstream in(path, std::ios::binary);
-  std::string s(limit, '\0');
-  in.read(s.data(), static_cast<std::streamsize>(limit));
-  s.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
-  return s;
-}
-
-std::string whole_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 std::vector<std::string> words(const std::string& line) {
   std::istringstream is(line);
@@ -118,7 +101,7 @@ void check_ply_header_ends(const std::string& head, bool whole, const std::files
 /// The header of a PLY file; false for a header this check cannot parse (left to Assimp).
 bool read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
   constexpr std::size_t kMaxHeader = 1 << 20;  // PLY headers are a few hundred bytes
-  const std::string head = head_of(path, kMaxHeader);
+  const std::string head = file_bytes(path, kMaxHeader);
   if (head.compare(0, 3, "ply") != 0) return false;  // Assimp finds no PLY reader for it
   check_ply_header_ends(head, head.size() < kMaxHeader, path);
   const std::size_t end = head.find("end_header");
@@ -381,7 +364,7 @@ void check_ply(const std::filesystem::path& path) {
 /// The OFF header's vertex and face counts against the file size: each vertex and face takes
 /// at least one line. A header this check cannot parse is left to Assimp.
 void check_off(const std::filesystem::path& path) {
-  const std::string head = head_of(path, 1 << 16);
+  const std::string head = file_bytes(path, 1 << 16);
   std::istringstream is(head);
   std::vector<std::string> tokens;
   std::vector<int> lines;
@@ -412,7 +395,7 @@ void check_off(const std::filesystem::path& path) {
   // Face indices: Assimp's OFF reader replaces one beyond the vertices by the last vertex
   // (logging an error nobody sees), a silently different triangle. Lines after the header's:
   // nv vertex lines, then faces "k i1 .. ik [colour]"; blank and '#' lines skipped.
-  std::istringstream all(whole_file(path));
+  std::istringstream all(file_bytes(path));
   int no = 0;
   std::uint64_t seen_v = 0, seen_f = 0;
   for (std::string line; seen_f < nf && std::getline(all, line);) {
@@ -436,108 +419,6 @@ void check_off(const std::filesystem::path& path) {
                              std::to_string(nv == 0 ? 0 : nv - 1) + ")");
     }
     ++seen_f;
-  }
-}
-
-// --- nesting -----------------------------------------------------------------------------
-
-[[noreturn]] void too_deep(const std::filesystem::path& path, int line, const std::string& what) {
-  throw InputError({path.string(), line, what},
-                   "nested more than " + std::to_string(kMaxMeshNesting) +
-                       " levels deep (Assimp reads the hierarchy recursively and would overflow the stack)");
-}
-
-/// The deepest XML element nesting of a DAE file (pugixml parses without recursion).
-void check_dae(const std::filesystem::path& path) {
-  const std::string text = whole_file(path);
-  pugi::xml_document doc;
-  if (!doc.load_buffer(text.data(), text.size(), pugi::parse_minimal)) return;
-  std::vector<std::pair<pugi::xml_node, std::size_t>> stack{{doc, 0}};
-  while (!stack.empty()) {
-    const auto [node, depth] = stack.back();
-    stack.pop_back();
-    if (depth > kMaxMeshNesting) {
-      const auto offset = node.offset_debug();
-      const int line = offset < 0 ? 0 : static_cast<int>(std::count(text.begin(), text.begin() + offset, '\n')) + 1;
-      too_deep(path, line, "<" + std::string(node.name()) + ">");
-    }
-    for (pugi::xml_node c = node.first_child(); c; c = c.next_sibling())
-      if (c.type() == pugi::node_element) stack.push_back({c, depth + 1});
-  }
-}
-
-/// The JSON of a glTF file, or of a GLB file's first (JSON) chunk; empty if there is none.
-std::string gltf_json(const std::filesystem::path& path, bool binary) {
-  if (!binary) return whole_file(path);
-  const std::string head = head_of(path, 20);
-  if (head.size() < 20 || head.compare(0, 4, "glTF") != 0) return {};
-  auto u32 = [&](std::size_t at) {
-    std::uint32_t v = 0;
-    for (int k = 3; k >= 0; --k) v = (v << 8) | static_cast<unsigned char>(head[at + static_cast<std::size_t>(k)]);
-    return v;
-  };
-  const std::uint32_t length = u32(12);
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
-  if (ec || 20 + static_cast<std::uint64_t>(length) > size) return {};
-  std::ifstream in(path, std::ios::binary);
-  in.seekg(20);
-  std::string json(length, '\0');
-  in.read(json.data(), static_cast<std::streamsize>(length));
-  return json;
-}
-
-/// The deepest node hierarchy of a glTF (2.0: "nodes" an array, children indices; 1.0: an
-/// object, children names), memoised so that shared subtrees are walked once.
-void check_gltf(const std::filesystem::path& path, bool binary) {
-  const nlohmann::json doc = nlohmann::json::parse(gltf_json(path, binary), nullptr, false);
-  if (doc.is_discarded() || !doc.is_object() || !doc.contains("nodes")) return;
-  const nlohmann::json& nodes = doc["nodes"];
-  std::map<std::string, std::vector<std::string>> children;
-  auto add = [&](const std::string& id, const nlohmann::json& node) {
-    auto& out = children[id];
-    if (!node.is_object() || !node.contains("children") || !node["children"].is_array()) return;
-    for (const auto& c : node["children"]) {
-      if (c.is_number_unsigned()) out.push_back(std::to_string(c.get<std::uint64_t>()));
-      else if (c.is_string()) out.push_back(c.get<std::string>());
-    }
-  };
-  if (nodes.is_array())
-    for (std::size_t i = 0; i < nodes.size(); ++i) add(std::to_string(i), nodes[i]);
-  else if (nodes.is_object())
-    for (const auto& [id, node] : nodes.items()) add(id, node);
-  else
-    return;
-  // Height of each node's subtree, computed iteratively (post-order). A node met again
-  // while still open is a cycle: Assimp reports those itself, so it ends the walk here.
-  std::map<std::string, std::size_t> height;
-  std::map<std::string, bool> open;
-  for (const auto& [root, unused] : children) {
-    (void)unused;
-    if (height.count(root)) continue;
-    std::vector<std::pair<std::string, std::size_t>> stack{{root, 0}};  // node, next child
-    open[root] = true;
-    while (!stack.empty()) {
-      auto& [id, next] = stack.back();
-      const auto it = children.find(id);
-      const std::vector<std::string> none;
-      const auto& kids = it == children.end() ? none : it->second;
-      if (next < kids.size()) {
-        const std::string kid = kids[next++];
-        if (height.count(kid)) continue;
-        if (open[kid]) return;  // a cycle
-        open[kid] = true;
-        stack.push_back({kid, 0});
-        if (stack.size() > kMaxMeshNesting) too_deep(path, 0, "node " + kid);
-        continue;
-      }
-      std::size_t h = 0;
-      for (const auto& k : kids) h = std::max(h, height.count(k) ? height[k] + 1 : 0);
-      if (h > kMaxMeshNesting) too_deep(path, 0, "node " + id);
-      height[id] = h;
-      open[id] = false;
-      stack.pop_back();
-    }
   }
 }
 
@@ -567,9 +448,9 @@ void check_mesh_file_structure(const std::filesystem::path& path) {
   const std::string ext = lower_extension(path);
   if (ext == ".ply") check_ply(path);
   else if (ext == ".off") check_off(path);
-  else if (ext == ".dae") check_dae(path);
-  else if (ext == ".gltf") check_gltf(path, false);
-  else if (ext == ".glb") check_gltf(path, true);
+  else if (ext == ".dae") check_dae_file(path);
+  else if (ext == ".gltf") check_gltf_file(path, false);
+  else if (ext == ".glb") check_gltf_file(path, true);
 }
 
 }  // namespace loom
