@@ -3,6 +3,7 @@
 #include "core/error.hpp"
 #include "core/io/input_file.hpp"
 #include "core/io/mesh_file_checks.hpp"
+#include "core/io/step_file_checks.hpp"
 
 #include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
@@ -263,6 +264,7 @@ std::vector<NamedMesh> read_cad_file_occ(const std::filesystem::path& path, cons
   Interface_Static::SetCVal("xstep.cascade.unit", "MM");
   bool ok = false;
   if (ext == ".step" || ext == ".stp") {
+    check_step_references(path);  // OpenCASCADE's transfer follows a dangling one
     STEPCAFControl_Reader reader;
     reader.SetNameMode(true);
     if (reader.ReadFile(path.string().c_str()) != IFSelect_RetDone)
