@@ -227,8 +227,11 @@ class Reader {
   void no_text(const pugi::xml_node& n) const {
     for (auto c : n.children()) {
       if (c.type() != pugi::node_pcdata && c.type() != pugi::node_cdata) continue;
-      const std::string t = c.value();
-      if (std::all_of(t.begin(), t.end(), [](unsigned char ch) { return std::isspace(ch); })) continue;
+      std::string t = c.value();
+      const auto blank = [](unsigned char ch) { return std::isspace(ch); };
+      t.erase(t.begin(), std::find_if_not(t.begin(), t.end(), blank));
+      if (t.empty()) continue;
+      t.erase(std::find_if_not(t.rbegin(), t.rend(), blank).base(), t.end());
       constexpr std::size_t kShown = 40;
       throw InputError({file_, line(c), describe(n)},
                        "unexpected text '" + t.substr(0, kShown) + (t.size() > kShown ? "...'" : "'") + " inside <" +

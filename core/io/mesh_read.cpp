@@ -76,12 +76,16 @@ class RegularFilesOnly : public Assimp::DefaultIOSystem {
   std::string served_path_, served_;
 };
 
-/// An OBJ text with its `o` and `usemtl` statements turned into comments (same bytes count,
-/// same lines). Why: Assimp's OBJ parser looks each object and material name up in a list of
-/// those seen before, quadratic in their number (40,000 one-triangle objects: 3.6 s, 100,000:
-/// 28 s; as many materials: 27 s for 40,000). loom merges every object into one mesh and
-/// reads no materials, so the names change nothing it reads.
-std::string obj_without_names(std::string text) {
+
+void finish_mesh(Mesh& m, const std::filesystem::path& path, const std::string& what) {
+  const long bad = first_non_finite_vertex(m);
+  if (bad >= 0)
+    throw InputError({path.string(), 0, what}, "vertex " + std::to_string(bad) + " has a NaN or infinite coordinate");
+  weld_identical_vertices(m);
+}
+}  // namespace
+
+std::string obj_text_for_assimp(std::string text) {
   bool continued = false;  // the previous line ended in a backslash: this one continues it
   for (std::size_t at = 0; at < text.size();) {
     std::size_t end = text.find('\n', at);
@@ -102,14 +106,6 @@ std::string obj_without_names(std::string text) {
   return text;
 }
 
-void finish_mesh(Mesh& m, const std::filesystem::path& path, const std::string& what) {
-  const long bad = first_non_finite_vertex(m);
-  if (bad >= 0)
-    throw InputError({path.string(), 0, what}, "vertex " + std::to_string(bad) + " has a NaN or infinite coordinate");
-  weld_identical_vertices(m);
-}
-}  // namespace
-
 bool is_cad_file(const std::filesystem::path& p) {
   const auto e = lower_extension(p);
   return e == ".step" || e == ".stp" || e == ".iges" || e == ".igs";
@@ -129,7 +125,7 @@ Mesh read_mesh_file(const std::filesystem::path& path) {
   Assimp::Importer importer;
   auto* io = new RegularFilesOnly;
   importer.SetIOHandler(io);  // the importer owns and deletes it
-  if (lower_extension(path) == ".obj") io->serve(path.string(), obj_without_names(file_bytes(path)));
+  if (lower_extension(path) == ".obj") io->serve(path.string(), obj_text_for_assimp(file_bytes(path)));
   // Points and lines are dropped; node transforms are baked in so one mesh results.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   // ValidateDataStructure runs before the other steps: a face index beyond the vertices (which
