@@ -4,6 +4,7 @@
 #include "core/harness_topology.hpp"
 #include "core/io/atomic_file.hpp"
 #include "core/io/input_file.hpp"
+#include "core/io/line_map.hpp"
 
 #include <pugixml.hpp>
 
@@ -50,22 +51,6 @@ std::size_t first_invalid_utf8(const std::string& s) {
   }
   return std::string::npos;
 }
-
-/// Maps pugixml byte offsets to 1-based line numbers.
-class LineMap {
- public:
-  explicit LineMap(const std::string& text) {
-    for (std::size_t i = 0; i < text.size(); ++i)
-      if (text[i] == '\n') newlines_.push_back(static_cast<std::ptrdiff_t>(i));
-  }
-  int line(std::ptrdiff_t offset) const {
-    if (offset < 0) return 0;
-    return static_cast<int>(std::lower_bound(newlines_.begin(), newlines_.end(), offset) - newlines_.begin()) + 1;
-  }
-
- private:
-  std::vector<std::ptrdiff_t> newlines_;
-};
 
 /// Longest entity or character reference looked at ("&#x10FFFF;" and every predefined
 /// entity fit); a longer one is not a reference pugixml or this reader knows.
@@ -182,11 +167,15 @@ class Reader {
   }
 
   double parse_number(const pugi::xml_node& n, const std::string& attr, const std::string& v) const {
+    // Blanks alone are no value: strtod converts nothing, and skipping the trailing blanks
+    // before asking whether it did read " " as 0.
+    if (std::all_of(v.begin(), v.end(), [](unsigned char c) { return std::isspace(c); }))
+      fail(n, "attribute '" + attr + "' is empty");
     char* end = nullptr;
     const double d = std::strtod(v.c_str(), &end);
-    while (end && *end && std::isspace(static_cast<unsigned char>(*end))) ++end;
-    if (end == v.c_str() || (end && *end != '\0'))
-      fail(n, "attribute '" + attr + "' is not a number: '" + v + "'");
+    if (end == v.c_str()) fail(n, "attribute '" + attr + "' is not a number: '" + v + "'");
+    while (*end && std::isspace(static_cast<unsigned char>(*end))) ++end;
+    if (*end != '\0') fail(n, "attribute '" + attr + "' is not a number: '" + v + "'");
     if (!std::isfinite(d)) fail(n, "attribute '" + attr + "' is not finite: '" + v + "'");
     if (std::abs(d) > kMaxInputMagnitude)
       fail(n, "attribute '" + attr + "' = " + v + " is beyond ±" + full_precision(kMaxInputMagnitude) +
@@ -201,10 +190,11 @@ class Reader {
 
   Vec3 point(const pugi::xml_node& n) const { return {number(n, "x"), number(n, "y"), number(n, "z")}; }
 
-  /// Every element the reader accepts passes here: its attributes must be known ones, and
-  /// their values valid UTF-8 (ids, types and colours travel into report.json and view.html,
+  /// Every element the reader accepts passes here: it holds no text, its attributes must be
+  /// known ones, and their values valid UTF-8 (ids, types and colours travel into report.json and view.html,
   /// which are UTF-8; pugixml has already converted a declared or BOM-marked encoding).
   void only_attributes(const pugi::xml_node& n, std::initializer_list<const char*> allowed) const {
+    no_text(n);
     for (auto a : n.attributes()) {
       // pugixml keeps both of `id="C1" id="C2"` and lookups see only the first.
       for (auto b = n.first_attribute(); b != a; b = b.next_attribute())
@@ -230,6 +220,30 @@ class Reader {
 
   [[noreturn]] void unknown_child(const pugi::xml_node& parent, const pugi::xml_node& child) const {
     fail(child, std::string("unexpected element <") + child.name() + "> inside <" + parent.name() + ">");
+  }
+
+  /// Refuses text (other than blanks) directly inside `n`: no harness element holds text, and
+  /// the element loops below look at child elements only, so it would be dropped unread.
+  void no_text(const pugi::xml_node& n) const {
+    for (auto c : n.children()) {
+      if (c.type() != pugi::node_pcdata && c.type() != pugi::node_cdata) continue;
+      std::string t = c.value();
+      const auto blank = [](unsigned char ch) { return std::isspace(ch); };
+      t.erase(t.begin(), std::find_if_not(t.begin(), t.end(), blank));
+      if (t.empty()) continue;
+      t.erase(std::find_if_not(t.rbegin(), t.rend(), blank).base(), t.end());
+      constexpr std::size_t kShown = 40;
+      throw InputError({file_, line(c), describe(n)},
+                       "unexpected text '" + t.substr(0, kShown) + (t.size() > kShown ? "...'" : "'") + " inside <" +
+                           n.name() + ">");
+    }
+  }
+
+  /// Refuses any child element of an element that takes attributes only (<pt>, <cp>, <port>,
+  /// <physical>): the reader would drop it unread.
+  void leaf(const pugi::xml_node& n) const {
+    for (auto c : n.children())
+      if (c.type() == pugi::node_element) unknown_child(n, c);
   }
 
   Harness read(const pugi::xml_document& doc) {
@@ -274,6 +288,7 @@ class Reader {
 
  private:
   void read_attributes(const pugi::xml_node& node, Harness& h) {
+    no_text(node);
     for (auto c : node.children()) {
       if (c.type() != pugi::node_element) continue;
       if (std::string(c.name()) != "cable") unknown_child(node, c);
@@ -294,6 +309,7 @@ class Reader {
             if (p.type() != pugi::node_element) continue;
             if (std::string(p.name()) != "port") unknown_child(sub, p);
             only_attributes(p, {"id"});
+            leaf(p);
             if (n >= 2) fail(p, "a cable connects exactly two ports; this is a third");
             cab.ports[n++] = required(p, "id");
           }
@@ -302,6 +318,7 @@ class Reader {
           if (have_phys) fail(sub, "duplicate <physical>");
           have_phys = true;
           only_attributes(sub, {"type", "color", "colour", "diameter", "min_bend_radius"});
+          leaf(sub);
           cab.physical.type = sub.attribute("type").value();
           if (sub.attribute("color") && sub.attribute("colour"))
             fail(sub, "both 'color' and 'colour' given: one would be ignored");
@@ -355,6 +372,7 @@ class Reader {
           if (p.type() != pugi::node_element) continue;
           if (std::string(p.name()) != "pt") unknown_child(c, p);
           only_attributes(p, {"x", "y", "z"});
+          leaf(p);
           seg.path.push_back(point(p));
         }
       } else if (n == "bspline") {
@@ -373,6 +391,7 @@ class Reader {
           if (p.type() != pugi::node_element) continue;
           if (std::string(p.name()) != "cp") unknown_child(c, p);
           only_attributes(p, {"x", "y", "z"});
+          leaf(p);
           b.control_points.push_back(point(p));
         }
         if (b.control_points.size() < static_cast<std::size_t>(b.degree) + 1)
@@ -404,11 +423,13 @@ class Reader {
   }
 
   void read_structure(const pugi::xml_node& node, Harness& h) {
+    no_text(node);
     for (auto c : node.children()) {
       if (c.type() != pugi::node_element) continue;
       const std::string n = c.name();
       if (n == "port") {
         only_attributes(c, {"id", "x", "y", "z", "dx", "dy", "dz"});
+        leaf(c);
         Port p;
         p.id = required(c, "id");
         p.line = line(c);

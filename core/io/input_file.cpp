@@ -2,6 +2,7 @@
 
 #include "core/error.hpp"
 
+#include <algorithm>
 #include <fstream>
 #include <system_error>
 
@@ -19,6 +20,16 @@ void require_input_file(const std::filesystem::path& path, const std::string& wh
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError({path.string(), 0, ""}, "not a regular file");
   std::ifstream probe(path, std::ios::binary);
   if (!probe) throw InputError({path.string(), 0, ""}, "cannot read " + what);
+}
+
+std::string file_bytes(const std::filesystem::path& path, std::size_t limit) {
+  std::ifstream in(path, std::ios::binary);
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  std::string s(ec ? 0 : static_cast<std::size_t>(std::min<std::uintmax_t>(size, limit)), '\0');
+  in.read(s.data(), static_cast<std::streamsize>(s.size()));
+  s.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+  return s;
 }
 
 }  // namespace loom

@@ -1,7 +1,9 @@
 #pragma once
 /// The check every reader makes before it opens an input file.
 
+#include <cstddef>
 #include <filesystem>
+#include <limits>
 #include <string>
 
 namespace loom {
@@ -12,5 +14,10 @@ namespace loom {
 /// loop, say), or "cannot read <what>". `what` names the kind
 /// of file ("scene file", "harness file", ...).
 void require_input_file(const std::filesystem::path& path, const std::string& what);
+
+/// The bytes of a file, at most `limit` of them from its start ("" for a file that does not
+/// open): for the readers' checks made before a library reads the file.
+std::string file_bytes(const std::filesystem::path& path,
+                       std::size_t limit = std::numeric_limits<std::size_t>::max());
 
 }  // namespace loom

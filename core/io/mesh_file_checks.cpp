@@ -1,14 +1,15 @@
 #include "core/io/mesh_file_checks.hpp"
 
 #include "core/error.hpp"
-
-#include <nlohmann/json.hpp>
-#include <pugixml.hpp>
+#include "core/io/input_file.hpp"
+#include "core/io/mesh_node_checks.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cctype>
 #include <charconv>
+#include <cmath>
+#include <cstdlib>
 #include <cstdint>
 #include <fstream>
 #include <map>
@@ -20,22 +21,6 @@
 namespace loom {
 
 namespace {
-
-/// At most `limit` bytes from the start of the file.
-std::string head_of(const std::filesystem::path& path, std::size_t limit) {
-  std::ifstream in(path, std::ios::binary);
-  std::string s(limit, '\0');
-  in.read(s.data(), static_cast<std::streamsize>(limit));
-  s.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
-  return s;
-}
-
-std::string whole_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 std::vector<std::string> words(const std::string& line) {
   std::istringstream is(line);
@@ -74,6 +59,7 @@ struct PlyProperty {
   std::uint64_t count_bytes = 0;
   bool count_signed = false;  ///< the length field's type is signed (a negative length is corrupt)
   std::uint64_t bytes = 0;
+  bool floating = false;  ///< the values are float or double
 };
 
 /// Whether a PLY integer type is signed.
@@ -85,19 +71,43 @@ bool ply_scalar_signed(const std::string& t) {
 struct PlyLayout {
   enum class Format { Ascii, BinaryLittle, BinaryBig } format = Format::Ascii;
   std::uint64_t data_at = 0;  ///< byte offset of the first byte after the header
+  int header_lines = 0;       ///< lines of the header, end_header's included
   std::vector<PlyElementExtent> extents;
   std::vector<std::vector<PlyProperty>> properties;  ///< per element
 };
 
+/// 1-based line of byte `at` of `text`.
+int line_at(const std::string& text, std::size_t at) {
+  return static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n')) + 1;
+}
+
+/// Throws InputError unless the PLY header in `head` (the file's first bytes, `whole` if
+/// they are all of it) ends, holding no NUL byte. Why: Assimp's line reader looks for a
+/// newline past the end of its buffer: a header without end_header spun forever, one with a
+/// NUL read out of bounds (SIGSEGV).
+void check_ply_header_ends(const std::string& head, bool whole, const std::filesystem::path& path) {
+  const std::size_t end = head.find("end_header");
+  const std::size_t nul = head.find('\0');
+  if (nul < end)
+    throw InputError({path.string(), line_at(head, nul), "PLY header"}, "holds a NUL byte (a binary or corrupt file?)");
+  if (end != std::string::npos && head.find('\n', end) != std::string::npos) return;
+  if (!whole)
+    throw InputError({path.string(), 0, "PLY header"},
+                     "no end_header in the first " + std::to_string(head.size()) + " bytes (not a PLY header)");
+  const std::size_t last = head.empty() || head.back() != '\n' ? head.size() : head.size() - 1;
+  throw InputError({path.string(), line_at(head, last), "end_header"}, "PLY header does not end (truncated file?)");
+}
+
 /// The header of a PLY file; false for a header this check cannot parse (left to Assimp).
 bool read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
   constexpr std::size_t kMaxHeader = 1 << 20;  // PLY headers are a few hundred bytes
-  const std::string head = head_of(path, kMaxHeader);
+  const std::string head = file_bytes(path, kMaxHeader);
+  if (head.compare(0, 3, "ply") != 0) return false;  // Assimp finds no PLY reader for it
+  check_ply_header_ends(head, head.size() < kMaxHeader, path);
   const std::size_t end = head.find("end_header");
-  if (end == std::string::npos) return false;
   const std::size_t data_at = head.find('\n', end);
-  if (data_at == std::string::npos) return false;
   out.data_at = data_at + 1;
+  out.header_lines = line_at(head, data_at);
   std::istringstream is(head.substr(0, end));
   int line_no = 0;
   for (std::string line; std::getline(is, line);) {
@@ -121,7 +131,9 @@ bool read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
       p.list = w.size() == 5 && w[1] == "list";
       p.count_bytes = p.list ? ply_scalar_bytes(w[2]) : 0;
       p.count_signed = p.list && ply_scalar_signed(w[2]);
-      p.bytes = ply_scalar_bytes(p.list ? w[3] : (w.size() >= 2 ? w[1] : w[0]));
+      const std::string& type = p.list ? w[3] : (w.size() >= 2 ? w[1] : w[0]);
+      p.bytes = ply_scalar_bytes(type);
+      p.floating = type.rfind("float", 0) == 0 || type == "double";
       if (p.bytes == 0 || (p.list && p.count_bytes == 0)) return false;
       out.extents.back().min_bytes += p.list ? p.count_bytes : p.bytes;
       out.properties.back().push_back(p);
@@ -235,37 +247,99 @@ void check_ply_binary_lists(const std::filesystem::path& path, const PlyLayout& 
   }
 }
 
-/// Every ASCII list length against the bytes left after it (each value takes at least a
-/// digit and a separator). Why: as for binary lists, Assimp allocates a list before reading
-/// it ("4000000000 0 1 2" ended in std::bad_alloc).
-void check_ply_ascii_lists(const std::filesystem::path& path, const PlyLayout& layout) {
-  const bool any_list = std::any_of(layout.properties.begin(), layout.properties.end(), [](const auto& ps) {
-    return std::any_of(ps.begin(), ps.end(), [](const PlyProperty& p) { return p.list; });
-  });
-  if (!any_list) return;
+/// Whether `t` reads whole as a value of a PLY property of `bytes` bytes: an integer
+/// (optional sign, digits) for the integer types, a finite decimal number for float and
+/// double. Why: Assimp's ASCII reader neither checks a token nor moves past one it cannot
+/// read, so "-inf" or "1.5" for an index left the values that follow misaligned.
+bool ply_ascii_value(const std::string& t, bool floating, std::string& why) {
+  if (floating) {
+    char* end = nullptr;
+    const double v = std::strtod(t.c_str(), &end);
+    if (end != t.c_str() + t.size()) why = "is not a number";
+    else if (!std::isfinite(v)) why = "is not a finite number";
+    return why.empty();
+  }
+  const std::size_t digits = t[0] == '-' || t[0] == '+' ? 1 : 0;
+  const bool ok = t.size() > digits &&
+                  std::all_of(t.begin() + static_cast<std::ptrdiff_t>(digits), t.end(),
+                              [](unsigned char c) { return std::isdigit(c); });
+  if (!ok) why = "is not an integer";
+  return ok;
+}
+
+/// The words of an ASCII PLY line, split where Assimp's reader splits them.
+std::vector<std::string> ply_words(const std::string& line) {
+  std::vector<std::string> w;
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
+    const std::size_t from = i;
+    while (i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != '\r') ++i;
+    if (i > from) w.push_back(line.substr(from, i - from));
+  }
+  return w;
+}
+
+/// Every instance of every element of an ASCII PLY, against its properties: Assimp reads one
+/// instance per line and takes a missing value as 0 (a vertex at the origin, a face of no
+/// vertices that then failed an assertion: SIGABRT), so each line must hold exactly its
+/// properties' values, each a number of its type, and every declared instance must be there.
+/// A list's length is checked against the bytes left before anything else (Assimp allocates
+/// the list first: "4000000000 0 1 2" ended in std::bad_alloc).
+void check_ply_ascii_body(const std::filesystem::path& path, const PlyLayout& layout, std::uint64_t size) {
   std::ifstream in(path, std::ios::binary);
   in.seekg(static_cast<std::streamoff>(layout.data_at));
-  std::error_code ec;
-  const auto size = static_cast<std::uint64_t>(std::filesystem::file_size(path, ec));
-  if (ec) return;
-  std::string token;
+  std::uint64_t line_at_byte = layout.data_at;
+  int line_no = layout.header_lines;
+  std::string line;
   for (std::size_t i = 0; i < layout.extents.size(); ++i) {
     const PlyElementExtent& e = layout.extents[i];
-    for (std::uint64_t k = 0; k < e.count; ++k)
-      for (const PlyProperty& p : layout.properties[i]) {
-        if (!(in >> token)) return;  // a short file: Assimp reports it
-        if (!p.list) continue;
-        std::uint64_t n = 0;
-        const auto at = in.tellg();
-        const std::uint64_t left = at < 0 ? 0 : size - std::min<std::uint64_t>(size, static_cast<std::uint64_t>(at));
-        if (!parse_count(token, n)) {
-          if (!token.empty() && token[0] == '-') bad_list(path, e, k, token, left);
-          return;  // not a number: Assimp reports it
+    const auto& props = layout.properties[i];
+    for (std::uint64_t k = 0; k < e.count; ++k) {
+      const std::string where = "element " + e.name + " instance " + std::to_string(k);
+      if (!std::getline(in, line))
+        throw InputError({path.string(), e.line, "element " + e.name},
+                         std::to_string(e.count) + " declared, " + std::to_string(k) +
+                             " in the file (a truncated file?)");
+      ++line_no;
+      const std::uint64_t next_line_at = line_at_byte + line.size() + 1;
+      const auto w = ply_words(line);
+      std::size_t at = 0;  // index in w of the next value
+      bool short_line = false;
+      for (const PlyProperty& p : props) {
+        std::uint64_t n = 1;
+        if (p.list) {
+          if (at >= w.size()) {
+            short_line = true;
+            break;
+          }
+          const std::string& t = w[at++];
+          const std::uint64_t left = size - std::min(size, line_at_byte);  // from this line on
+          if (!parse_count(t, n)) {
+            if (t[0] == '-') bad_list(path, e, k, t, left);
+            throw InputError({path.string(), line_no, where}, "list length '" + t + "' is not a count");
+          }
+          if (n > left / 2) bad_list(path, e, k, t, left);  // " v" per value at least
         }
-        if (n > left / 2) bad_list(path, e, k, token, left);  // " v" per value at least
-        for (std::uint64_t v = 0; v < n; ++v)
-          if (!(in >> token)) return;
+        if (n > w.size() - at) {
+          short_line = true;
+          break;
+        }
+        for (std::size_t v = at; v < at + n; ++v) {
+          std::string why;
+          if (!ply_ascii_value(w[v], p.floating, why))
+            throw InputError({path.string(), line_no, where}, "value '" + w[v] + "' " + why);
+        }
+        at += static_cast<std::size_t>(n);
       }
+      if (short_line || at != w.size())
+        throw InputError({path.string(), line_no, where},
+                         std::to_string(w.size()) + " values on the line, " +
+                             (short_line ? std::string("too few for its properties")
+                                         : "its properties take " + std::to_string(at)) +
+                             " (one instance per line)");
+      line_at_byte = next_line_at;
+    }
   }
 }
 
@@ -281,7 +355,7 @@ void check_ply(const std::filesystem::path& path) {
   if (ec || size < layout.data_at) return;
   const bool ascii = layout.format == PlyLayout::Format::Ascii;
   check_ply_extents(layout.extents, ascii, size - layout.data_at, path.string());
-  if (ascii) check_ply_ascii_lists(path, layout);
+  if (ascii) check_ply_ascii_body(path, layout, size);
   else check_ply_binary_lists(path, layout, size);
 }
 
@@ -290,7 +364,7 @@ void check_ply(const std::filesystem::path& path) {
 /// The OFF header's vertex and face counts against the file size: each vertex and face takes
 /// at least one line. A header this check cannot parse is left to Assimp.
 void check_off(const std::filesystem::path& path) {
-  const std::string head = head_of(path, 1 << 16);
+  const std::string head = file_bytes(path, 1 << 16);
   std::istringstream is(head);
   std::vector<std::string> tokens;
   std::vector<int> lines;
@@ -321,7 +395,7 @@ void check_off(const std::filesystem::path& path) {
   // Face indices: Assimp's OFF reader replaces one beyond the vertices by the last vertex
   // (logging an error nobody sees), a silently different triangle. Lines after the header's:
   // nv vertex lines, then faces "k i1 .. ik [colour]"; blank and '#' lines skipped.
-  std::istringstream all(whole_file(path));
+  std::istringstream all(file_bytes(path));
   int no = 0;
   std::uint64_t seen_v = 0, seen_f = 0;
   for (std::string line; seen_f < nf && std::getline(all, line);) {
@@ -345,108 +419,6 @@ void check_off(const std::filesystem::path& path) {
                              std::to_string(nv == 0 ? 0 : nv - 1) + ")");
     }
     ++seen_f;
-  }
-}
-
-// --- nesting -----------------------------------------------------------------------------
-
-[[noreturn]] void too_deep(const std::filesystem::path& path, int line, const std::string& what) {
-  throw InputError({path.string(), line, what},
-                   "nested more than " + std::to_string(kMaxMeshNesting) +
-                       " levels deep (Assimp reads the hierarchy recursively and would overflow the stack)");
-}
-
-/// The deepest XML element nesting of a DAE file (pugixml parses without recursion).
-void check_dae(const std::filesystem::path& path) {
-  const std::string text = whole_file(path);
-  pugi::xml_document doc;
-  if (!doc.load_buffer(text.data(), text.size(), pugi::parse_minimal)) return;
-  std::vector<std::pair<pugi::xml_node, std::size_t>> stack{{doc, 0}};
-  while (!stack.empty()) {
-    const auto [node, depth] = stack.back();
-    stack.pop_back();
-    if (depth > kMaxMeshNesting) {
-      const auto offset = node.offset_debug();
-      const int line = offset < 0 ? 0 : static_cast<int>(std::count(text.begin(), text.begin() + offset, '\n')) + 1;
-      too_deep(path, line, "<" + std::string(node.name()) + ">");
-    }
-    for (pugi::xml_node c = node.first_child(); c; c = c.next_sibling())
-      if (c.type() == pugi::node_element) stack.push_back({c, depth + 1});
-  }
-}
-
-/// The JSON of a glTF file, or of a GLB file's first (JSON) chunk; empty if there is none.
-std::string gltf_json(const std::filesystem::path& path, bool binary) {
-  if (!binary) return whole_file(path);
-  const std::string head = head_of(path, 20);
-  if (head.size() < 20 || head.compare(0, 4, "glTF") != 0) return {};
-  auto u32 = [&](std::size_t at) {
-    std::uint32_t v = 0;
-    for (int k = 3; k >= 0; --k) v = (v << 8) | static_cast<unsigned char>(head[at + static_cast<std::size_t>(k)]);
-    return v;
-  };
-  const std::uint32_t length = u32(12);
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
-  if (ec || 20 + static_cast<std::uint64_t>(length) > size) return {};
-  std::ifstream in(path, std::ios::binary);
-  in.seekg(20);
-  std::string json(length, '\0');
-  in.read(json.data(), static_cast<std::streamsize>(length));
-  return json;
-}
-
-/// The deepest node hierarchy of a glTF (2.0: "nodes" an array, children indices; 1.0: an
-/// object, children names), memoised so that shared subtrees are walked once.
-void check_gltf(const std::filesystem::path& path, bool binary) {
-  const nlohmann::json doc = nlohmann::json::parse(gltf_json(path, binary), nullptr, false);
-  if (doc.is_discarded() || !doc.is_object() || !doc.contains("nodes")) return;
-  const nlohmann::json& nodes = doc["nodes"];
-  std::map<std::string, std::vector<std::string>> children;
-  auto add = [&](const std::string& id, const nlohmann::json& node) {
-    auto& out = children[id];
-    if (!node.is_object() || !node.contains("children") || !node["children"].is_array()) return;
-    for (const auto& c : node["children"]) {
-      if (c.is_number_unsigned()) out.push_back(std::to_string(c.get<std::uint64_t>()));
-      else if (c.is_string()) out.push_back(c.get<std::string>());
-    }
-  };
-  if (nodes.is_array())
-    for (std::size_t i = 0; i < nodes.size(); ++i) add(std::to_string(i), nodes[i]);
-  else if (nodes.is_object())
-    for (const auto& [id, node] : nodes.items()) add(id, node);
-  else
-    return;
-  // Height of each node's subtree, computed iteratively (post-order). A node met again
-  // while still open is a cycle: Assimp reports those itself, so it ends the walk here.
-  std::map<std::string, std::size_t> height;
-  std::map<std::string, bool> open;
-  for (const auto& [root, unused] : children) {
-    (void)unused;
-    if (height.count(root)) continue;
-    std::vector<std::pair<std::string, std::size_t>> stack{{root, 0}};  // node, next child
-    open[root] = true;
-    while (!stack.empty()) {
-      auto& [id, next] = stack.back();
-      const auto it = children.find(id);
-      const std::vector<std::string> none;
-      const auto& kids = it == children.end() ? none : it->second;
-      if (next < kids.size()) {
-        const std::string kid = kids[next++];
-        if (height.count(kid)) continue;
-        if (open[kid]) return;  // a cycle
-        open[kid] = true;
-        stack.push_back({kid, 0});
-        if (stack.size() > kMaxMeshNesting) too_deep(path, 0, "node " + kid);
-        continue;
-      }
-      std::size_t h = 0;
-      for (const auto& k : kids) h = std::max(h, height.count(k) ? height[k] + 1 : 0);
-      if (h > kMaxMeshNesting) too_deep(path, 0, "node " + id);
-      height[id] = h;
-      open[id] = false;
-      stack.pop_back();
-    }
   }
 }
 
@@ -476,9 +448,9 @@ void check_mesh_file_structure(const std::filesystem::path& path) {
   const std::string ext = lower_extension(path);
   if (ext == ".ply") check_ply(path);
   else if (ext == ".off") check_off(path);
-  else if (ext == ".dae") check_dae(path);
-  else if (ext == ".gltf") check_gltf(path, false);
-  else if (ext == ".glb") check_gltf(path, true);
+  else if (ext == ".dae") check_dae_file(path);
+  else if (ext == ".gltf") check_gltf_file(path, false);
+  else if (ext == ".glb") check_gltf_file(path, true);
 }
 
 }  // namespace loom

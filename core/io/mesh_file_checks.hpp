@@ -7,9 +7,11 @@
 ///    refused before any allocation.
 ///  - Assimp's OFF reader replaces a face index beyond the vertices by the last vertex (a
 ///    silently different triangle); such an index is refused, naming its line.
-///  - DAE (COLLADA) and glTF/GLB node hierarchies are walked recursively by Assimp; a
-///    hierarchy nested some thousands of levels deep overflows the stack (SIGSEGV). Nesting
-///    deeper than kMaxMeshNesting is refused.
+///  - A PLY header must end (Assimp's line reader spun forever on one that did not), and
+///    each ASCII instance must be one line of its properties' values (Assimp takes a missing
+///    one as 0, and aborted on the face of no vertices that made).
+///  - DAE (COLLADA) and glTF/GLB node graphs (mesh_node_checks.hpp): nesting deeper than
+///    kMaxMeshNesting, instancing cycles and fan-outs, DAE index lists and accessor ranges.
 ///
 /// Files of other formats, and files these checks cannot parse (Assimp then reports its own
 /// error), pass unchanged.
@@ -49,8 +51,9 @@ void check_ply_extents(const std::vector<PlyElementExtent>& elements, bool ascii
 std::string lower_extension(const std::filesystem::path& path);
 
 /// Throws InputError naming the file (and the line or element) when the file's declared
-/// counts exceed what its size can hold, an OFF face names no vertex, or its nesting
-/// exceeds kMaxMeshNesting.
+/// counts exceed what its size can hold, an OFF face names no vertex, a PLY header does not
+/// end or an ASCII PLY line does not hold its instance, or a DAE/glTF node graph fails
+/// check_dae_file / check_gltf_file.
 void check_mesh_file_structure(const std::filesystem::path& path);
 
 }  // namespace loom

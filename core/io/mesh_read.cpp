@@ -3,9 +3,11 @@
 #include "core/error.hpp"
 #include "core/io/input_file.hpp"
 #include "core/io/mesh_file_checks.hpp"
+#include "core/io/step_file_checks.hpp"
 
 #include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
+#include <assimp/MemoryIOWrapper.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
@@ -39,6 +41,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstring>
 #include <map>
 #include <set>
 #include <system_error>
@@ -50,11 +53,19 @@ namespace {
 /// Assimp's file system restricted to regular files. Assimp opens the files a mesh refers to
 /// itself (an OBJ's mtllib, a glTF buffer or image uri, a DAE image); a FIFO there blocks the
 /// read forever and a device never ends, so to Assimp such a path does not exist.
+/// It can also serve one file from memory in place of its bytes on disk (serve()).
 class RegularFilesOnly : public Assimp::DefaultIOSystem {
  public:
   bool Exists(const char* file) const override { return regular(file) && DefaultIOSystem::Exists(file); }
   Assimp::IOStream* Open(const char* file, const char* mode = "rb") override {
+    if (file && !served_path_.empty() && served_path_ == file)
+      return new Assimp::MemoryIOStream(reinterpret_cast<const std::uint8_t*>(served_.data()), served_.size());
     return regular(file) ? DefaultIOSystem::Open(file, mode) : nullptr;
+  }
+  /// Opening `path` (as given to ReadFile) reads `bytes` instead of the file.
+  void serve(const std::string& path, std::string bytes) {
+    served_path_ = path;
+    served_ = std::move(bytes);
   }
 
  private:
@@ -62,7 +73,9 @@ class RegularFilesOnly : public Assimp::DefaultIOSystem {
     std::error_code ec;
     return file && std::filesystem::is_regular_file(file, ec);
   }
+  std::string served_path_, served_;
 };
+
 
 void finish_mesh(Mesh& m, const std::filesystem::path& path, const std::string& what) {
   const long bad = first_non_finite_vertex(m);
@@ -71,6 +84,27 @@ void finish_mesh(Mesh& m, const std::filesystem::path& path, const std::string& 
   weld_identical_vertices(m);
 }
 }  // namespace
+
+std::string obj_text_for_assimp(std::string text) {
+  bool continued = false;  // the previous line ended in a backslash: this one continues it
+  for (std::size_t at = 0; at < text.size();) {
+    std::size_t end = text.find('\n', at);
+    if (end == std::string::npos) end = text.size();
+    std::size_t first = at;
+    while (first < end && (text[first] == ' ' || text[first] == '\t')) ++first;
+    auto statement = [&](const char* word) {
+      const std::size_t n = std::strlen(word);
+      return text.compare(first, n, word) == 0 &&
+             (first + n == end || text[first + n] == ' ' || text[first + n] == '\t' || text[first + n] == '\r');
+    };
+    if (!continued && (statement("o") || statement("usemtl"))) text[first] = '#';
+    std::size_t last = end;
+    while (last > at && (text[last - 1] == '\r' || text[last - 1] == ' ' || text[last - 1] == '\t')) --last;
+    continued = last > at && text[last - 1] == '\\';
+    at = end + 1;
+  }
+  return text;
+}
 
 bool is_cad_file(const std::filesystem::path& p) {
   const auto e = lower_extension(p);
@@ -89,7 +123,9 @@ Mesh read_mesh_file(const std::filesystem::path& path) {
                                                  "' (meshes: .stl .obj .ply .off .gltf .glb .dae; CAD: .step .stp .iges .igs)");
   check_mesh_file_structure(path);  // declared counts and nesting Assimp would trust
   Assimp::Importer importer;
-  importer.SetIOHandler(new RegularFilesOnly);  // the importer owns and deletes it
+  auto* io = new RegularFilesOnly;
+  importer.SetIOHandler(io);  // the importer owns and deletes it
+  if (lower_extension(path) == ".obj") io->serve(path.string(), obj_text_for_assimp(file_bytes(path)));
   // Points and lines are dropped; node transforms are baked in so one mesh results.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   // ValidateDataStructure runs before the other steps: a face index beyond the vertices (which
@@ -224,6 +260,7 @@ std::vector<NamedMesh> read_cad_file_occ(const std::filesystem::path& path, cons
   Interface_Static::SetCVal("xstep.cascade.unit", "MM");
   bool ok = false;
   if (ext == ".step" || ext == ".stp") {
+    check_step_references(path);  // OpenCASCADE's transfer follows a dangling one
     STEPCAFControl_Reader reader;
     reader.SetNameMode(true);
     if (reader.ReadFile(path.string().c_str()) != IFSelect_RetDone)

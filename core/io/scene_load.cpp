@@ -6,9 +6,11 @@
 #include "core/io/input_file.hpp"
 #include "core/io/mesh_read.hpp"
 #include "core/io/tessellation_cache.hpp"
+#include "core/io/toml_checks.hpp"
 
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -125,12 +127,20 @@ Eigen::Affine3d part_transform(const TomlReader& r, const toml::table* t, const 
   return m;
 }
 
+/// The names routing.planner accepts (set by register_planner_names; empty: any).
+std::vector<std::string>& known_planners() {
+  static std::vector<std::string> names;
+  return names;
+}
+
 std::filesystem::path resolve(const std::filesystem::path& base, const std::string& rel) {
   std::filesystem::path p(rel);
   return p.is_absolute() ? p : base / p;
 }
 
 }  // namespace
+
+void register_planner_names(std::vector<std::string> names) { known_planners() = std::move(names); }
 
 void apply_routes(Scene& scene, const std::filesystem::path& routes) {
   Harness routed = read_harness_xml(routes);
@@ -146,9 +156,17 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
   const auto t0 = std::chrono::steady_clock::now();
   const std::string file = toml_path.string();
   require_input_file(toml_path, "scene file");
+  std::string text;
+  {
+    std::ifstream in(toml_path, std::ios::binary);
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    text = ss.str();
+  }
+  check_toml_nesting(text, file);  // before toml++ recurses through it
   toml::table doc;
   try {
-    doc = toml::parse_file(file);
+    doc = toml::parse(text, file);
   } catch (const toml::parse_error& e) {
     throw InputError({file, static_cast<int>(e.source().begin.line), ""},
                      std::string("malformed TOML: ") + std::string(e.description()));
@@ -208,7 +226,15 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
       if (*v < 0) r.fail(rt->get("time_limit"), "routing.time_limit", "must not be negative");
       scene.routing.time_limit = {*v, "scene file"};
     }
-    if (auto v = r.string(*rt, "routing", "planner")) scene.routing.planner = *v;
+    if (auto v = r.string(*rt, "routing", "planner")) {
+      const std::vector<std::string>& known = known_planners();
+      if (!known.empty() && std::find(known.begin(), known.end(), *v) == known.end()) {
+        std::string valid;
+        for (const auto& k : known) valid += (valid.empty() ? "" : ", ") + k;
+        r.fail(rt->get("planner"), "routing.planner", "unknown planner '" + *v + "'; valid planners: " + valid);
+      }
+      scene.routing.planner = *v;
+    }
     if (auto v = r.number(*rt, "routing", "seed")) {
       // The seed is an unsigned 32-bit value: a larger one would be cut, silently another seed.
       if (*v < 0 || *v != std::floor(*v) || *v > static_cast<double>(std::numeric_limits<std::uint32_t>::max()))

@@ -1,0 +1,432 @@
+#include "core/io/mesh_node_checks.hpp"
+
+#include "core/error.hpp"
+#include "core/io/input_file.hpp"
+#include "core/io/line_map.hpp"
+#include "core/io/mesh_file_checks.hpp"
+
+#include <nlohmann/json.hpp>
+#include <pugixml.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cstdint>
+#include <sstream>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace loom {
+
+namespace {
+
+/// A graph of nodes, each instancing its children (a child may repeat) and some geometry of
+/// its own, measured by its triangle corners.
+struct NodeGraph {
+  std::vector<std::vector<std::size_t>> children;
+  std::vector<double> own_corners;
+  std::vector<std::string> names;  ///< for messages
+  std::vector<int> lines;          ///< for messages (0: unknown)
+
+  std::size_t add(std::string name, int line) {
+    children.emplace_back();
+    own_corners.push_back(0.0);
+    names.push_back(std::move(name));
+    lines.push_back(line);
+    return children.size() - 1;
+  }
+};
+
+/// What instancing the roots of a NodeGraph builds.
+struct Expansion {
+  double nodes = 0.0;    ///< node instances
+  double corners = 0.0;  ///< triangle corners of the geometry instanced
+};
+
+[[noreturn]] void too_deep(const std::filesystem::path& path, int line, const std::string& what) {
+  throw InputError({path.string(), line, what},
+                   "nested more than " + std::to_string(kMaxMeshNesting) +
+                       " levels deep (Assimp reads the hierarchy recursively and would overflow the stack)");
+}
+
+/// Instances and corners below each root, each node's subtree measured once (post-order,
+/// without recursion: the graph is the file's to choose). Throws InputError for a cycle
+/// (Assimp would recurse through it until the stack overflows) and for a hierarchy deeper
+/// than kMaxMeshNesting. `what` names the kind of link ("instance_node", "child").
+Expansion expand(const NodeGraph& g, const std::vector<std::size_t>& roots, const std::filesystem::path& path,
+                 const std::string& what) {
+  const std::size_t n = g.children.size();
+  enum : unsigned char { kNew, kOpen, kDone };
+  std::vector<unsigned char> state(n, kNew);
+  std::vector<double> nodes(n, 0.0), corners(n, 0.0);
+  std::vector<std::size_t> height(n, 0);
+  Expansion total;
+  for (const std::size_t root : roots) {
+    if (state[root] == kNew) {
+      std::vector<std::pair<std::size_t, std::size_t>> stack{{root, 0}};  // node, next child
+      state[root] = kOpen;
+      while (!stack.empty()) {
+        auto& [v, next] = stack.back();
+        if (next < g.children[v].size()) {
+          const std::size_t c = g.children[v][next++];
+          if (state[c] == kOpen)
+            throw InputError({path.string(), g.lines[v], "node '" + g.names[v] + "'"},
+                             what + " cycle through node '" + g.names[c] +
+                                 "' (Assimp would follow it until the stack overflows)");
+          if (state[c] == kNew) {
+            state[c] = kOpen;
+            stack.push_back({c, 0});
+            if (stack.size() > kMaxMeshNesting) too_deep(path, g.lines[c], "node '" + g.names[c] + "'");
+          }
+          continue;
+        }
+        // Doubles: a fan-out of 2 per level passes 2^64 instances at 64 levels; the sums
+        // only need to tell "beyond the cap" apart (inf compares as such).
+        nodes[v] = 1.0;
+        corners[v] = g.own_corners[v];
+        for (const std::size_t c : g.children[v]) {
+          nodes[v] += nodes[c];
+          corners[v] += corners[c];
+          height[v] = std::max(height[v], height[c] + 1);
+        }
+        if (height[v] > kMaxMeshNesting) too_deep(path, g.lines[v], "node '" + g.names[v] + "'");
+        state[v] = kDone;
+        stack.pop_back();
+      }
+    }
+    total.nodes += nodes[root];
+    total.corners += corners[root];
+  }
+  return total;
+}
+
+std::string count_text(double v) {
+  std::ostringstream os;
+  if (v < 1e15) os << static_cast<std::uint64_t>(v);
+  else os << v;
+  return os.str();
+}
+
+/// Throws InputError when `e` exceeds the caps and the file's own nodes and corners (a file
+/// holding that much geometry itself is not amplified by instancing). `where` names the roots.
+void check_expansion(const Expansion& e, double own_nodes, double own_corners, const std::filesystem::path& path,
+                     int line, const std::string& where) {
+  if (e.nodes > std::max(kMaxMeshNodeInstances, own_nodes))
+    throw InputError({path.string(), line, where},
+                     "shared nodes expand to " + count_text(e.nodes) + " node instances, more than the " +
+                         count_text(kMaxMeshNodeInstances) + " accepted from a file of " + count_text(own_nodes) +
+                         " nodes (Assimp would build every instance)");
+  if (e.corners > std::max(kMaxMeshInstancedCorners, own_corners))
+    throw InputError({path.string(), line, where},
+                     "shared nodes expand to " + count_text(e.corners / 3.0) + " triangles, more than the " +
+                         count_text(kMaxMeshInstancedCorners / 3.0) + " accepted from a file of " +
+                         count_text(own_corners / 3.0) + " (Assimp would build every instance)");
+}
+
+// --- DAE ----------------------------------------------------------------------------------
+
+/// The DAE document with what its checks need: element ids and line numbers.
+class Dae {
+ public:
+  Dae(const std::filesystem::path& path, const std::string& text) : path_(path), lines_(text) {}
+
+  int line(const pugi::xml_node& n) const { return lines_.line(n.offset_debug()); }
+
+  [[noreturn]] void fail(const pugi::xml_node& n, const std::string& reason) const {
+    throw InputError({path_.string(), line(n), "<" + std::string(n.name()) + ">"}, reason);
+  }
+
+  /// The element a "#id" URL names, or null (external and unresolved URLs: Assimp's concern).
+  pugi::xml_node target(const pugi::xml_node& n, const char* attr) const {
+    const std::string url = n.attribute(attr).value();
+    if (url.size() < 2 || url[0] != '#') return {};
+    const auto it = ids_.find(url.substr(1));
+    return it == ids_.end() ? pugi::xml_node() : it->second;
+  }
+
+  /// Every element once, depth-first without recursion: XML nesting within kMaxMeshNesting,
+  /// ids indexed, index lists and accessors checked, nodes collected.
+  void scan(const pugi::xml_document& doc) {
+    std::vector<std::pair<pugi::xml_node, std::size_t>> stack{{doc, 0}};
+    std::vector<pugi::xml_node> accessors;
+    while (!stack.empty()) {
+      const auto [node, depth] = stack.back();
+      stack.pop_back();
+      if (depth > kMaxMeshNesting) too_deep(path_, line(node), "<" + std::string(node.name()) + ">");
+      if (const char* id = node.attribute("id").value(); *id) ids_.emplace(id, node);
+      const std::string name = node.name();
+      if (name == "p" || name == "vcount") check_indices(node);
+      else if (name == "accessor") accessors.push_back(node);
+      else if (name == "node") node_of(node);
+      else if (name == "visual_scene") visual_scenes_.push_back(node);
+      else if (name == "geometry") geometries_.push_back(node);
+      for (pugi::xml_node c = node.first_child(); c; c = c.next_sibling())
+        if (c.type() == pugi::node_element) stack.push_back({c, depth + 1});
+    }
+    for (const auto& a : accessors) check_accessor(a);
+    const auto in_file_order = [](const pugi::xml_node& a, const pugi::xml_node& b) {
+      return a.offset_debug() < b.offset_debug();
+    };
+    std::sort(visual_scenes_.begin(), visual_scenes_.end(), in_file_order);
+  }
+
+  /// Expands the instantiated visual scene (or all of them) and checks the caps.
+  void check_instancing(const pugi::xml_document& doc) {
+    NodeGraph g;
+    for (const pugi::xml_node& xml : nodes_) {
+      const char* id = xml.attribute("id").value();
+      const std::size_t v = g.add(*id ? id : xml.attribute("name").value(), line(xml));
+      for (pugi::xml_node c = xml.first_child(); c; c = c.next_sibling()) {
+        const std::string cn = c.name();
+        if (cn == "node") {
+          g.children[v].push_back(node_index_.at(c));
+        } else if (cn == "instance_node") {
+          const pugi::xml_node t = target(c, "url");
+          if (t && node_index_.count(t)) g.children[v].push_back(node_index_.at(t));
+        } else if (cn == "instance_geometry" || cn == "instance_controller") {
+          g.own_corners[v] += geometry_corners(target(c, "url"));
+        }
+      }
+    }
+    // The scene Assimp builds: the one <scene> instantiates, else every visual scene.
+    std::vector<pugi::xml_node> scenes;
+    const pugi::xml_node chosen = target(doc.document_element().child("scene").child("instance_visual_scene"), "url");
+    if (chosen) scenes.push_back(chosen);
+    else scenes = visual_scenes_;
+    std::vector<std::size_t> roots;
+    for (const auto& s : scenes)
+      for (pugi::xml_node c = s.child("node"); c; c = c.next_sibling("node")) roots.push_back(node_index_.at(c));
+    const Expansion e = expand(g, roots, path_, "instance_node");
+    double own_corners = 0.0;
+    for (const auto& geometry : geometries_) own_corners += geometry_corners(geometry);
+    const int at = scenes.empty() ? 0 : line(scenes.front());
+    check_expansion(e, static_cast<double>(nodes_.size()), own_corners, path_, at, "<visual_scene>");
+  }
+
+ private:
+  void node_of(const pugi::xml_node& n) {
+    node_index_.emplace(n, nodes_.size());
+    nodes_.push_back(n);
+  }
+
+  /// A <p> or <vcount> list: unsigned decimal integers. Why: Assimp's reader does not move
+  /// past a token it cannot read as one and appended indices until memory ran out.
+  void check_indices(const pugi::xml_node& n) {
+    const char* s = n.child_value();
+    std::size_t values = 0;
+    for (const char* c = s; *c;) {
+      while (*c && std::isspace(static_cast<unsigned char>(*c))) ++c;
+      if (!*c) break;
+      const char* from = c;
+      while (*c && !std::isspace(static_cast<unsigned char>(*c))) ++c;
+      if (!std::all_of(from, c, [](char ch) { return std::isdigit(static_cast<unsigned char>(ch)); })) {
+        constexpr std::ptrdiff_t kShown = 20;
+        fail(n, "'" + std::string(from, std::min(c - from, kShown)) + "' is not an index (value " +
+                    std::to_string(values) + " of the list)");
+      }
+      ++values;
+    }
+    if (std::string(n.name()) == "p") p_values_[n.parent()] += static_cast<double>(values);
+  }
+
+  /// The corners a geometry (or a controller's source geometry) holds: per primitive, the
+  /// values of its <p> lists over the values per vertex (its highest input offset + 1).
+  double geometry_corners(pugi::xml_node g) {
+    for (int hops = 0; g && std::string(g.name()) == "controller" && hops < 4; ++hops) {
+      pugi::xml_node source = g.child("skin");
+      if (!source) source = g.child("morph");
+      g = target(source, "source");
+    }
+    if (!g || std::string(g.name()) != "geometry") return 0.0;
+    if (const auto it = corners_.find(g); it != corners_.end()) return it->second;
+    double corners = 0.0;
+    for (pugi::xml_node m = g.first_child(); m; m = m.next_sibling())
+      for (pugi::xml_node prim = m.first_child(); prim; prim = prim.next_sibling()) {
+        const auto it = p_values_.find(prim);
+        if (it == p_values_.end()) continue;
+        std::uint64_t stride = 1;
+        for (pugi::xml_node in = prim.child("input"); in; in = in.next_sibling("input")) {
+          std::uint64_t offset = 0;
+          const std::string o = in.attribute("offset").value();
+          if (std::from_chars(o.data(), o.data() + o.size(), offset).ec == std::errc()) stride = std::max(stride, offset + 1);
+        }
+        corners += it->second / static_cast<double>(stride);
+      }
+    corners_[g] = corners;
+    return corners;
+  }
+
+  /// An unsigned decimal attribute, `fallback` if absent; fails for anything else.
+  std::uint64_t count_attribute(const pugi::xml_node& n, const char* attr, std::uint64_t fallback) const {
+    const pugi::xml_attribute a = n.attribute(attr);
+    if (!a) return fallback;
+    const std::string v = a.value();
+    std::uint64_t out = 0;
+    const auto r = std::from_chars(v.data(), v.data() + v.size(), out);
+    if (v.empty() || r.ec != std::errc() || r.ptr != v.data() + v.size())
+      fail(n, std::string("attribute '") + attr + "' = '" + v + "' is not a count");
+    return out;
+  }
+
+  /// An accessor's last element within its array. Why: Assimp reads element k at offset +
+  /// k·stride unchecked; stride 2^31 on a 9-value array read far outside it (SIGSEGV).
+  void check_accessor(const pugi::xml_node& a) const {
+    const std::uint64_t count = count_attribute(a, "count", 0);
+    const std::uint64_t stride = count_attribute(a, "stride", 1);
+    const std::uint64_t offset = count_attribute(a, "offset", 0);
+    const pugi::xml_node array = target(a, "source");
+    if (!array || count == 0) return;
+    std::uint64_t params = 0;
+    for (pugi::xml_node p = a.child("param"); p; p = p.next_sibling("param")) ++params;
+    const std::uint64_t size = count_attribute(array, "count", 0);
+    // offset + (count − 1)·stride + params ≤ size, without overflow.
+    const bool fits = offset <= size && params <= size - offset &&
+                      (stride == 0 || count - 1 <= (size - offset - params) / stride);
+    if (!fits)
+      fail(a, "count " + std::to_string(count) + " x stride " + std::to_string(stride) + " from offset " +
+                  std::to_string(offset) + " reaches beyond the " + std::to_string(size) + " values of <" +
+                  array.name() + " id=\"" + array.attribute("id").value() + "\">");
+  }
+
+  struct NodeHash {
+    std::size_t operator()(const pugi::xml_node& n) const { return std::hash<const void*>()(n.internal_object()); }
+  };
+
+  const std::filesystem::path& path_;
+  LineMap lines_;
+  std::unordered_map<std::string, pugi::xml_node> ids_;
+  std::vector<pugi::xml_node> nodes_;
+  std::vector<pugi::xml_node> visual_scenes_, geometries_;
+  std::unordered_map<pugi::xml_node, std::size_t, NodeHash> node_index_;
+  std::unordered_map<pugi::xml_node, double, NodeHash> p_values_;  ///< per primitive: values of its <p>
+  std::unordered_map<pugi::xml_node, double, NodeHash> corners_;   ///< per geometry
+};
+
+// --- glTF ---------------------------------------------------------------------------------
+
+/// The JSON of a glTF file, or of a GLB file's first (JSON) chunk; empty if there is none.
+std::string gltf_json(const std::filesystem::path& path, bool binary) {
+  if (!binary) return file_bytes(path);
+  const std::string head = file_bytes(path, 20);
+  if (head.size() < 20 || head.compare(0, 4, "glTF") != 0) return {};
+  auto u32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (int k = 3; k >= 0; --k) v = (v << 8) | static_cast<unsigned char>(head[at + static_cast<std::size_t>(k)]);
+    return v;
+  };
+  const std::uint32_t length = u32(12);
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec || 20 + static_cast<std::uint64_t>(length) > size) return {};
+  return file_bytes(path, 20 + static_cast<std::size_t>(length)).substr(20);
+}
+
+/// The corners of a glTF mesh: per primitive, its index accessor's count, else its POSITION
+/// accessor's (2.0: accessors an array and ids indices; 1.0: objects and ids names).
+double gltf_mesh_corners(const nlohmann::json& doc, const nlohmann::json& mesh) {
+  const nlohmann::json* accessors = doc.contains("accessors") ? &doc["accessors"] : nullptr;
+  auto count_of = [&](const nlohmann::json& id) -> double {
+    if (!accessors) return 0.0;
+    const nlohmann::json* a = nullptr;
+    if (id.is_number_unsigned() && accessors->is_array() && id.get<std::uint64_t>() < accessors->size())
+      a = &(*accessors)[id.get<std::size_t>()];
+    else if (id.is_string() && accessors->is_object() && accessors->contains(id.get<std::string>()))
+      a = &(*accessors)[id.get<std::string>()];
+    if (!a || !a->is_object() || !a->contains("count") || !(*a)["count"].is_number()) return 0.0;
+    return (*a)["count"].get<double>();
+  };
+  double corners = 0.0;
+  if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) return 0.0;
+  for (const auto& prim : mesh["primitives"]) {
+    if (!prim.is_object()) continue;
+    if (prim.contains("indices")) corners += count_of(prim["indices"]);
+    else if (prim.contains("attributes") && prim["attributes"].is_object() && prim["attributes"].contains("POSITION"))
+      corners += count_of(prim["attributes"]["POSITION"]);
+  }
+  return corners;
+}
+
+/// The meshes a glTF node instances: 2.0 "mesh" (an index), 1.0 "meshes" (names).
+double gltf_node_corners(const nlohmann::json& doc, const nlohmann::json& node) {
+  if (!node.is_object() || !doc.contains("meshes")) return 0.0;
+  const nlohmann::json& meshes = doc["meshes"];
+  double corners = 0.0;
+  if (node.contains("mesh") && node["mesh"].is_number_unsigned() && meshes.is_array() &&
+      node["mesh"].get<std::uint64_t>() < meshes.size())
+    corners += gltf_mesh_corners(doc, meshes[node["mesh"].get<std::size_t>()]);
+  if (node.contains("meshes") && node["meshes"].is_array() && meshes.is_object())
+    for (const auto& m : node["meshes"])
+      if (m.is_string() && meshes.contains(m.get<std::string>())) corners += gltf_mesh_corners(doc, meshes[m.get<std::string>()]);
+  return corners;
+}
+
+}  // namespace
+
+void check_dae_file(const std::filesystem::path& path) {
+  const std::string text = file_bytes(path);
+  pugi::xml_document doc;
+  if (!doc.load_buffer(text.data(), text.size(), pugi::parse_minimal)) return;  // Assimp reports it
+  Dae dae(path, text);
+  dae.scan(doc);
+  dae.check_instancing(doc);
+}
+
+void check_gltf_file(const std::filesystem::path& path, bool binary) {
+  const nlohmann::json doc = nlohmann::json::parse(gltf_json(path, binary), nullptr, false);
+  if (doc.is_discarded() || !doc.is_object() || !doc.contains("nodes")) return;
+  const nlohmann::json& nodes = doc["nodes"];
+  NodeGraph g;
+  std::unordered_map<std::string, std::size_t> index;  // node id → graph node
+  std::vector<const nlohmann::json*> json_of;
+  auto add = [&](const std::string& id, const nlohmann::json& node) {
+    index.emplace(id, g.add(id, 0));
+    json_of.push_back(&node);
+  };
+  if (nodes.is_array())
+    for (std::size_t i = 0; i < nodes.size(); ++i) add(std::to_string(i), nodes[i]);
+  else if (nodes.is_object())
+    for (const auto& [id, node] : nodes.items()) add(id, node);
+  else
+    return;
+  std::vector<bool> is_child(json_of.size(), false);
+  for (std::size_t v = 0; v < json_of.size(); ++v) {
+    const nlohmann::json& node = *json_of[v];
+    g.own_corners[v] = gltf_node_corners(doc, node);
+    if (!node.is_object() || !node.contains("children") || !node["children"].is_array()) continue;
+    for (const auto& c : node["children"]) {
+      std::string id;
+      if (c.is_number_unsigned()) id = std::to_string(c.get<std::uint64_t>());
+      else if (c.is_string()) id = c.get<std::string>();
+      const auto it = index.find(id);
+      if (it == index.end()) continue;  // Assimp reports a dangling child
+      g.children[v].push_back(it->second);
+      is_child[it->second] = true;
+    }
+  }
+  // The roots Assimp builds: every scene's nodes; without scenes, the nodes nobody parents.
+  std::vector<std::size_t> roots;
+  if (doc.contains("scenes") && (doc["scenes"].is_array() || doc["scenes"].is_object()))
+    for (const auto& s : doc["scenes"])
+      if (s.is_object() && s.contains("nodes") && s["nodes"].is_array())
+        for (const auto& r : s["nodes"]) {
+          const std::string id = r.is_number_unsigned() ? std::to_string(r.get<std::uint64_t>())
+                                                        : (r.is_string() ? r.get<std::string>() : "");
+          if (const auto it = index.find(id); it != index.end()) roots.push_back(it->second);
+        }
+  if (roots.empty())
+    for (std::size_t v = 0; v < is_child.size(); ++v)
+      if (!is_child[v]) roots.push_back(v);
+  // Every node is walked (not only those under the roots): the depth limit held for all of
+  // them before, and a hierarchy Assimp would not build costs only this walk.
+  std::vector<std::size_t> all(json_of.size());
+  for (std::size_t v = 0; v < all.size(); ++v) all[v] = v;
+  expand(g, all, path, "children");
+  double own_corners = 0.0;
+  if (doc.contains("meshes") && (doc["meshes"].is_array() || doc["meshes"].is_object()))
+    for (const auto& m : doc["meshes"]) own_corners += gltf_mesh_corners(doc, m);
+  check_expansion(expand(g, roots, path, "children"), static_cast<double>(json_of.size()), own_corners, path, 0,
+                  "scene nodes");
+}
+
+}  // namespace loom

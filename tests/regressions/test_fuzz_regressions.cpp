@@ -1,0 +1,467 @@
+// One test per reader finding of the mutational fuzzing campaign against the loom executable
+// (crashes, hangs and silently wrong readings of hostile mesh, STEP, TOML and harness files).
+// Each input is written out here (or generated, where it is large); each test failed before
+// its fix. Inputs that crashed or hung the process are run through the command line under
+// `timeout`, so that the old behaviour fails the test instead of killing or stalling it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include <sys/wait.h>
+
+#include "core/error.hpp"
+#include "core/io/harness_xml.hpp"
+#include "core/io/mesh_node_checks.hpp"
+#include "core/io/mesh_read.hpp"
+#include "core/io/toml_checks.hpp"
+#include "common/run_loom.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using loom::InputError;
+
+/// A fresh scratch directory for the running test.
+fs::path scratch() {
+  const fs::path d = fs::temp_directory_path() /
+                     ("loom_fuzz_regression_" + std::string(testing::UnitTest::GetInstance()->current_test_info()->name()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+void write(const fs::path& p, const std::string& bytes) { std::ofstream(p, std::ios::binary) << bytes; }
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+/// The InputError message of `f()`, or "" with a test failure if it throws none.
+template <typename F>
+std::string input_error(F f) {
+  try {
+    f();
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return {};
+}
+
+/// run_loom under `timeout 60`: an old hang ends with status 124, an old crash with 128 + its
+/// signal, instead of stalling or killing the test.
+loom::testing::LoomRun run_bounded(const std::string& args) {
+  loom::testing::LoomRun r;
+  const std::string cmd = "timeout 60 " + std::string(LOOM_EXE) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  while (fgets(buf, sizeof buf, p)) r.out += buf;
+  const int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+/// `loom info --quiet` (bounded) on a scene of the one part `file` in `dir`.
+loom::testing::LoomRun bounded_info_of_part(const fs::path& dir, const std::string& file) {
+  write(dir / "scene.toml", "[scene]\n[[part]]\nfile = '" + file + "'\n");
+  return run_bounded("info " + (dir / "scene.toml").string() + " --quiet");
+}
+
+// --- DAE -------------------------------------------------------------------------------------
+
+const char* kDaeHead =
+    R"(<?xml version="1.0"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+)";
+
+/// One triangle as a DAE geometry "g", its accessor's stride and its <p> list as given.
+std::string dae_triangle_geometry(const std::string& stride, const std::string& p) {
+  return R"(<library_geometries><geometry id="g"><mesh>
+<source id="p"><float_array id="pa" count="9">0 0 0 1 0 0 0 1 0</float_array>
+<technique_common><accessor source="#pa" count="3" stride=")" +
+         stride + R"("><param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/></accessor></technique_common></source>
+<vertices id="v"><input semantic="POSITION" source="#p"/></vertices>
+<triangles count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>)" +
+         p + R"(</p></triangles>
+</mesh></geometry></library_geometries>
+)";
+}
+
+const char* kDaeSceneOfG =
+    R"(<library_visual_scenes><visual_scene id="S"><node id="n"><instance_geometry url="#g"/></node></visual_scene></library_visual_scenes>
+<scene><instance_visual_scene url="#S"/></scene>
+</COLLADA>
+)";
+
+// An accessor stride of 2^31 - 1 on a 9-value array: Assimp read element k at k·stride
+// unchecked (SIGSEGV in `loom info`).
+TEST(FuzzRegression, DaeAccessorHugeStrideCrashed) {
+  const fs::path d = scratch();
+  write(d / "stride.dae", kDaeHead + dae_triangle_geometry("2147483647", "0 1 2") + kDaeSceneOfG);
+  const auto r = bounded_info_of_part(d, "stride.dae");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("stride.dae:5: <accessor>: count 3 x stride 2147483647 from offset 0 reaches beyond the 9 "
+                       "values of <float_array id=\"pa\">"),
+            std::string::npos)
+      << r.out;
+  // Stride 3 (the array exactly) reads the triangle; stride 4 reaches one value beyond.
+  write(d / "ok.dae", kDaeHead + dae_triangle_geometry("3", "0 1 2") + kDaeSceneOfG);
+  EXPECT_EQ(loom::read_mesh_file(d / "ok.dae").triangle_count(), 1u);
+  write(d / "four.dae", kDaeHead + dae_triangle_geometry("4", "0 1 2") + kDaeSceneOfG);
+  const std::string e = input_error([&] { loom::read_mesh_file(d / "four.dae"); });
+  EXPECT_NE(e.find("count 3 x stride 4 from offset 0 reaches beyond the 9 values"), std::string::npos) << e;
+}
+
+// A DAE node instancing itself (and A -> B -> A): Assimp followed instance_node without a
+// visited set until the stack overflowed (SIGSEGV).
+TEST(FuzzRegression, DaeInstanceNodeCycleCrashed) {
+  const fs::path d = scratch();
+  const std::string scene =
+      R"(<library_visual_scenes><visual_scene id="S"><node id="r"><instance_node url="#A"/></node></visual_scene></library_visual_scenes>
+<scene><instance_visual_scene url="#S"/></scene>
+</COLLADA>
+)";
+  write(d / "cycle.dae",
+        kDaeHead + std::string(R"(<library_nodes><node id="A"><instance_node url="#A"/></node></library_nodes>)") +
+            "\n" + scene);
+  auto r = bounded_info_of_part(d, "cycle.dae");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("cycle.dae:3: node 'A': instance_node cycle through node 'A'"), std::string::npos) << r.out;
+  write(d / "ab.dae", kDaeHead +
+                          std::string(R"(<library_nodes><node id="A"><instance_node url="#B"/></node>)"
+                                      R"(<node id="B"><instance_node url="#A"/></node></library_nodes>)") +
+                          "\n" + scene);
+  r = bounded_info_of_part(d, "ab.dae");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("ab.dae:3: node 'B': instance_node cycle through node 'A'"), std::string::npos) << r.out;
+  // glTF children in a cycle are refused the same way.
+  write(d / "cycle.gltf", R"({"asset":{"version":"2.0"},"nodes":[{"children":[1]},{"children":[0]}],)"
+                          R"("scenes":[{"nodes":[0]}],"scene":0})");
+  const std::string e = input_error([&] { loom::read_mesh_file(d / "cycle.gltf"); });
+  EXPECT_NE(e.find("children cycle through node '0'"), std::string::npos) << e;
+}
+
+// `<p>0 1 x</p>`: Assimp's COLLADA reader did not move past a token it could not read as an
+// index and appended indices without end (>6 GB in 20 s).
+TEST(FuzzRegression, DaeNonIntegerIndexHung) {
+  const fs::path d = scratch();
+  for (const std::string bad : {"x", ".5", "-1e38", "1..2", "-1"}) {
+    write(d / "bad.dae", kDaeHead + dae_triangle_geometry("3", "0 1 " + bad) + kDaeSceneOfG);
+    const auto r = bounded_info_of_part(d, "bad.dae");
+    EXPECT_EQ(r.status, 2) << bad << ": " << r.out;
+    EXPECT_NE(r.out.find("bad.dae:7: <p>: '" + bad + "' is not an index (value 2 of the list)"), std::string::npos)
+        << r.out;
+  }
+}
+
+/// A DAE of one triangle instanced through `levels` library nodes, each instancing the one
+/// below twice, under one scene node.
+std::string dae_fan(int levels) {
+  std::string nodes = R"(<node id="N0"><instance_geometry url="#g"/></node>)";
+  for (int i = 1; i <= levels; ++i)
+    nodes += "<node id=\"N" + std::to_string(i) + "\"><instance_node url=\"#N" + std::to_string(i - 1) +
+             "\"/><instance_node url=\"#N" + std::to_string(i - 1) + "\"/></node>";
+  return kDaeHead + dae_triangle_geometry("3", "0 1 2") + "<library_nodes>" + nodes +
+         "</library_nodes>\n<library_visual_scenes><visual_scene id=\"S\"><node id=\"r\"><instance_node url=\"#N" +
+         std::to_string(levels) +
+         "\"/></node></visual_scene></library_visual_scenes>\n<scene><instance_visual_scene url=\"#S\"/></scene>\n"
+         "</COLLADA>\n";
+}
+
+/// The glTF of the same fan: node i has children [i+1, i+1], the last one the triangle.
+std::string gltf_fan(int levels) {
+  std::string nodes;
+  for (int i = 0; i < levels; ++i)
+    nodes += "{\"children\":[" + std::to_string(i + 1) + "," + std::to_string(i + 1) + "]},";
+  return R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[)" + nodes +
+         R"({"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)"
+         R"("buffers":[{"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA=","byteLength":44}],)"
+         R"("bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":6}],)"
+         R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","max":[1,1,0],"min":[0,0,0]},)"
+         R"({"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}]})";
+}
+
+// 24 levels of nodes each instancing the one below twice (2.7 kB of DAE, 1.2 kB of glTF):
+// Assimp built all 2^24 instances of the triangle (>6 GB, no end in 20 s).
+TEST(FuzzRegression, MeshNodeFanOutExpandedExponentially) {
+  const fs::path d = scratch();
+  // Node instances, closed form: the scene node plus 2^k instances of level 24 - k.
+  const double dae_instances = 1.0 + (std::pow(2.0, 25) - 1.0);
+  write(d / "fan.dae", dae_fan(24));
+  auto r = bounded_info_of_part(d, "fan.dae");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("fan.dae:10: <visual_scene>: shared nodes expand to " +
+                       std::to_string(static_cast<long long>(dae_instances)) + " node instances, more than the " +
+                       std::to_string(static_cast<long long>(loom::kMaxMeshNodeInstances)) +
+                       " accepted from a file of 26 nodes"),
+            std::string::npos)
+      << r.out;
+  write(d / "fan.gltf", gltf_fan(24));
+  r = bounded_info_of_part(d, "fan.gltf");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("fan.gltf: scene nodes: shared nodes expand to " +
+                       std::to_string(static_cast<long long>(std::pow(2.0, 25) - 1.0)) + " node instances"),
+            std::string::npos)
+      << r.out;
+  // Ten levels (1,024 instances of the triangle) are well within the cap and read whole:
+  // the expansion the check counts is the one Assimp builds.
+  write(d / "ten.dae", dae_fan(10));
+  EXPECT_EQ(loom::read_mesh_file(d / "ten.dae").triangle_count(), 1024u);
+  write(d / "ten.gltf", gltf_fan(10));
+  EXPECT_EQ(loom::read_mesh_file(d / "ten.gltf").triangle_count(), 1024u);
+  // The triangle cap: a fan of 12 levels over a geometry of 1,100 triangles expands to
+  // 4,505,600 > 2^22 triangles with only 4,096 node instances.
+  std::string p;
+  for (int t = 0; t < 1100; ++t) p += "0 1 2 ";
+  std::string big = dae_fan(12);
+  big.replace(big.find("<triangles count=\"1\">"), 21, "<triangles count=\"1100\">");
+  big.replace(big.find("<p>0 1 2</p>"), 12, "<p>" + p + "</p>");
+  write(d / "wide.dae", big);
+  const std::string e = input_error([&] { loom::read_mesh_file(d / "wide.dae"); });
+  EXPECT_NE(e.find("shared nodes expand to 4505600 triangles, more than the 4194304 accepted"), std::string::npos) << e;
+}
+
+// --- OBJ -------------------------------------------------------------------------------------
+
+// 40,000 one-triangle `o` objects took 4.7 s of CPU where the same triangles in one object
+// took 0.4 s, growing quadratically (100,000: 28 s): Assimp looks each object (and `usemtl`
+// material) name up in a list. Assimp now gets those statements as comments, byte for byte.
+TEST(FuzzRegression, ObjManyObjectsLoadedQuadratically) {
+  const std::string text = "o a\nv 0 0 0\n  usemtl m1\nv 1 0 0\nv 0 1 0 \\\no x\nf 1 2 3\nobj\ng grp\n";
+  const std::string served = loom::obj_text_for_assimp(text);
+  EXPECT_EQ(served, "# a\nv 0 0 0\n  #semtl m1\nv 1 0 0\nv 0 1 0 \\\no x\nf 1 2 3\nobj\ng grp\n");
+  // Oracle: the same triangles in one object. 2,000 objects of one triangle each read as the
+  // 2,000 triangles of the single-object file, vertex for vertex.
+  const fs::path d = scratch();
+  std::string many, one = "o all\n";
+  for (int i = 0; i < 2000; ++i) {
+    const std::string tri = "v 0 0 " + std::to_string(i) + "\nv 1 0 " + std::to_string(i) + "\nv 0 1 " +
+                            std::to_string(i) + "\nf -3 -2 -1\n";
+    many += "o g" + std::to_string(i) + "\nusemtl m" + std::to_string(i) + "\n" + tri;
+    one += tri;
+  }
+  write(d / "many.obj", many);
+  write(d / "one.obj", one);
+  const loom::Mesh a = loom::read_mesh_file(d / "many.obj"), b = loom::read_mesh_file(d / "one.obj");
+  ASSERT_EQ(a.triangle_count(), 2000u);
+  ASSERT_EQ(a.vertices.size(), b.vertices.size());
+  for (std::size_t i = 0; i < a.vertices.size(); ++i) EXPECT_EQ(a.vertices[i], b.vertices[i]) << i;
+  EXPECT_EQ(a.triangles, b.triangles);
+}
+
+// --- PLY -------------------------------------------------------------------------------------
+
+const std::string kPlyQuadHeader =
+    "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+    "element face 2\nproperty list uchar int vertex_indices\nend_header\n";
+
+// Four vertices and a face all on one line, the second face missing: Assimp reads one
+// instance per line, took the missing values as 0, and a face of no vertices failed an
+// assertion in its triangulation (SIGABRT).
+TEST(FuzzRegression, PlyAsciiShortFaceListAborted) {
+  const fs::path d = scratch();
+  write(d / "short.ply", kPlyQuadHeader + "0 0 0 1 0 0 0 1 0 1 1 1 3 0 1 2\n");
+  const auto r = bounded_info_of_part(d, "short.ply");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("short.ply:10: element vertex instance 0: 16 values on the line, its properties take 3"),
+            std::string::npos)
+      << r.out;
+  const std::string vertices = "0 0 0\n1 0 0\n0 1 0\n1 1 1\n";
+  write(d / "missing.ply", kPlyQuadHeader + vertices + "3 0 1 2\n");
+  std::string e = input_error([&] { loom::read_mesh_file(d / "missing.ply"); });
+  EXPECT_NE(e.find("missing.ply:7: element face: 2 declared, 1 in the file"), std::string::npos) << e;
+  write(d / "inf.ply", kPlyQuadHeader + "0 0 0\n1 0 -inf\n0 1 0\n1 1 1\n3 0 1 2\n3 1 2 3\n");
+  e = input_error([&] { loom::read_mesh_file(d / "inf.ply"); });
+  EXPECT_NE(e.find("inf.ply:11: element vertex instance 1: value '-inf' is not a finite number"), std::string::npos)
+      << e;
+  write(d / "few.ply", kPlyQuadHeader + vertices + "3 0 1\n3 1 2 3\n");
+  e = input_error([&] { loom::read_mesh_file(d / "few.ply"); });
+  EXPECT_NE(e.find("few.ply:14: element face instance 0: 3 values on the line, too few for its properties"),
+            std::string::npos)
+      << e;
+  // Whole instances read, a triangle and a quad (three triangles).
+  write(d / "ok.ply", kPlyQuadHeader + vertices + "3 0 1 2\n4 0 1 3 2\n");
+  EXPECT_EQ(loom::read_mesh_file(d / "ok.ply").triangle_count(), 3u);
+}
+
+// A mesh PLY whose header never reaches end_header: Assimp's line reader spun forever (and
+// read out of bounds, SIGSEGV, with a NUL after the header's last line).
+TEST(FuzzRegression, PlyMeshUnterminatedHeaderHung) {
+  const fs::path d = scratch();
+  write(d / "open.ply", "ply\nformat ascii 1.0\n");
+  auto r = bounded_info_of_part(d, "open.ply");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("open.ply:2: end_header: PLY header does not end (truncated file?)"), std::string::npos)
+      << r.out;
+  write(d / "bin.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 3");
+  r = bounded_info_of_part(d, "bin.ply");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("bin.ply:3: end_header: PLY header does not end"), std::string::npos) << r.out;
+  write(d / "nul.ply", std::string("ply\nformat ascii 1.0\n\0", 22));
+  r = bounded_info_of_part(d, "nul.ply");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("nul.ply:3: PLY header: holds a NUL byte"), std::string::npos) << r.out;
+}
+
+// --- STEP ------------------------------------------------------------------------------------
+
+// The wing section's actuator envelope without the DIRECTION its first VECTOR refers to:
+// OpenCASCADE's transfer followed the null reference (SIGSEGV).
+TEST(FuzzRegression, StepVectorMissingDirectionCrashed) {
+  const fs::path d = scratch();
+  const std::string full = slurp(fs::path(LOOM_SOURCE_DIR) / "examples/wing-section/actuator-envelope.step");
+  const std::string gone = "#91 = DIRECTION('',(0.,0.,1.));\n";
+  const std::size_t at = full.find(gone);
+  ASSERT_NE(at, std::string::npos);
+  ASSERT_NE(full.find("#90 = VECTOR('',#91,1.);"), std::string::npos);
+  std::string text = full;
+  text.erase(at, gone.size());
+  write(d / "v.step", text);
+  // The line of #90: counted in the file written.
+  const int line90 = static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(
+                                                                                  text.find("#90 = VECTOR")),
+                                                 '\n')) + 1;
+  write(d / "scene.toml", "[scene]\n[[part]]\nfile = 'v.step'\n");
+  const auto r = run_bounded("info " + (d / "scene.toml").string() + " --quiet");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("v.step:" + std::to_string(line90) +
+                       ": entity #90 (VECTOR): refers to #91, which the file does not define"),
+            std::string::npos)
+      << r.out;
+  // A reference inside a string or a comment is no reference.
+  write(d / "s.step", "ISO-10303-21;\nHEADER;\nENDSEC;\nDATA;\n#1 = CARTESIAN_POINT('#7 /* x',(0.,0.,0.));\n"
+                      "/* #2 = VECTOR('',#8,1.); */\n#3 = VECTOR('',#9,1.);\nENDSEC;\nEND-ISO-10303-21;\n");
+  loom::TessellationParams tp;
+  const std::string e = input_error([&] { loom::read_cad_file(d / "s.step", tp, false); });
+  EXPECT_NE(e.find("s.step:7: entity #3 (VECTOR): refers to #9, which the file does not define"), std::string::npos)
+      << e;
+}
+
+// --- scene TOML ------------------------------------------------------------------------------
+
+// A table header 60,000 keys deep: toml++ bounds arrays and inline tables but not dotted
+// keys, and built and destroyed the tables recursively (SIGSEGV).
+TEST(FuzzRegression, TomlDeepDottedTableCrashed) {
+  const fs::path d = scratch();
+  auto header = [](std::size_t keys) {
+    std::string h = "[a";
+    for (std::size_t i = 1; i < keys; ++i) h += ".a";
+    return h + "]\n";
+  };
+  write(d / "deep.toml", "[scene]\n" + header(60000));
+  auto r = run_bounded("info " + (d / "deep.toml").string());
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("deep.toml:2: nesting deeper than 256 levels"), std::string::npos) << r.out;
+  // The limit is exact: 256 keys pass the check (and meet loom's unknown key), 257 do not,
+  // and a dotted key adds to the header's depth like inline tables and arrays do.
+  EXPECT_NO_THROW(loom::check_toml_nesting("[scene]\n" + header(256), "t.toml"));
+  std::string e = input_error([&] { loom::check_toml_nesting("[scene]\n" + header(257), "t.toml"); });
+  EXPECT_NE(e.find("t.toml:2: nesting deeper than 256"), std::string::npos) << e;
+  e = input_error([&] { loom::check_toml_nesting(header(200) + "\n# c\nb" + header(57).substr(2, 2 * 56) + " = 1\n", "t.toml"); });
+  EXPECT_NE(e.find("t.toml:4: nesting deeper"), std::string::npos) << e;
+  e = input_error(
+      [&] { loom::check_toml_nesting(header(250) + "x = { y = [[[[[[1]]]]]] }\n", "t.toml"); });
+  EXPECT_NE(e.find("t.toml:2: nesting deeper"), std::string::npos) << e;
+  // Dots in values and strings are no keys: 10,000 floats and a dotted string pass.
+  std::string floats = "v = [";
+  for (int i = 0; i < 10000; ++i) floats += "1.5, ";
+  EXPECT_NO_THROW(loom::check_toml_nesting(floats + "]\ns = \"" + header(1000) + "\"\n", "t.toml"));
+}
+
+const char* kClearHarness = R"(<harness name="h" units="mm">
+  <attributes>
+    <cable id="C1"><electrical><port id="J1"/><port id="J2"/></electrical>
+      <physical diameter="2" min_bend_radius="10"/></cable>
+  </attributes>
+  <structure>
+    <port id="J1" x="-20" y="5" z="30" dx="1" dy="0" dz="0"/>
+    <port id="J2" x="30" y="5" z="30" dx="-1" dy="0" dz="0"/>
+    <segment from="J1" to="J2"/>
+  </structure>
+</harness>
+)";
+
+// routing.planner = 'nope' was checked only when route got to plan, in a message naming no
+// file, and `loom info` accepted it.
+TEST(FuzzRegression, TomlPlannerErrorNamedNoFile) {
+  const fs::path d = scratch();
+  write(d / "box.obj", "v 0 0 0\nv 10 0 0\nv 0 10 0\nv 0 0 10\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  write(d / "h.xml", kClearHarness);
+  write(d / "scene.toml", "[scene]\n[[part]]\nfile = 'box.obj'\n[harness]\nfile = 'h.xml'\n[routing]\n"
+                          "planner = 'nope'\n");
+  for (const std::string cmd : {"info", "route"}) {
+    const auto r = run_bounded(cmd + " " + (d / "scene.toml").string() +
+                               (cmd == "route" ? " --iterations 10 --out " + (d / "out").string() : ""));
+    EXPECT_EQ(r.status, 2) << cmd << ": " << r.out;
+    EXPECT_NE(r.out.find("scene.toml:7: routing.planner: unknown planner 'nope'; valid planners: "), std::string::npos)
+        << cmd << ": " << r.out;
+    EXPECT_NE(r.out.find("rrtconnect"), std::string::npos) << r.out;
+  }
+}
+
+// --- harness XML -----------------------------------------------------------------------------
+
+std::string with(const std::string& text, const std::string& from, const std::string& to) {
+  std::string s = text;
+  const auto at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? s : s.replace(at, from.size(), to);
+}
+
+// x=" " (or a tab, two blanks) read as 0: strtod converted nothing and the trailing blanks
+// were skipped before that was asked.
+TEST(FuzzRegression, XmlBlankNumberReadAsZero) {
+  for (const std::string blank : {" ", "\t", "  "}) {
+    std::string e = input_error(
+        [&] { loom::parse_harness_xml(with(kClearHarness, "x=\"-20\"", "x=\"" + blank + "\""), "h.xml"); });
+    EXPECT_NE(e.find("h.xml:7: <port id=\"J1\">: attribute 'x' is empty"), std::string::npos) << e;
+    e = input_error([&] {
+      loom::parse_harness_xml(with(kClearHarness, "min_bend_radius=\"10\"", "min_bend_radius=\"" + blank + "\""),
+                              "h.xml");
+    });
+    EXPECT_NE(e.find("h.xml:4: <physical>: attribute 'min_bend_radius' is empty"), std::string::npos) << e;
+  }
+  // Blanks around a number are still the number.
+  const loom::Harness h = loom::parse_harness_xml(with(kClearHarness, "x=\"-20\"", "x=\" -20 \""), "h.xml");
+  EXPECT_EQ(h.ports[0].position.x(), -20.0);
+}
+
+// A <pt> nested in a <pt> (a point through the box: a clash) and <junk/> inside <port> and
+// <physical> were dropped unread: the audit said clean.
+TEST(FuzzRegression, XmlLeafChildrenIgnored) {
+  const std::string path = R"(<segment from="J1" to="J2">
+      <path interp="polyline"><pt x="0" y="5" z="30"><pt x="5" y="5" z="-50"/></pt></path>
+    </segment>)";
+  std::string e = input_error([&] {
+    loom::parse_harness_xml(with(kClearHarness, "<segment from=\"J1\" to=\"J2\"/>", path), "h.xml");
+  });
+  EXPECT_NE(e.find("h.xml:10: <pt>: unexpected element <pt> inside <pt>"), std::string::npos) << e;
+  e = input_error([&] {
+    loom::parse_harness_xml(with(kClearHarness, "<port id=\"J1\"/>", "<port id=\"J1\"><junk/></port>"), "h.xml");
+  });
+  EXPECT_NE(e.find("h.xml:3: <junk>: unexpected element <junk> inside <port>"), std::string::npos) << e;
+  e = input_error([&] {
+    loom::parse_harness_xml(with(kClearHarness, "min_bend_radius=\"10\"/>", "min_bend_radius=\"10\"><junk/></physical>"),
+                            "h.xml");
+  });
+  EXPECT_NE(e.find("h.xml:4: <junk>: unexpected element <junk> inside <physical>"), std::string::npos) << e;
+  e = input_error([&] {
+    loom::parse_harness_xml(with(kClearHarness, "dz=\"0\"/>", "dz=\"0\"><cp x=\"0\" y=\"0\" z=\"0\"/></port>"), "h.xml");
+  });
+  EXPECT_NE(e.find("h.xml:7: <cp>: unexpected element <cp> inside <port>"), std::string::npos) << e;
+  e = input_error([&] {
+    loom::parse_harness_xml(with(kClearHarness, "<attributes>", "<attributes>stray words"), "h.xml");
+  });
+  EXPECT_NE(e.find("h.xml:2: <attributes>: unexpected text 'stray words' inside <attributes>"), std::string::npos)
+      << e;
+}
+
+}  // namespace
