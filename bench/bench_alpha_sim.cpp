@@ -1,4 +1,4 @@
-// α-SIM benchmark (issue 4). Scenario program, fixed seeds, baselines in the same run:
+// α-SIM benchmark. Scenario program, fixed seeds, baselines in the same run:
 //  1. the bundled wing-section scene and the real meshes at dim_pre = the scene's value
 //     (smallest cable diameter) / a fixed fraction of each part's size: triangle ratio,
 //     Hausdorff distance, containment, time;
@@ -373,12 +373,13 @@ void throughput(const fs::path& out_dir, const std::vector<Set>& sets) {
   std::ofstream tp_csv(out_dir / "alpha_sim_throughput.csv");
   tp_csv << "threads,triangles,seconds,triangles_per_second,measure,cpu_seconds,triangles_per_cpu_second,"
             "absorb_box_prisms,occt_booleans,edge_on_segments,exact_containment,coarse_interior,runs,median_seconds\n";
-  // Without the measures: as loom runs; then as in the twenty-fourth session (random
-  // containment samples and verification rounds, the whole lattice at L_max); then also
-  // with the samples of triangles seen edge-on tested (the twenty-third session's path);
-  // then also with the general Booleans on OpenCASCADE (the twenty-second's); then with
-  // every OpenCASCADE Boolean run (no prism absorbed: the solids before it) — the
-  // baselines in the same process; last, as loom runs with the mesh verification.
+  // Without the measures: as loom runs; then the ablations, each adding one slower path
+  // that AlphaSimOptions still offers — random containment samples and verification
+  // rounds with the whole lattice at L_max (exact_containment and coarse_interior off);
+  // also the samples of triangles seen edge-on tested (edge_on_segments off); also the
+  // general Booleans on OpenCASCADE (occt_booleans); also every prism through OpenCASCADE's
+  // Booleans (absorb_box_prisms off) — the baselines in the same process; last, as loom
+  // runs with the mesh verification.
   // LOOM_TP_ONE=1 runs the first only (for profiling).
   struct Config {
     bool measure, absorb, occt, edge_on, exact, coarse;

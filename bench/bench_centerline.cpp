@@ -1,4 +1,4 @@
-// Centerline benchmark (issue 5): a 1 m, r = 2 mm cable at 0.01 mm chord tolerance
+// Centerline benchmark: a 1 m, r = 2 mm cable at 0.01 mm chord tolerance
 // interpolated + faired + swept on one core (target < 90 µs; the scan seed reports 9 ms per
 // cable surface), 1000 cables on 1 and 2 threads (target < 50 ms on 2), against an
 // OpenCASCADE baseline run in the same process (GeomAPI_Interpolate + BRepOffsetAPI_MakePipe

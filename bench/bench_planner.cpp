@@ -1,4 +1,4 @@
-// Planner speed against quality (issue 7): for each planner and time budget, route a fixed
+// Planner speed against quality: for each planner and time budget, route a fixed
 // set of cables through a fixed-seed cluttered scene of boxes (EmbreeIndex) and compare each
 // route's length with the best length found for that cable in the same process (all runs plus
 // long baseline runs of BIT* and Informed RRT* at kBaselineBudget). Writes

@@ -1,10 +1,10 @@
-// End-to-end routing benchmark (issue 7): the bundled wing-section harness routed by every
+// End-to-end routing benchmark: the bundled wing-section harness routed by every
 // planner at a ladder of time budgets, on the exact parts and on α-simplified parts
 // (simplified once, in the same process), against long runs at 20× the scene's budget as
 // the quality reference. For each run: cables routed, total cable length / best known
 // length, clashes and violations left by the exact audit, and the time split (index,
 // simplify, plan, spline, audit, repair). Fixed seed. Writes bench/results/route.csv,
-// route_summary.csv, route.gp and route.png (gnuplot).
+// route_<series>.dat, route.gp and route.png (gnuplot).
 //
 // Usage: bench_route [--quick] [--scene PATH]   (--quick: two planners, two budgets)
 #include "core/io/scene_load.hpp"

@@ -1,4 +1,4 @@
-// Scan → centerline benchmark (issue 8). Fixed seeds; writes bench/results/scan_*.csv and
+// Scan → centerline benchmark. Fixed seeds; writes bench/results/scan_*.csv and
 // charts (gnuplot):
 //   scan_speed   points/s of the graph method on 1 and 2 threads (paper-size cloud of 76,503
 //                points and a 500k cloud), with the paper's axis method as the baseline

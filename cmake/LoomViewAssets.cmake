@@ -1,4 +1,4 @@
-# view.html assets (issue 9): three.js r111 and its OrbitControls from Debian's libjs-three,
+# view.html assets: three.js r111 and its OrbitControls from Debian's libjs-three,
 # turned at BUILD time into a generated C++ source so that the loom binary carries them and
 # every view.html it writes is self-contained (opens from disk, no network).
 #

@@ -1,4 +1,4 @@
-// Progress reports and their terminal rendering (issue 9).
+// Progress reports and their terminal rendering.
 #include "core/progress.hpp"
 
 #include <unistd.h>

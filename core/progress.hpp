@@ -1,5 +1,5 @@
 #pragma once
-/// Progress of long stages (issue 9). Library code says how far a stage is through a
+/// Progress of long stages. Library code says how far a stage is through a
 /// ProgressFn (counts of items, never fractions or timings); the command line draws the
 /// reports as bars on a terminal with a ProgressBar. No global state: whoever wants
 /// reports passes a function, whoever does not leaves it empty.

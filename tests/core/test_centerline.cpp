@@ -219,11 +219,11 @@ TEST(Centerline, ArcLengthMatchesOpenCascadeAndInverts) {
   }
 }
 
-// Regression (2026-11-25, session 20): key points a micrometre apart on a metre-scale route
-// (a dense export) made every span's quadrature aim at 1e-13 of its own micrometre, and on
-// the wiggles of noisy points bisect to its deepest level: 0.5 s per curve, and a 200,000
-// point route took hours to audit. The tolerance is now relative to the whole curve; the
-// lengths must still agree with OpenCASCADE's.
+// Key points a micrometre apart on a metre-scale route (a dense export): a quadrature
+// tolerance of 1e-13 of each span's own micrometre makes the wiggles of noisy points bisect
+// to the deepest level (0.5 s per curve; a 200,000-point route takes hours to audit). The
+// tolerance is relative to the whole curve, and the lengths must still agree with
+// OpenCASCADE's.
 TEST(Centerline, DenseNoisyKeyPointsKeepTheirArcLength) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> noise(-1e-3, 1e-3);

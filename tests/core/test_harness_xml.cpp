@@ -266,8 +266,8 @@ TEST(HarnessXml, BsplineKnotDomainMustNotVanish) {
   EXPECT_NO_THROW(parse_harness_xml(text, "ok.xml"));
 }
 
-// A directory, a device or a pipe is not a harness file (a device such as /dev/zero was read
-// without end until memory ran out).
+// A directory, a device or a pipe is not a harness file (a device such as /dev/zero would be
+// read without end until memory runs out).
 TEST(HarnessXml, NonRegularFileIsRefused) {
   const auto dir = std::filesystem::temp_directory_path() / "loom_harness_dir.xml";
   std::filesystem::create_directories(dir);

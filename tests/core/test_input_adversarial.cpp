@@ -1,9 +1,9 @@
-// Adversarial review of loom's inputs (scene TOML, harness XML, mesh files) through the
-// library readers and the command line. The oracle is DESIGN §3–§4: every bad input is exit
+// Adversarial inputs to loom's readers (scene TOML, harness XML, mesh files), through the
+// library and the command line. The oracle is DESIGN §3–§4: every bad input is exit
 // status 2 with a message naming the file, the line or element and what is wrong, and nothing
 // half-written; valid edge values (BOM, CRLF, comments, unicode, predefined entities, UTF-16,
-// hex floats in TOML) keep working. The bugs this review found are in
-// tests/regressions/test_input_regressions.cpp; this file keeps the broader catalogue.
+// hex floats in TOML) keep working. Each defect such inputs exposed has its regression test
+// in tests/regressions/test_input_regressions.cpp; this file keeps the broader catalogue.
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
 #include "core/io/harness_xml.hpp"
@@ -308,8 +308,9 @@ TEST_F(InputAdversarial, HarnessMarkupPugixmlWouldMisreadIsRefused) {
 }
 
 // A large harness (20,000 ports, 10,000 cables, each with its own segment, plus one branch
-// joining three more ports) is read with every cable's chain right. Port lookups used to be
-// linear per cable end, quadratic in all (no timing is asserted here).
+// joining three more ports) is read with every cable's chain right. Ports are looked up in
+// one node table: a linear search per cable end would be quadratic in all (no timing is
+// asserted here).
 TEST_F(InputAdversarial, LargeHarnessIsReadWithItsChains) {
   constexpr int kPairs = 10000;
   std::string cables, ports, segments;

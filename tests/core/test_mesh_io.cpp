@@ -165,8 +165,8 @@ const char* kPlyTriangleHeader =
     "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
 
 // Assimp's PLY reader passes a face index beyond the vertices on, and its post-processing
-// read it out of bounds (SIGSEGV for -5): its structure validation now runs first. Its OFF
-// reader clamps such an index instead: checked before it reads.
+// reads it out of bounds (SIGSEGV for -5): loom runs Assimp's structure validation first.
+// Its OFF reader clamps such an index instead: checked before it reads.
 TEST_F(TempDir, FaceIndexBeyondTheVerticesIsAnInputError) {
   for (const char* face : {"3 0 1 99\n", "3 0 1 -5\n"}) {
     std::ofstream(dir_ / "f.ply") << kPlyTriangleHeader << face;
@@ -174,14 +174,14 @@ TEST_F(TempDir, FaceIndexBeyondTheVerticesIsAnInputError) {
     EXPECT_NE(e.find("f.ply"), std::string::npos) << e;
     EXPECT_NE(e.find("out of range"), std::string::npos) << e;
   }
-  // Assimp's OFF reader replaced such an index by the last vertex (another triangle).
+  // Assimp's OFF reader replaces such an index by the last vertex (another triangle).
   std::ofstream(dir_ / "f.off") << "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 77\n";
   const std::string e = read_error(dir_ / "f.off");
   EXPECT_NE(e.find("f.off:6: face 0: vertex index 77 is not one of the 3 vertices"), std::string::npos) << e;
 }
 
-// Counts declared in a PLY or OFF header were allocated before any data was read: a
-// 200-byte file declaring 4e9 vertices asked for 48 GB. They are checked against the size.
+// Assimp allocates the counts a PLY or OFF header declares before reading any data: a
+// 200-byte file declaring 4e9 vertices asks for 48 GB. They are checked against the size.
 TEST_F(TempDir, DeclaredCountsBeyondTheFileAreRefused) {
   std::ofstream(dir_ / "a.ply") << "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\n"
                                    "property float y\nproperty float z\nend_header\n0 0 0\n";
@@ -229,8 +229,8 @@ std::string binary_ply(bool big_endian, const std::string& count_type, const std
 }
 
 // Assimp allocates a PLY list by its length field before reading it: a 100-byte file with a
-// face of 10⁸ indices took 830 MB, and 4·10⁹ ended in std::bad_alloc naming nothing. Every
-// list length is now checked against the bytes left, in both byte orders and in ASCII.
+// face of 10⁸ indices takes 830 MB, and 4·10⁹ ends in std::bad_alloc naming nothing. Every
+// list length is checked against the bytes left, in both byte orders and in ASCII.
 TEST_F(TempDir, PlyListLengthsBeyondTheFileAreRefused) {
   for (bool big : {false, true}) {
     std::ofstream(dir_ / "l.ply", std::ios::binary) << binary_ply(big, "uint", {{3, 0, 1, 2}, {100000000, 0, 2, 3}}, 4);
@@ -392,8 +392,8 @@ TEST(RealCad, CacheReturnsTheSameMeshes) {
   fs::remove_all(dir);
 }
 
-// A cache entry whose vertex count is corrupt (2^32) sized its arrays from it: 96 GB,
-// std::bad_alloc on every run until the cache was deleted. It is now a miss, re-tessellated
+// A cache entry whose vertex count is corrupt (2^32) must not size arrays from it (96 GB,
+// std::bad_alloc on every run until the cache is deleted): it is a miss, re-tessellated
 // and stored again.
 TEST(RealCad, CorruptCacheEntryIsAMiss) {
   const fs::path dir = fs::temp_directory_path() / "loom_tess_cache_corrupt";

@@ -1,4 +1,4 @@
-// Progress reports (issue 9): ProgressCounter's event sequence and ProgressBar's drawing,
+// Progress reports: ProgressCounter's event sequence and ProgressBar's drawing,
 // throttling and thread-safety. Time is an injected clock; nothing asserts on real time.
 #include "core/progress.hpp"
 

@@ -166,8 +166,8 @@ TEST_F(SceneDir, BadNumbers) {
   expect_bad("[scene]\nname='t'\n[[part]]\nfile='cube.stl'\ntransform={translate=[1,2]}\n", {"array of 3"});
 }
 
-// A section given as anything but a table was ignored without a word (`harness = "h.xml"`
-// loaded a scene without its harness); it is now an error naming the key and line.
+// A section given as anything but a table is an error naming the key and line, not ignored
+// (`harness = "h.xml"` would load a scene without its harness).
 TEST_F(SceneDir, SectionsMustBeTables) {
   EXPECT_NO_THROW(load_scene(scene("[scene]\nname='t'\n[routing]\n")));
   expect_bad("harness = 'harness.xml'\n[scene]\nname='t'\n", {"scene.toml:1", "harness", "expected a table [harness]"});
@@ -177,7 +177,7 @@ TEST_F(SceneDir, SectionsMustBeTables) {
   expect_bad("scene = 'x'\n", {"scene.toml:1", "expected a table [scene]"});
 }
 
-// The seed is the planner's unsigned 32-bit value: a larger one was cut to another seed.
+// The seed is the planner's unsigned 32-bit value: a larger one would be cut to another seed.
 TEST_F(SceneDir, SeedMustFitThirtyTwoBits) {
   EXPECT_EQ(load_scene(scene("[scene]\nname='t'\n[routing]\nseed=4294967295\n")).routing.seed, 4294967295u);
   expect_bad("[scene]\nname='t'\n[routing]\nseed=4294967296\n", {"scene.toml:4", "routing.seed", "0..4294967295"});

@@ -26,7 +26,7 @@ using namespace loom::testmesh;
 namespace {
 
 /// Embree distances are computed in double on the exact triangles: far better than the
-/// issue's 1e-5 relative bound, which is what we assert.
+/// 1e-5 relative bound the index promises, which is what we assert.
 constexpr double kEmbreeRel = 1e-5;
 
 }  // namespace
@@ -208,12 +208,6 @@ TEST(EmbreeIndex, InsideAgreesWithWindingNumberNearEdgesAndVertices) {
   EXPECT_FALSE(EmbreeIndex({parts[3]}).inside(parts[3].mesh.bounds().center(), &part));
 }
 
-// Embree's float ray test and loom's double crossing test can disagree about which of two
-// triangles sharing an edge a ray crosses when the triangles are small against their
-// distance from the index centre (float barycentrics err by ~2^-24 · distance / edge).
-// A crossing must then count as grazing, not vanish: with one ray per test (no majority
-// to outvote a lost crossing), every point of a fine closed sphere far from the centre is
-// classified exactly. Regression: one ray lost crossings on α-SIM's output for the motor.
 // Closed parts modelled through each other: inside_parts() names every one holding the
 // point (the audit clashes a cable with each), against closed forms and brute force.
 TEST(EmbreeIndex, InsidePartsNamesEveryOverlappingClosedPart) {
@@ -239,6 +233,12 @@ TEST(EmbreeIndex, InsidePartsNamesEveryOverlappingClosedPart) {
   EXPECT_TRUE(got.empty());
 }
 
+// Embree's float ray test and loom's double crossing test can disagree about which of two
+// triangles sharing an edge a ray crosses when the triangles are small against their
+// distance from the index centre (float barycentrics err by ~2^-24 · distance / edge).
+// A crossing must then count as grazing, not vanish: with one ray per test (no majority
+// to outvote a lost crossing, as in α-SIM's containment check), every point of a fine
+// closed sphere far from the centre is classified exactly.
 TEST(EmbreeIndex, OneRayInsideIsExactOnSmallTrianglesFarFromTheCentre) {
   const std::vector<Part> parts = {make_part("fine", uv_sphere(Vec3::Zero(), 1.0, 96, 48), true),
                                    make_part("far", box(Vec3::Constant(4000), Vec3::Constant(4001)), true)};
@@ -249,7 +249,7 @@ TEST(EmbreeIndex, OneRayInsideIsExactOnSmallTrianglesFarFromTheCentre) {
   std::mt19937_64 rng(27);
   std::uniform_real_distribution<double> u(-1.2, 1.2);
   int inside = 0, wrong = 0;
-  for (int i = 0; i < 8000; ++i) {  // one ray lost ~1.3 per 1000 before the fix
+  for (int i = 0; i < 8000; ++i) {  // without the grazing rule ~1.3 per 1000 come out wrong
     const Vec3 p(u(rng), u(rng), u(rng));
     const bool truth = b.inside(p);
     inside += truth ? 1 : 0;
@@ -616,8 +616,8 @@ RC_GTEST_PROP(EmbreeIndexProps, ClosestIsConsistentWithAnyWithinAndVertices, ())
 // One ray per inside test is exact on a closed mesh at any distance from the index centre:
 // a sphere of random tessellation and size, a far box setting the centre 10^0..10^6 sphere
 // radii away, random points off the band between the inscribed polyhedron and the sphere.
-// (Before the twenty-seventh session, crossings near shared edges were lost once the
-// triangles were small against float rounding there.)
+// (Without the grazing rule, crossings near shared edges are lost once the triangles are
+// small against float rounding there.)
 RC_GTEST_PROP(EmbreeIndexProps, OneRayInsideIsExactAtAnyDistanceFromTheCentre, ()) {
   const int nu = *rc::gen::inRange(8, 97);
   const int nv = *rc::gen::inRange(4, 49);
