@@ -3,7 +3,6 @@
 #include "core/error.hpp"
 #include "core/io/mesh_read.hpp"
 #include "core/io/scene_load.hpp"
-#include "routing/route/path_planner.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -18,9 +17,6 @@
 int main(int argc, char** argv) {
   // stdout is the command's (reports, --json); OpenCASCADE's transfer statistics would mix in.
   loom::silence_opencascade_console();
-  // A scene naming an unknown planner is refused when it loads, with its file and line, by
-  // every command (info included), not only when route gets to plan.
-  loom::register_planner_names(loom::planner_names());
   CLI::App app{"loom — automatic cable-harness routing and clash audits of large assemblies"};
   app.name("loom");
   app.set_version_flag("--version", std::string("loom ") + LOOM_VERSION);

@@ -2,6 +2,13 @@
 
 namespace loom {
 
+const std::vector<std::string>& routing_planner_names() {
+  static const std::vector<std::string> names = {
+      "abitstar", "bfmt",   "bitstar", "fmt",        "informedrrtstar", "lazyprm",  "lazyprmstar",
+      "prm",      "prmstar", "rrt",    "rrtconnect", "rrtsharp",        "rrtstar",  "sorrtstar"};
+  return names;
+}
+
 AABB Scene::bounds() const {
   AABB box;
   for (const auto& p : parts) box.extend(p.mesh.bounds());

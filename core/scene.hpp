@@ -25,6 +25,10 @@ struct Setting {
 constexpr long long kMaxPlanIterations = 100'000'000;
 
 /// [routing] of the scene file.
+/// The OMPL geometric planners that a scene's routing.planner may name, sorted. The scene
+/// loader refuses any other name (file and line); loom::route maps each to its OMPL class.
+const std::vector<std::string>& routing_planner_names();
+
 struct RoutingSettings {
   Setting clearance;       ///< required gap between cable surface and structure
   std::string planner = "informedrrtstar";

@@ -127,20 +127,12 @@ Eigen::Affine3d part_transform(const TomlReader& r, const toml::table* t, const 
   return m;
 }
 
-/// The names routing.planner accepts (set by register_planner_names; empty: any).
-std::vector<std::string>& known_planners() {
-  static std::vector<std::string> names;
-  return names;
-}
-
 std::filesystem::path resolve(const std::filesystem::path& base, const std::string& rel) {
   std::filesystem::path p(rel);
   return p.is_absolute() ? p : base / p;
 }
 
 }  // namespace
-
-void register_planner_names(std::vector<std::string> names) { known_planners() = std::move(names); }
 
 void apply_routes(Scene& scene, const std::filesystem::path& routes) {
   Harness routed = read_harness_xml(routes);
@@ -227,8 +219,8 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
       scene.routing.time_limit = {*v, "scene file"};
     }
     if (auto v = r.string(*rt, "routing", "planner")) {
-      const std::vector<std::string>& known = known_planners();
-      if (!known.empty() && std::find(known.begin(), known.end(), *v) == known.end()) {
+      const std::vector<std::string>& known = routing_planner_names();
+      if (std::find(known.begin(), known.end(), *v) == known.end()) {
         std::string valid;
         for (const auto& k : known) valid += (valid.empty() ? "" : ", ") + k;
         r.fail(rt->get("planner"), "routing.planner", "unknown planner '" + *v + "'; valid planners: " + valid);

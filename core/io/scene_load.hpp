@@ -25,12 +25,6 @@ struct SceneLoadReport {
   std::vector<std::string> notes;  ///< e.g. "part 'skin' is open: surface checks only"
 };
 
-/// Sets, for the whole process, the names that a scene's routing.planner may take, so that
-/// load_scene refuses any other naming the file and line. Until it is called any name loads
-/// (core does not know the planners; loom::route's planner_names() does, and the command
-/// line registers them at start-up). Call before any thread loads a scene.
-void register_planner_names(std::vector<std::string> names);
-
 /// Reads and validates a scene file. Relative paths in it are relative to its directory.
 /// Throws InputError (file, line, key, reason) for every malformed input.
 Scene load_scene(const std::filesystem::path& toml, const SceneLoadOptions& opt = {},

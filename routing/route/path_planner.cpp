@@ -1,5 +1,6 @@
 #include "routing/route/path_planner.hpp"
 
+#include "core/scene.hpp"
 #include "routing/route/tube_validity.hpp"
 
 #include <ompl/base/Goal.h>
@@ -785,10 +786,10 @@ const char* reason_name(NoPathReason r) {
 }
 
 std::vector<std::string> planner_names() {
-  std::vector<std::string> names;
-  for (const auto& e : planner_table()) names.emplace_back(e.name);
-  std::sort(names.begin(), names.end());
-  return names;
+  // The scene model's list is the one users see; every name on it must have a table entry
+  // (find_planner throws otherwise: PathPlanner.EveryPlannerNameSolvesAnEasyScene plans with each).
+  for (const std::string& n : routing_planner_names()) find_planner(n);
+  return routing_planner_names();
 }
 
 bool planner_is_optimizing(const std::string& name) { return find_planner(name).optimizing; }
