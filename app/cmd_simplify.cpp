@@ -3,6 +3,7 @@
 #include "app/commands.hpp"
 #include "app/option_checks.hpp"
 
+#include "core/stopwatch.hpp"
 #include "core/io/atomic_file.hpp"
 #include "core/io/output_set.hpp"
 #include "core/io/file_stems.hpp"
@@ -15,7 +16,6 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -71,7 +71,7 @@ int run_simplify(const SimplifyCommandOptions& o) {
                  scene.parts.size(), dim_pre, unit_name(scene.units),
                  given ? "--dim-pre" : scene.simplify.dim_pre.source.c_str(), opt.alpha_factor * dim_pre,
                  opt.sampling_factor * dim_pre, tolerance, unit_name(scene.units));
-  const auto t_start = std::chrono::steady_clock::now();
+  const Stopwatch t_start;
   std::vector<AlphaSimResult> results;
   const std::vector<Part> simple = simplify_parts(scene.parts, opt, &results);
 
@@ -151,7 +151,7 @@ int run_simplify(const SimplifyCommandOptions& o) {
   if (!o.quiet)
     std::fprintf(stderr, "loom simplify: %zu -> %zu triangles (%.1f%%) in %.2f s; wrote %s\n", before, after,
                  before > 0 ? 100.0 * after / before : 0.0,
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count(),
+                 t_start.seconds(),
                  (out_dir / "simplify.json").string().c_str());
   return 0;
 }

@@ -17,6 +17,7 @@
 // alpha_sim_tessellation.csv, alpha_sim_planner_queries.csv, alpha_sim.png,
 // alpha_sim_tessellation.png.
 #include "bench/forwarding_index.hpp"
+#include "core/stopwatch.hpp"
 #include "core/io/mesh_read.hpp"
 #include "core/io/scene_load.hpp"
 #include "core/units.hpp"
@@ -28,7 +29,6 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <algorithm>
@@ -44,11 +44,9 @@
 
 using namespace loom;
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 namespace {
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 /// CPU time (user + system) of the process so far, all threads (s): comparable on a busy
 /// machine, unlike wall time.
@@ -71,10 +69,10 @@ Fastest fastest_of(int runs, F&& f) {
   Fastest out;
   std::vector<double> walls;
   for (int run = 0; run < runs; ++run) {
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     const double cpu0 = cpu_seconds();
     f();
-    const double wall = seconds_since(t0), cpu = cpu_seconds() - cpu0;
+    const double wall = t0.seconds(), cpu = cpu_seconds() - cpu0;
     walls.push_back(wall);
     if (wall < out.sec) {
       out.sec = wall;
@@ -121,12 +119,12 @@ double rate(const ObstacleIndex& idx, const std::vector<Vec3>& pts, double radiu
   double best = 0.0;
   for (int rep = 0; rep < 3; ++rep) {
     double sum = 0.0;
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     for (const Vec3& p : ordered) {
       const ClosestHit h = idx.closest(p, radius);
       sum += h.found() ? h.distance : 0.0;
     }
-    const double s = seconds_since(t0);
+    const double s = t0.seconds();
     volatile double sink = sum;
     (void)sink;
     best = std::max(best, static_cast<double>(pts.size()) / s);
@@ -282,7 +280,7 @@ double replay_ns(const ObstacleIndex& idx, const std::vector<LoggedQuery>& qs) {
   double best = std::numeric_limits<double>::infinity();
   for (int rep = 0; rep < 3; ++rep) {
     double sum = 0.0;
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     for (const LoggedQuery& q : qs) switch (q.kind) {
         case LoggedQuery::kAnyWithin: sum += idx.any_within(q.a, q.r) ? 1.0 : 0.0; break;
         case LoggedQuery::kInside: sum += idx.inside(q.a) ? 1.0 : 0.0; break;
@@ -294,7 +292,7 @@ double replay_ns(const ObstacleIndex& idx, const std::vector<LoggedQuery>& qs) {
         case LoggedQuery::kSegmentWithin: sum += idx.segment_within(q.a, q.b, q.r) ? 1.0 : 0.0; break;
         case LoggedQuery::kKinds: break;
       }
-    const double s = seconds_since(t0);
+    const double s = t0.seconds();
     volatile double sink = sum;
     (void)sink;
     best = std::min(best, 1e9 * s / static_cast<double>(qs.size()));
@@ -535,9 +533,9 @@ int main(int argc, char** argv) {
     opt.dim_pre = set.dim_pre;
     std::vector<AlphaSimResult> res;
     const double cpu0 = cpu_seconds();
-    const auto t_set = Clock::now();
+    const Stopwatch t_set;
     const auto simple = simplify_parts(set.parts, opt, &res);
-    const double set_cpu = cpu_seconds() - cpu0, set_wall = seconds_since(t_set);
+    const double set_cpu = cpu_seconds() - cpu0, set_wall = t_set.seconds();
     AABB box;
     for (const auto& p : set.parts) box.extend(p.mesh.bounds());
     const EmbreeIndex original_index(set.parts), simple_index(simple);

@@ -1,5 +1,6 @@
 #include "index/simplify/alpha_sim.hpp"
 
+#include "core/stopwatch.hpp"
 #include "core/io/file_stems.hpp"
 
 #include "core/error.hpp"
@@ -33,7 +34,6 @@
 #include <array>
 #include <atomic>
 #include <exception>
-#include <chrono>
 #include <cstring>
 #include <cmath>
 #include <iterator>
@@ -252,11 +252,6 @@ std::vector<Vec3> dense_surface_samples(const Mesh& mesh, double spacing, double
 }
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 /// True if the projected edge pa–pb lies inside the projection of its two triangles:
 /// exactly two share it and their third corners project strictly to opposite sides.
@@ -1345,7 +1340,7 @@ AlphaSimPlaneSamples alpha_sim_plane_samples(const Mesh& mesh, const AlphaSimPri
 // ---------------------------------------------------------------------------------------
 
 AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const std::string& step_stem) {
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   if (!(std::isfinite(opt.dim_pre) && opt.dim_pre > 0.0))
     throw std::invalid_argument("alpha-sim: dim_pre must be finite and > 0, got " + full_precision(opt.dim_pre));
   if (!(opt.sampling_factor > 0.0 && opt.alpha_factor > 0.0))
@@ -1372,7 +1367,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   const double rounding_reserve = float_rounding_reserve(box, opt, r.tolerance);
   const double tol = r.tolerance - rounding_reserve;
   auto finish = [&]() {
-    r.time_ms = ms_since(t0);
+    r.time_ms = t0.ms();
     return std::move(out);
   };
 
@@ -1696,9 +1691,9 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
         grow_simplify(polys[k], opt.polygon_growth_factor * opt.dim_pre, opt.merge_convex_corners);
   }
 
-  r.shapes_ms = ms_since(t0);
+  r.shapes_ms = t0.ms();
   if (!opt.build_mesh) return finish();
-  const auto t_mesh = Clock::now();
+  const Stopwatch t_mesh;
 
   // 5–6. extrude and intersect, mesh the result. Each prism runs a margin past the part
   // so that no cap of one coincides with a face of another.
@@ -1773,7 +1768,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     }
     watertight = watertight_mesh(out.mesh, otopo);
   }
-  r.mesh_ms = ms_since(t_mesh);
+  r.mesh_ms = t_mesh.ms();
   if (watertight && out.mesh.signed_volume() < 0.0)
     for (auto& f : out.mesh.triangles) std::swap(f[1], f[2]);
   if (r.float_rounding > rounding_reserve) {
@@ -1794,7 +1789,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     return finish();
   }
 
-  const auto t_measure = Clock::now();
+  const Stopwatch t_measure;
   if (opt.measure) {
     // Containment of the original surface in the output mesh (what indices will use), on
     // a whole dense set (fixed and random points) of a seed no verification round used.
@@ -1879,7 +1874,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     }
   }
 
-  r.measure_ms = ms_since(t_measure);
+  r.measure_ms = t_measure.ms();
   if (!opt.step_dir.empty())
     write_step_atomic(result,
                       opt.step_dir / ((step_stem.empty() ? output_file_stems({part.name})[0] : step_stem) + ".step"));
@@ -1973,7 +1968,7 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
     if (e) std::rethrow_exception(e);
   for (std::size_t i = 0; i < parts.size(); ++i) {
     if (source[i] == i) continue;
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     const std::size_t j = source[i];
     Part p = parts[i];
     double rounding = 0.0;
@@ -2012,7 +2007,7 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
     if (!move[i].linear().isIdentity()) res[i].projections = turned_projections(res[j].projections, move[i].linear(), planes_for(o));
     res[i].name = parts[i].name;
     res[i].copy_of = parts[j].name;
-    res[i].time_ms = ms_since(t0);
+    res[i].time_ms = t0.ms();
     res[i].shapes_ms = res[i].mesh_ms = res[i].measure_ms = 0.0;
     simplified.add();
   }

@@ -1,4 +1,5 @@
 #include "routing/scan/scan_centerline.hpp"
+#include "core/stopwatch.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -6,7 +7,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -82,11 +82,6 @@ constexpr std::size_t kSpacingNeighbours = 16;
 /// Scale steps of the diameter estimate: enough to double from 10⁻⁶ of the cloud's size to
 /// all of it (20) and then settle.
 constexpr int kEstimateIterations = 24;
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 struct CloudAdaptor {
   const std::vector<Vec3>& pts;
@@ -844,7 +839,7 @@ std::optional<double> estimate_tube_diameter(const std::vector<Vec3>& cloud, std
 }
 
 ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptions& opt) {
-  const auto t_start = Clock::now();
+  const Stopwatch t_start;
   if (opt.diameter && !(std::isfinite(*opt.diameter) && *opt.diameter > 0.0))
     throw std::invalid_argument("extract_centerline: diameter must be positive and finite");
   if (!(std::isfinite(opt.block_length) && opt.block_length >= 0.0))
@@ -864,14 +859,14 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
   auto finish = [&](ScanStatus st, std::string msg) {
     res.status = st;
     res.message = std::move(msg);
-    res.timing.total_ms = ms_since(t_start);
+    res.timing.total_ms = t_start.ms();
     return res;
   };
   if (pts.size() < 2 * kMinBlockPoints)
     return finish(ScanStatus::TooFewPoints, "the cloud has " + std::to_string(pts.size()) + " finite points; at least " +
                                                 std::to_string(2 * kMinBlockPoints) + " are needed");
 
-  auto t0 = Clock::now();
+  Stopwatch t0;
   // Neighbourhood statistics (diameter estimate, contraction onto the axis) only need a
   // bounded, evenly strided subset of the cloud.
   std::vector<Vec3> sub_storage;
@@ -890,9 +885,9 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
   if (opt.diameter) {
     d = *opt.diameter;
   } else {
-    const auto tdia = Clock::now();
+    const Stopwatch tdia;
     auto est = coarse_diameter(sub, tree, opt.seed);
-    res.timing.diameter_ms = ms_since(tdia);
+    res.timing.diameter_ms = tdia.ms();
     if (!est) return finish(ScanStatus::NotATube, "cannot estimate a diameter: no neighbourhood has a circular cross-section");
     d = *est;
     res.diameter_estimated = true;
@@ -975,10 +970,10 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
     for (std::size_t i = 0; i < pts.size(); ++i)
       if (use[i]) sorted[fill[blk_of[i]]++] = pts[i];
   }
-  res.timing.ordering_ms = ms_since(t0);
+  res.timing.ordering_ms = t0.ms();
 
   // Block fits: pass 1 (free radius when estimating), pass 2 (nominal radius, smoothness prior).
-  t0 = Clock::now();
+  t0.restart();
   const bool graph = opt.method == ScanMethod::Graph;
   std::vector<FitOut> fits(m);
   std::vector<Vec3> c0(m), a0(m);
@@ -1091,10 +1086,10 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
   }
   const std::vector<FitOut> pass1 = fits;
   run_pass(false, 0.5 * fitted_d, priors, &pass1);
-  res.timing.fitting_ms = ms_since(t0);
+  res.timing.fitting_ms = t0.ms();
 
   // Key points in order along the cable.
-  t0 = Clock::now();
+  t0.restart();
   double sq = 0.0;
   bool run_open = false;  // a run's start point has been emitted
   std::vector<std::pair<std::size_t, std::size_t>> gap_keys;  // key point indices either side of a gap
@@ -1172,7 +1167,7 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
       res.largest_gap = std::max(res.largest_gap, g);
     }
   }
-  res.timing.spline_ms = ms_since(t0);
+  res.timing.spline_ms = t0.ms();
   return finish(ScanStatus::Ok, "");
 }
 
