@@ -1,16 +1,16 @@
 #include "routing/route/route_pipeline.hpp"
 
+#include "core/stopwatch.hpp"
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
 #include "index/simplify/alpha_sim.hpp"
-#include "index/box_tree.hpp"
 #include "index/embree_index.hpp"
 #include "routing/curve/bend_repair.hpp"
 #include "routing/route/branch_layout.hpp"
+#include "routing/route/port_check.hpp"
 #include "routing/curve/cable_geometry.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -21,8 +21,6 @@ namespace loom {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 /// The straight stubs at both ends of a segment may eat at most this share of the way
 /// between its ends (the part of each stub that heads towards the other end).
@@ -103,72 +101,6 @@ double free_stub(const ObstacleIndex& index, const Vec3& p, const Vec3& dir, dou
   return 0.0;
 }
 
-/// A part whose surface comes within the tube's required distance of a port, and how far
-/// along the port's straight exit the cable may run closer to it than that.
-struct NearPart {
-  int part = -1;
-  double excused = 0.0;  ///< scene units along the exit from the port
-};
-
-/// The parts near a port. One the port sits on (its connector: any part but a keep-out zone,
-/// DESIGN / README "Attached parts") is excused over `excused_on` — the audit does not check
-/// the cable against it over the port's straight exit; a keep-out zone never is, but its
-/// first `excused_near` cannot be helped (the audit reports it).
-std::vector<NearPart> near_port_parts(const ObstacleIndex& index, const std::vector<AABB>& part_boxes,
-                                      const std::vector<Part>& parts, const Vec3& port, double required,
-                                      double excused_on, double excused_near) {
-  std::vector<NearPart> near;
-  for (std::size_t q = 0; q < parts.size(); ++q)
-    if (part_boxes[q].inflated(required).contains(port) &&
-        index.closest_on_part(port, static_cast<int>(q), required).found())
-      near.push_back({static_cast<int>(q), parts[q].role == PartRole::KeepOut ? excused_near : excused_on});
-  return near;
-}
-
-/// The nearest part that the straight exit port → stub_end comes within `required` of
-/// (found() == false if none). A part near the port is measured only past its excused run,
-/// and over that run (from `lift` off the port, where the port's own surface is left behind)
-/// it must not be entered; every other part is measured over the whole exit. An exit lifted
-/// off the port inside a part meets it at distance 0 there.
-ClosestHit exit_obstacle(const ObstacleIndex& index, const std::vector<AABB>& part_boxes, const Vec3& port,
-                         const Vec3& stub_end, const std::vector<NearPart>& near, double lift, double required) {
-  ClosestHit best;
-  const double len = (stub_end - port).norm();
-  if (!(len > 0.0)) return best;
-  const Vec3 dir = (stub_end - port) / len;
-  // Lifted off the port, the exit must be outside every part (a segment that starts inside
-  // a part need not touch its surface).
-  const Vec3 lifted = port + std::min(lift, len) * dir;
-  int inside_part = -1;
-  if (index.inside(lifted, &inside_part)) {
-    best.distance = 0.0;
-    best.point = lifted;
-    best.part = inside_part;
-    return best;
-  }
-  AABB exit_box;
-  exit_box.extend(port);
-  exit_box.extend(stub_end);
-  auto measure = [&](int q, double from, double to, double need) {
-    if (!(to > from)) return;
-    const ClosestHit hit = index.segment_closest_on_part(port + from * dir, port + to * dir, q, need);
-    if (hit.found() && hit.distance <= best.distance) best = hit;
-  };
-  for (std::size_t q = 0; q < part_boxes.size(); ++q) {
-    if (!boxes_overlap(exit_box.inflated(required), part_boxes[q])) continue;
-    const int id = static_cast<int>(q);
-    const auto it = std::find_if(near.begin(), near.end(), [id](const NearPart& n) { return n.part == id; });
-    if (it == near.end()) {
-      measure(id, 0.0, len, required);
-    } else {
-      const double excused = std::min(it->excused, len);
-      measure(id, std::min(lift, len), excused, 0.0);  // not into it
-      measure(id, excused, len, required);
-    }
-  }
-  return best;
-}
-
 BSplineData to_bspline(const Centerline& c) {
   return BSplineData{c.degree(), c.knots(), c.control_points()};
 }
@@ -216,7 +148,7 @@ class RouteRun {
 
   const Scene& scene_;
   const RouteOptions& opt_;
-  Clock::time_point t_total_ = Clock::now();
+  Stopwatch total_;
   RouteReport rep_;
   Harness& h_;
   const HarnessTopology topo_;  // ids and structure never change below, only geometry
@@ -257,14 +189,14 @@ RouteReport RouteRun::run() {
   replan_bend_failures();
   audit_and_repair();
   note_reproducibility();
-  rep_.timing.total = ms_since(t_total_);
+  rep_.timing.total = total_.ms();
   return std::move(rep_);
 }
 
 /// Planning obstacles: α-simplified parts (they contain the originals, so a route clear of
 /// them is clear of the real parts), the caller's, or the exact parts; indexed once.
 void RouteRun::prepare_obstacles() {
-  auto t0 = Clock::now();
+  Stopwatch t0;
   plan_on_other_parts_ = opt_.planning_parts || (opt_.simplify && !scene_.parts.empty());
   if (opt_.planning_parts) {
     planning_parts_ = *opt_.planning_parts;
@@ -284,8 +216,8 @@ void RouteRun::prepare_obstacles() {
   } else {
     planning_parts_ = scene_.parts;
   }
-  rep_.timing.simplify = ms_since(t0);
-  t0 = Clock::now();
+  rep_.timing.simplify = t0.ms();
+  t0.restart();
   ProgressCounter indexed(opt_.progress, "index", 1, "indices");
   plan_index_ = std::make_unique<EmbreeIndex>(planning_parts_);
   indexed.finish();
@@ -293,7 +225,7 @@ void RouteRun::prepare_obstacles() {
     const auto kept = plan_index_->part_bounds(static_cast<int>(q));
     part_boxes_.push_back(kept ? *kept : planning_parts_[q].mesh.bounds());
   }
-  rep_.timing.index = ms_since(t0);
+  rep_.timing.index = t0.ms();
 }
 
 /// Places the branch points the file leaves open where the legs are short and can turn into
@@ -414,8 +346,7 @@ PlanRequest RouteRun::plan_request(int s, const SegmentExits& x) const {
 }
 
 /// Why an end of the segment cannot be left (message empty if both can): a branch point in
-/// or too near a part (`branch_blocked` set), a port inside a part, or a port whose straight
-/// exit meets a part.
+/// or too near a part (`branch_blocked` set), or a port that check_port_exit refuses.
 PlanResult RouteRun::blocked_end(const SegmentExits& x, bool& branch_blocked) const {
   const EndFrame& ea = x.ea;
   const double radius = x.radius, required = x.required;
@@ -440,34 +371,11 @@ PlanResult RouteRun::blocked_end(const SegmentExits& x, bool& branch_blocked) co
                                   full_precision(radius));
       continue;
     }
-    int inside_part = -1;
-    if (plan_index_->inside(e->position, &inside_part)) {
-      blocked.reason = e == &ea ? NoPathReason::StartInObstacle : NoPathReason::GoalInObstacle;
-      blocked.blocked_at = e->position;
-      blocked.blocking_part = inside_part;
-      blocked.message = "port " + e->node + " at " + full_precision(e->position) + " is inside part '" +
-                        planning_parts_[inside_part].name + "'";
-      continue;
-    }
-    const Vec3 stub_end = e == &ea ? x.a_stub : x.b_stub;
-    // The connector the port sits on may touch its exit over the excused run; every other
-    // part is kept `required` away from all of it, and the planner starts at its end.
-    const double len = (stub_end - e->position).norm();
-    const std::vector<NearPart>& on = e == &ea ? x.on_a : x.on_b;
-    ClosestHit hit;
-    if (plan_index_->segment_within(e->position, stub_end, required))
-      hit = exit_obstacle(*plan_index_, part_boxes_, e->position, stub_end, on, x.attach_slack, required);
-    const ClosestHit at_end = hit.found() ? ClosestHit{} : plan_index_->closest(stub_end, required);
-    if (hit.found() || at_end.found()) {
-      const ClosestHit& w = hit.found() ? hit : at_end;
-      blocked.reason = e == &ea ? NoPathReason::StartPortBlocked : NoPathReason::GoalPortBlocked;
-      blocked.blocked_at = w.point;
-      blocked.blocking_part = w.part;
-      blocked.message = "port " + e->node + " faces a wall: its straight exit of length " + full_precision(len) +
-                        (hit.found() ? " comes" : " ends") + " within " + full_precision(w.distance) +
-                        " of part '" + (w.part >= 0 ? planning_parts_[w.part].name : std::string("?")) +
-                        "' (needs " + full_precision(required) + ")";
-    }
+    // The connector the port sits on may touch its exit over the excused run.
+    const PortExit exit{"port " + e->node, e->position, e == &ea ? x.a_stub : x.b_stub, e == &ea,
+                        e == &ea ? x.on_a : x.on_b, x.attach_slack};
+    check_port_exit(*plan_index_, part_boxes_, exit, required,
+                    [this](int part) { return planning_parts_[part].name; }, blocked);
   }
   return blocked;
 }
@@ -520,7 +428,7 @@ void RouteRun::plan_segment(int s) {
   PlanRequest req = plan_request(s, x);
   bool branch_blocked = false;
   const PlanResult blocked = blocked_end(x, branch_blocked);
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   PlanResult plan;
   if (!blocked.message.empty()) {
     plan = blocked;
@@ -530,7 +438,7 @@ void RouteRun::plan_segment(int s) {
   } else {
     plan = plan_with_retry(seg, req, info);
   }
-  rep_.timing.plan += ms_since(t0);
+  rep_.timing.plan += t0.ms();
   if (!plan.solved() && plan.blocking_part >= 0 && plan.blocking_part < static_cast<int>(planning_parts_.size()) &&
       plan.message.find("'" + planning_parts_[plan.blocking_part].name + "'") == std::string::npos)
     plan.message += " (part '" + planning_parts_[plan.blocking_part].name + "')";
@@ -617,9 +525,9 @@ void RouteRun::build_curve(int s) {
 
 /// Splines of every planned segment: bend-radius repair within half the clearance margin.
 void RouteRun::build_splines() {
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   for (auto& [s, g] : geom_) build_curve(s);
-  rep_.timing.spline = ms_since(t0);
+  rep_.timing.spline = t0.ms();
 }
 
 SegmentRouteInfo& RouteRun::info_of(int s) {
@@ -641,9 +549,9 @@ void RouteRun::replan_bend_failures() {
       req.seed = g.request.seed + 7919u * static_cast<unsigned>(attempt);
       req.time_limit = g.request.time_limit * std::pow(2.0, attempt);
       req.max_iterations = g.request.max_iterations << attempt;  // twice the budget, as the time
-      const auto t0 = Clock::now();
+      const Stopwatch t0;
       const PlanResult plan = plan_path(*plan_index_, req);
-      rep_.timing.plan += ms_since(t0);
+      rep_.timing.plan += t0.ms();
       // Whether the re-plan is kept depends on its result: a timed-out one makes the segment
       // irreproducible either way.
       info_of(s).time_limited = info_of(s).time_limited || plan.time_limited;
@@ -710,21 +618,21 @@ std::set<int> RouteRun::segments_to_repair() const {
 /// segment whose curve clashes or crowds and audit again. The exact index is built once: the
 /// planning index when planning used the exact parts.
 void RouteRun::audit_and_repair() {
-  auto t0 = Clock::now();
+  Stopwatch t0;
   if (plan_on_other_parts_) exact_owned_ = std::make_unique<EmbreeIndex>(scene_.parts);
   audit_options_.check.threads = opt_.threads;
   audit_options_.progress = opt_.progress;
   audit_options_.index = exact_owned_ ? exact_owned_.get() : plan_index_.get();
-  rep_.timing.index += ms_since(t0);
+  rep_.timing.index += t0.ms();
   routed_scene_.name = scene_.name;
   routed_scene_.units = scene_.units;
   routed_scene_.routing = scene_.routing;
   routed_scene_.has_harness = true;
   routed_scene_.parts = scene_.parts;
-  t0 = Clock::now();
+  t0.restart();
   rep_.audit = audit_now();
-  rep_.timing.audit = ms_since(t0);
-  t0 = Clock::now();
+  rep_.timing.audit = t0.ms();
+  t0.restart();
   for (int round = 0; round < opt_.max_repair_rounds; ++round) {
     const std::set<int> bad = segments_to_repair();
     if (bad.empty()) break;
@@ -736,7 +644,7 @@ void RouteRun::audit_and_repair() {
     }
     rep_.audit = audit_now();
   }
-  rep_.timing.repair = ms_since(t0);
+  rep_.timing.repair = t0.ms();
   for (const auto& f : failed_segments_) rep_.notes.push_back("segment " + f + " could not be routed");
 }
 
