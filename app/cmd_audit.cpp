@@ -8,9 +8,10 @@
 #include "core/error.hpp"
 #include "core/io/atomic_file.hpp"
 #include "core/io/output_set.hpp"
-#include "core/progress.hpp"
+#include "app/progress_bar.hpp"
 #include "routing/audit/audit.hpp"
 #include "routing/view/render.hpp"
+#include "core/io/json_text.hpp"
 #include "routing/audit/report_json.hpp"
 #include "routing/view/view_html.hpp"
 

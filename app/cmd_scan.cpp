@@ -13,7 +13,7 @@
 #include "core/io/mesh_write.hpp"
 #include "routing/curve/cable_geometry.hpp"
 #include "routing/scan/point_cloud_io.hpp"
-#include "routing/audit/report_json.hpp"
+#include "core/io/json_text.hpp"
 #include "routing/scan/scan_centerline.hpp"
 #include "routing/curve/sweep.hpp"
 

@@ -9,9 +9,9 @@
 #include "core/io/file_stems.hpp"
 #include "core/io/mesh_write.hpp"
 #include "core/io/scene_load.hpp"
-#include "core/progress.hpp"
+#include "app/progress_bar.hpp"
 #include "index/simplify/alpha_sim.hpp"
-#include "routing/audit/report_json.hpp"
+#include "core/io/json_text.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
