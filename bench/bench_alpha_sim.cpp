@@ -369,31 +369,15 @@ void throughput(const fs::path& out_dir, const std::vector<Set>& sets) {
   for (const Set& set : sets)
     for (const auto& p : set.parts) all_tris += p.mesh.triangle_count();
   std::ofstream tp_csv(out_dir / "alpha_sim_throughput.csv");
-  tp_csv << "threads,triangles,seconds,triangles_per_second,measure,cpu_seconds,triangles_per_cpu_second,"
-            "absorb_box_prisms,occt_booleans,edge_on_segments,exact_containment,coarse_interior,runs,median_seconds\n";
-  // Without the measures: as loom runs; then as in the twenty-fourth session (random
-  // containment samples and verification rounds, the whole lattice at L_max); then also
-  // with the samples of triangles seen edge-on tested (the twenty-third session's path);
-  // then also with the general Booleans on OpenCASCADE (the twenty-second's); then with
-  // every OpenCASCADE Boolean run (no prism absorbed: the solids before it) — the
-  // baselines in the same process; last, as loom runs with the mesh verification.
+  tp_csv << "threads,triangles,seconds,triangles_per_second,measure,cpu_seconds,triangles_per_cpu_second,runs,"
+            "median_seconds\n";
+  // Without the mesh verification, then with it, as loom runs.
   // LOOM_TP_ONE=1 runs the first only (for profiling).
   struct Config {
-    bool measure, absorb, occt, edge_on, exact, coarse;
+    bool measure;
     const char* what;
   };
-  const Config configs[] = {
-      {false, true, false, true, true, true, "without mesh verification"},
-      {false, true, false, true, false, false, "without mesh verification, random containment samples, fine lattice"},
-      {false, true, false, false, false, false,
-       "without mesh verification, random containment samples, fine lattice, edge-on triangles sampled"},
-      {false, true, true, false, false, false,
-       "without mesh verification, random containment samples, fine lattice, OpenCASCADE Booleans, edge-on "
-       "triangles sampled"},
-      {false, false, true, false, false, false,
-       "without mesh verification, random containment samples, fine lattice, every OpenCASCADE Boolean run, "
-       "edge-on triangles sampled"},
-      {true, true, false, true, true, true, "with verification"}};
+  const Config configs[] = {{false, "without mesh verification"}, {true, "with verification"}};
   const std::size_t n_configs = std::getenv("LOOM_TP_ONE") ? 1 : std::size(configs);
   for (std::size_t c = 0; c < n_configs; ++c)
     for (int threads : {1, 2}) {
@@ -406,18 +390,13 @@ void throughput(const fs::path& out_dir, const std::vector<Set>& sets) {
           AlphaSimOptions o;
           o.dim_pre = sets[s].dim_pre;
           o.measure = cf.measure;
-          o.absorb_box_prisms = cf.absorb;
-          o.occt_booleans = cf.occt;
-          o.edge_on_segments = cf.edge_on;
-          o.exact_containment = cf.exact;
-          o.coarse_interior = cf.coarse;
           std::vector<AlphaSimResult> res;
           simplify_parts(sets[s].parts, o, &res);
         });
       });
       const double sec = f.sec, cpu = f.cpu, median = f.median;
       tp_csv << threads << "," << all_tris << "," << sec << "," << all_tris / sec << "," << int(cf.measure) << ","
-             << cpu << "," << all_tris / cpu << "," << int(cf.absorb) << "," << int(cf.occt) << "," << int(cf.edge_on) << "," << int(cf.exact) << "," << int(cf.coarse) << "," << kThroughputRuns << "," << median << "\n";
+             << cpu << "," << all_tris / cpu << "," << kThroughputRuns << "," << median << "\n";
       std::printf("throughput (%s): %d thread(s): %zu triangles in %.3f s = %.3g triangles/s (CPU %.2f s = %.3g "
                   "triangles per CPU second; fastest of %d, median %.3f s = %.3g/s)\n",
                   cf.what, threads, all_tris, sec, all_tris / sec, cpu, all_tris / cpu, kThroughputRuns, median, all_tris / median);
