@@ -1315,41 +1315,89 @@ AlphaSimPlaneSamples alpha_sim_plane_samples(const Mesh& mesh, const AlphaSimPri
 
 // ---------------------------------------------------------------------------------------
 
-AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const std::string& step_stem) {
+namespace {
+
+/// One run of simplify_part: the part, the options and what the stages share. Each stage
+/// returns false when it has settled the result early (original kept, or nothing more to
+/// do); run() calls them in order.
+struct PartSimplification {
+  PartSimplification(const Part& part_in, const AlphaSimOptions& opt_in, const std::string& stem);
+  /// Runs the stages and returns the simplified part with its report.
+  AlphaSimPart run();
+  /// Empty and non-finite input, sheets, and sampling that would not fit in memory.
+  bool check_input();
+  /// α-SIM steps 1–3: samples, α-shape and exact containment repair of each projection.
+  bool build_shapes();
+  /// Step 4: the boundary polygons to extrude, simplified within the tolerance.
+  void outline_polygons();
+  /// Steps 5–6: the prisms intersected and meshed (CGAL, else OpenCASCADE).
+  bool build_mesh();
+  /// Containment of the original in the mesh and the implicit solid, Hausdorff distance,
+  /// lost space.
+  bool measure();
+  /// The STEP file, when asked for.
+  void write_step();
+
+  const Part& part;
+  const AlphaSimOptions& opt;
+  const std::string& step_stem;
   const Stopwatch t0;
+  std::vector<PlaneSpec> specs;
+  AlphaSimPart out;
+  AlphaSimResult& r = out.result;
+  std::vector<MeshEdge> edges;
+  AABB box;
+  double rounding_reserve = 0.0;
+  double tol = 0.0;  ///< the containment tolerance less the float32 rounding reserve
+  std::vector<std::vector<Vec2>> projected;  ///< the vertices in each plane
+  std::vector<AlphaSimPrism> prisms;
+  std::vector<std::shared_ptr<AlphaShape2D>> shapes;
+  std::shared_ptr<AlphaSimSolid> solid;
+  std::vector<std::vector<PolygonWithHoles2>> polys;
+  TopoDS_Shape result;  ///< OpenCASCADE's solid, when it ran the Booleans
+};
+
+PartSimplification::PartSimplification(const Part& part_in, const AlphaSimOptions& opt_in, const std::string& stem)
+    : part(part_in), opt(opt_in), step_stem(stem) {
   if (!(std::isfinite(opt.dim_pre) && opt.dim_pre > 0.0))
     throw std::invalid_argument("alpha-sim: dim_pre must be finite and > 0, got " + full_precision(opt.dim_pre));
   if (!(opt.sampling_factor > 0.0 && opt.alpha_factor > 0.0))
     throw std::invalid_argument("alpha-sim: sampling_factor and alpha_factor must be > 0");
-  const auto specs = planes_for(opt);
+  specs = planes_for(opt);
 
-  AlphaSimPart out;
-  AlphaSimResult& r = out.result;
   r.name = part.name;
   r.dim_pre = opt.dim_pre;
   r.alpha = opt.alpha_factor * opt.dim_pre;
   r.l_max = opt.sampling_factor * opt.dim_pre;
   r.triangles_before = part.mesh.triangle_count();
   r.faces_before = part.source_faces;
-  const auto edges = unique_edges(part.mesh);
+  edges = unique_edges(part.mesh);
   r.closed_before = closed_mesh(part.mesh, edges);
   r.volume_before = r.closed_before ? std::abs(part.mesh.signed_volume()) : 0.0;
-  const AABB box = part.mesh.bounds();
+  box = part.mesh.bounds();
   const double size = opt.scene_size > 0.0 ? opt.scene_size : box.diagonal();
   r.tolerance = opt.containment_tolerance_factor * (size > 0.0 ? size : 1.0);
   // Rounding the output mesh to float32 (float32_vertices) may move its vertices by
   // rounding_reserve (checked once it is made): the shapes are built and checked within the
   // rest of the tolerance, tol.
-  const double rounding_reserve = float_rounding_reserve(box, opt, r.tolerance);
-  const double tol = r.tolerance - rounding_reserve;
-  auto finish = [&]() {
-    r.time_ms = t0.ms();
-    return std::move(out);
-  };
+  rounding_reserve = float_rounding_reserve(box, opt, r.tolerance);
+  tol = r.tolerance - rounding_reserve;
+}
 
+AlphaSimPart PartSimplification::run() {
+  if (check_input() && build_shapes()) {
+    outline_polygons();
+    r.shapes_ms = t0.ms();
+    if (opt.build_mesh && build_mesh() && measure()) write_step();
+  }
+  r.time_ms = t0.ms();
+  return std::move(out);
+}
+
+bool PartSimplification::check_input() {
   if (part.mesh.empty()) {
     keep_original(out, part, AlphaSimStatus::EmptyInput, "the part has no triangles");
-    return finish();
+    return false;
   }
   if (first_non_finite_vertex(part.mesh) >= 0)
     throw std::invalid_argument("alpha-sim: part '" + part.name + "' has a non-finite vertex");
@@ -1377,11 +1425,11 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
                               " (the part is smaller than the cable scale, nothing to simplify): original kept"
                         : "extent along the " + plane + " normal is " + full_precision(*thinnest) + " < " +
                               full_precision(thin) + " (a sheet): original kept");
-    return finish();
+    return false;
   }
 
   // The sample count is known before sampling: refuse what would not fit in memory.
-  std::vector<std::vector<Vec2>> projected(specs.size());  // the vertices in each plane
+  projected.assign(specs.size(), {});  // the vertices in each plane
   {
     std::vector<double> per_plane(specs.size());
     tbb::parallel_for(std::size_t(0), specs.size(), [&](std::size_t k) {
@@ -1396,13 +1444,16 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
                     "sampling at L_max = " + full_precision(r.l_max) + " needs about " +
                         full_precision(std::round(estimate)) + " points in a plane > " +
                         std::to_string(opt.max_cloud_points) + ": original kept (raise dim_pre)");
-      return finish();
+      return false;
     }
   }
+  return true;
+}
 
+bool PartSimplification::build_shapes() {
   // 1–2. Sample each projection (L_max), 3. build its α-shape (planes in parallel).
-  std::vector<AlphaSimPrism> prisms(specs.size());
-  std::vector<std::shared_ptr<AlphaShape2D>> shapes(specs.size());
+  prisms.assign(specs.size(), AlphaSimPrism{});
+  shapes.assign(specs.size(), nullptr);
   r.projections.resize(specs.size());
   std::atomic<bool> degenerate{false};
   std::vector<AlphaSimPlaneSamples> plane_samples(specs.size());
@@ -1457,7 +1508,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   for (const auto& rep : r.projections) r.sample_points += rep.points;
   if (degenerate) {
     keep_original(out, part, AlphaSimStatus::Thin, "a projection is degenerate (collinear points): original kept");
-    return finish();
+    return false;
   }
 
   plane_samples.clear();
@@ -1468,7 +1519,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     rep.area = shapes[k]->area();
     hull = hull || is_hull(rep.status);
   }
-  auto solid = std::make_shared<AlphaSimSolid>(prisms);
+  solid = std::make_shared<AlphaSimSolid>(prisms);
   out.solid = solid;
   if (hull) {
     r.status = AlphaSimStatus::HullFallback;
@@ -1479,7 +1530,10 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
         planes += (planes.empty() ? "" : ", ") + rep.plane + " (" + projection_status_name(rep.status) + ")";
     r.reason = "convex hull used for " + planes;
   }
+  return true;
+}
 
+void PartSimplification::outline_polygons() {
   // 4. boundary polygons, merged collinear points (paper: included angle < 1e-6 deg).
   // Vertices within merge_tol (tol/4) of the chord replacing them are merged too: the
   // snapped projections of a straight edge are collinear only up to the snap grid. The
@@ -1492,7 +1546,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   auto merge = [&](std::vector<Vec2>& ring) {
     if (merge_collinear(ring, kCollinearAngle, merge_tol / 2.0) > 0) merge_collinear(ring, kCollinearAngle, merge_tol / 2.0);
   };
-  std::vector<std::vector<PolygonWithHoles2>> polys(specs.size());
+  polys.assign(specs.size(), {});
   for (std::size_t k = 0; k < specs.size(); ++k) {
     polys[k] = shapes[k]->polygons();
     auto& rep = r.projections[k];
@@ -1519,9 +1573,9 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     rep.polygon_vertices -=
         grow_simplify(polys[k], opt.polygon_growth_factor * opt.dim_pre, opt.merge_convex_corners);
   }
+}
 
-  r.shapes_ms = t0.ms();
-  if (!opt.build_mesh) return finish();
+bool PartSimplification::build_mesh() {
   const Stopwatch t_mesh;
 
   // 5–6. extrude and intersect, mesh the result. Each prism runs a margin past the part
@@ -1571,7 +1625,6 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       r.booleans_note = e.what();
     }
   }
-  TopoDS_Shape result;
   if (!watertight) {
     try {
       std::vector<TopoDS_Shape> solids(reduced.kept.size());
@@ -1586,11 +1639,11 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       keep_original(out, part, AlphaSimStatus::Failed,
                     std::string("OpenCASCADE failed: ") + (e.GetMessageString() ? e.GetMessageString() : "?") +
                         ": original kept");
-      return finish();
+      return false;
     } catch (const std::exception& e) {
       keep_original(out, part, AlphaSimStatus::Failed,
                     std::string("OpenCASCADE failed: ") + e.what() + ": original kept");
-      return finish();
+      return false;
     }
     watertight = watertight_mesh(out.mesh, otopo);
   }
@@ -1602,7 +1655,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
                   "rounding the simplified mesh to float32 (binary STL) moved a vertex by " +
                       full_precision(r.float_rounding) + " > the " + full_precision(rounding_reserve) +
                       " of the containment tolerance kept for it (the part lies far from the origin for its size): original kept");
-    return finish();
+    return false;
   }
   r.closed_after = watertight;
   r.triangles_after = out.mesh.triangle_count();
@@ -1612,9 +1665,12 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
                   "the OpenCASCADE result mesh is not closed (" + std::to_string(otopo.boundary_edges) +
                       " boundary, " + std::to_string(otopo.nonmanifold_edges) + " non-manifold, " +
                       std::to_string(otopo.misoriented_edges) + " misoriented edges): original kept");
-    return finish();
+    return false;
   }
+  return true;
+}
 
+bool PartSimplification::measure() {
   const Stopwatch t_measure;
   if (opt.measure) {
     // Containment of the original surface in the output mesh (what indices will use), on
@@ -1647,7 +1703,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
                         full_precision(in != samples.size() ? c : ci) + " of the surface samples: original kept");
       r.containment = c;  // report what was measured before falling back
       r.containment_implicit = ci;
-      return finish();
+      return false;
     }
     // One-sided Hausdorff distance: output surface → original surface.
     const EmbreeIndex original = mesh_index(part.mesh, r.closed_before);
@@ -1696,16 +1752,25 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
                           " outside the original fits inside the simplified part: a feature is hidden in every "
                           "projection (split the part); original kept");
         r.lost_space_radius = lost;
-        return finish();
+        return false;
       }
     }
   }
 
   r.measure_ms = t_measure.ms();
+  return true;
+}
+
+void PartSimplification::write_step() {
   if (!opt.step_dir.empty())
     write_step_atomic(result,
                       opt.step_dir / ((step_stem.empty() ? output_file_stems({part.name})[0] : step_stem) + ".step"));
-  return finish();
+}
+
+}  // namespace
+
+AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const std::string& step_stem) {
+  return PartSimplification(part, opt, step_stem).run();
 }
 
 std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimOptions& opt,
