@@ -491,15 +491,6 @@ RunOutcome run_planner(TubeContext& ctx, const ob::PlannerPtr& planner, bool opt
   return out;
 }
 
-/// Removes consecutive points closer than tol.
-std::vector<Vec3> dedupe(const std::vector<Vec3>& pts, double tol) {
-  std::vector<Vec3> out;
-  for (const auto& p : pts)
-    if (out.empty() || (p - out.back()).norm() > tol) out.push_back(p);
-  if (out.size() == 1 && pts.size() > 1) out.push_back(pts.back());
-  return out;
-}
-
 /// OMPL shortcutting with our objective, then greedy reduction to key points: from each
 /// kept point, jump to the farthest later point whose straight capsule is clear and no
 /// costlier than the stretch it replaces.
@@ -530,7 +521,7 @@ std::vector<Vec3> simplify_to_key_points(const ObstacleIndex& index, TubeContext
     pts.front() = raw.front();
     pts.back() = raw.back();
   }
-  pts = dedupe(pts, kDuplicateRel * ctx.required);
+  pts = dedupe_consecutive(pts, kDuplicateRel * ctx.required);
   if (pts.size() <= 2) return pts;
 
   // Prefix costs of the stretch (our objective).
@@ -720,7 +711,7 @@ void plan_between_stubs(const ObstacleIndex& index, TubeContext& ctx, const ob::
   key.push_back(start.position);
   key.insert(key.end(), interior.begin(), interior.end());
   key.push_back(goal.position);
-  key = dedupe(key, kDuplicateRel * ctx.required);
+  key = dedupe_consecutive(key, kDuplicateRel * ctx.required);
   if (!verify_polyline(index, ctx, settings.radius, key, r)) {
     r.reason = NoPathReason::InvalidSolution;
     r.message = "the planner's path failed the exact capsule re-check near " +
@@ -736,6 +727,14 @@ void plan_between_stubs(const ObstacleIndex& index, TubeContext& ctx, const ob::
 }  // namespace
 
 // --- public API -------------------------------------------------------------------------
+
+std::vector<Vec3> dedupe_consecutive(const std::vector<Vec3>& pts, double tol) {
+  std::vector<Vec3> out;
+  for (const auto& p : pts)
+    if (out.empty() || (p - out.back()).norm() > tol) out.push_back(p);
+  if (out.size() == 1 && pts.size() > 1) out.push_back(pts.back());
+  return out;
+}
 
 const char* preference_name(PartPreference p) {
   switch (p) {

@@ -48,15 +48,6 @@ struct SegmentGeometry {
 };
 
 
-/// Removes consecutive points closer than `eps`.
-std::vector<Vec3> dedupe(const std::vector<Vec3>& pts, double eps) {
-  std::vector<Vec3> out;
-  for (const auto& p : pts)
-    if (out.empty() || (p - out.back()).norm() > eps) out.push_back(p);
-  if (out.size() == 1 && pts.size() > 1) out.push_back(pts.back());
-  return out;
-}
-
 /// The key-point polyline of a segment: node, stub end, the planner's interior key points,
 /// stub end, node; coincident points removed.
 std::vector<Vec3> assemble(const SegmentGeometry& g, const std::vector<Vec3>& key_points, double eps) {
@@ -64,7 +55,7 @@ std::vector<Vec3> assemble(const SegmentGeometry& g, const std::vector<Vec3>& ke
   pts.insert(pts.end(), key_points.begin(), key_points.end());
   pts.push_back(g.b_stub);
   pts.push_back(g.b);
-  return dedupe(pts, eps);
+  return dedupe_consecutive(pts, eps);
 }
 
 /// Inserts the midpoint of every polyline edge but the two end stubs: the interpolating
