@@ -129,7 +129,7 @@ int run_audit_command(const AuditFlags& f) {
   const AuditReport rep = audit_scene_file(f.scene, opt, &scene);
   const std::filesystem::path report_path = std::filesystem::path(f.out) / "report.json";
   const nlohmann::json report = audit_report_json(rep);
-  write_view_outputs(outputs.staging(), scene, scene.harness, report, render);  // view.html, render.png (issue 9)
+  write_view_outputs(outputs.staging(), scene, scene.harness, report, render);  // view.html, render.png
   write_audit_report(rep, outputs.staging() / "report.json");
   outputs.commit();
   if (f.json)

@@ -1,5 +1,5 @@
 // `loom scan CLOUD [--diameter D] [--out DIR] [--method axis|graph] [--compare routed.xml
-// --cable ID] [--quiet]`: centerline of a scanned cable (DESIGN §4, issue 8) →
+// --cable ID] [--quiet]`: centerline of a scanned cable (DESIGN §4) →
 // DIR/centerline.xml (a harness with one routed segment), DIR/tube.ply, DIR/report.json.
 #include "app/commands.hpp"
 #include "app/option_checks.hpp"

@@ -1,4 +1,4 @@
-// `loom simplify SCENE [--dim-pre X] [--out DIR] [--quiet]`: α-SIM per part (issue 4).
+// `loom simplify SCENE [--dim-pre X] [--out DIR] [--quiet]`: α-SIM per part.
 // Writes DIR/<part>.stl and DIR/simplify.json (DESIGN §4 fields, plus status and reason).
 #include "app/commands.hpp"
 #include "app/option_checks.hpp"

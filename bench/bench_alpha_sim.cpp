@@ -1,4 +1,4 @@
-// α-SIM benchmark (issue 4). Scenario program, fixed seeds, baselines in the same run:
+// α-SIM benchmark. Scenario program, fixed seeds, baselines in the same run:
 //  1. the bundled wing-section scene and the real meshes at dim_pre = the scene's value
 //     (smallest cable diameter) / a fixed fraction of each part's size: triangle ratio,
 //     Hausdorff distance, containment, time;

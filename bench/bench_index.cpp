@@ -1,4 +1,4 @@
-// Obstacle-index benchmarks (issue 3, DESIGN §8): Embree BVH build rate and memory per
+// Obstacle-index benchmarks (DESIGN §8): Embree BVH build rate and memory per
 // triangle from 10k to 5M triangles (generated scenes + the shared motor.stl), closest-point
 // queries/s on 1 and 2 threads for points within 10 cable radii of a 1M-triangle scene
 // against the brute-force and FCL baselines in the same run, voxelisation time, distance

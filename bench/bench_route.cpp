@@ -1,4 +1,4 @@
-// End-to-end routing benchmark (issue 7): the bundled wing-section harness routed by every
+// End-to-end routing benchmark: the bundled wing-section harness routed by every
 // planner at a ladder of time budgets, on the exact parts and on α-simplified parts
 // (simplified once, in the same process), against long runs at 20× the scene's budget as
 // the quality reference. For each run: cables routed, total cable length / best known

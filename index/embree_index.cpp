@@ -135,7 +135,7 @@ bool point_query_callback(RTCPointQueryFunctionArguments* args) {
   // An approximate segment query skips what cannot beat best / (1 + rel_error) once it has
   // a best (before, best2 is the caller's radius, whose answer must stay exact). Point
   // queries do not: Embree culls their leaves by the shrunk sphere and the few triangles of
-  // a leaf beyond it cost nothing measurable (DESIGN-NOTES, eighteenth session).
+  // a leaf beyond it cost nothing measurable (DESIGN-NOTES).
   if (q->mode == Mode::Segment && q->hit.part >= 0) limit2 *= q->shrink * q->shrink;
   const Vec3 lo = c[0].cwiseMin(c[1]).cwiseMin(c[2]), hi = c[0].cwiseMax(c[1]).cwiseMax(c[2]);
   double d2;

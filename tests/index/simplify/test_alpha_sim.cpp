@@ -1,4 +1,4 @@
-// α-SIM (issue 4): the 2D α-shape, the simplified solid and its failure modes, checked
+// α-SIM: the 2D α-shape, the simplified solid and its failure modes, checked
 // against closed forms (plates, L-bracket, cylinder), an independent containment oracle
 // (BruteForceIndex winding numbers) and real meshes from ../shared/data.
 #include "core/io/mesh_read.hpp"
