@@ -1,6 +1,7 @@
 // The command line's ProgressBar: drawing, throttling and thread-safety, also behind a
 // ProgressCounter fed from many threads. Time is an injected clock; nothing asserts on real time.
 #include "app/progress_bar.hpp"
+#include "common/progress_recorder.hpp"
 
 #include <gtest/gtest.h>
 
@@ -149,26 +150,11 @@ TEST(ProgressBar, NewStageEndsTheRunningLineAndRepeatsAreIgnored) {
   EXPECT_EQ(s.back(), '\n');
 }
 
-/// Records a counter's events and checks they are never delivered concurrently.
-struct Recorder {
-  std::atomic<int> inside{0};
-  std::atomic<bool> overlapped{false};
-  std::vector<ProgressEvent> events;  // written only inside the (exclusive) callback
-  ProgressFn fn() {
-    return [this](const ProgressEvent& e) {
-      if (inside.fetch_add(1) != 0) overlapped = true;
-      events.push_back(e);
-      std::this_thread::yield();  // widen the window an overlap would need
-      inside.fetch_sub(1);
-    };
-  }
-};
-
 TEST(ProgressCounter, ConcurrentReportsAreSerialisedAndIncreasing) {
   constexpr int kThreads = 8;
   constexpr std::size_t kPerThread = 5000;
   constexpr std::size_t kTotal = kThreads * kPerThread;
-  Recorder rec;
+  ProgressRecorder rec;
   TempFile tf;
   ManualClock clock;
   ProgressBar::Options o = forced(clock);

@@ -1,6 +1,7 @@
 // ProgressCounter's event sequence: starts at 0, completes only on finish(), never
 // decreases.
 #include "core/progress.hpp"
+#include "common/progress_recorder.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,23 +13,8 @@
 namespace loom {
 namespace {
 
-/// Records a counter's events and checks they are never delivered concurrently.
-struct Recorder {
-  std::atomic<int> inside{0};
-  std::atomic<bool> overlapped{false};
-  std::vector<ProgressEvent> events;  // written only inside the (exclusive) callback
-  ProgressFn fn() {
-    return [this](const ProgressEvent& e) {
-      if (inside.fetch_add(1) != 0) overlapped = true;
-      events.push_back(e);
-      std::this_thread::yield();  // widen the window an overlap would need
-      inside.fetch_sub(1);
-    };
-  }
-};
-
 TEST(ProgressCounter, SequenceStartsAtZeroAndCompletesOnlyOnFinish) {
-  Recorder rec;
+  ProgressRecorder rec;
   {
     ProgressCounter c(rec.fn(), "simplify", 3, "parts");
     for (int i = 0; i < 5; ++i) c.add();  // more adds than items: still not "complete"
@@ -44,7 +30,7 @@ TEST(ProgressCounter, SequenceStartsAtZeroAndCompletesOnlyOnFinish) {
   EXPECT_EQ(rec.events.back().total, 3u);
   EXPECT_EQ(std::count_if(rec.events.begin(), rec.events.end(), [](const ProgressEvent& e) { return e.done == 3; }), 1);
 
-  Recorder empty;
+  ProgressRecorder empty;
   {
     ProgressCounter c(empty.fn(), "audit", 0, "cables");
     c.finish();
