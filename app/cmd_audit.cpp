@@ -8,9 +8,10 @@
 #include "core/error.hpp"
 #include "core/io/atomic_file.hpp"
 #include "core/io/output_set.hpp"
-#include "core/progress.hpp"
+#include "app/progress_bar.hpp"
 #include "routing/audit/audit.hpp"
 #include "routing/view/render.hpp"
+#include "core/io/json_text.hpp"
 #include "routing/audit/report_json.hpp"
 #include "routing/view/view_html.hpp"
 
@@ -128,7 +129,7 @@ int run_audit_command(const AuditFlags& f) {
   const AuditReport rep = audit_scene_file(f.scene, opt, &scene);
   const std::filesystem::path report_path = std::filesystem::path(f.out) / "report.json";
   const nlohmann::json report = audit_report_json(rep);
-  write_view_outputs(outputs.staging(), scene, scene.harness, report, render);  // view.html, render.png (issue 9)
+  write_view_outputs(outputs.staging(), scene, scene.harness, report, render);  // view.html, render.png
   write_audit_report(rep, outputs.staging() / "report.json");
   outputs.commit();
   if (f.json)

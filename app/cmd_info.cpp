@@ -3,8 +3,8 @@
 
 #include "core/harness_topology.hpp"
 #include "core/io/scene_load.hpp"
-#include "core/progress.hpp"
-#include "routing/audit/report_json.hpp"
+#include "app/progress_bar.hpp"
+#include "core/io/json_text.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>

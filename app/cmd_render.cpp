@@ -6,7 +6,7 @@
 #include "core/error.hpp"
 #include "core/io/atomic_file.hpp"
 #include "core/io/scene_load.hpp"
-#include "core/progress.hpp"
+#include "app/progress_bar.hpp"
 #include "core/units.hpp"
 #include "routing/audit/audit.hpp"
 #include "routing/view/render.hpp"

@@ -9,9 +9,9 @@
 #include "core/io/output_set.hpp"
 #include "core/io/scene_load.hpp"
 #include "core/scene.hpp"
-#include "core/progress.hpp"
+#include "app/progress_bar.hpp"
 #include "routing/view/render.hpp"
-#include "routing/audit/report_json.hpp"
+#include "core/io/json_text.hpp"
 #include "routing/route/route_report.hpp"
 #include "routing/view/view_html.hpp"
 

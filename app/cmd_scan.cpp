@@ -1,9 +1,10 @@
 // `loom scan CLOUD [--diameter D] [--out DIR] [--method axis|graph] [--compare routed.xml
-// --cable ID] [--quiet]`: centerline of a scanned cable (DESIGN §4, issue 8) →
+// --cable ID] [--quiet]`: centerline of a scanned cable (DESIGN §4) →
 // DIR/centerline.xml (a harness with one routed segment), DIR/tube.ply, DIR/report.json.
 #include "app/commands.hpp"
 #include "app/option_checks.hpp"
 
+#include "core/stopwatch.hpp"
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
 #include "core/io/atomic_file.hpp"
@@ -12,14 +13,13 @@
 #include "core/io/mesh_write.hpp"
 #include "routing/curve/cable_geometry.hpp"
 #include "routing/scan/point_cloud_io.hpp"
-#include "routing/audit/report_json.hpp"
+#include "core/io/json_text.hpp"
 #include "routing/scan/scan_centerline.hpp"
 #include "routing/curve/sweep.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -136,7 +136,7 @@ int run_scan(const ScanCommandOptions& o) {
                               report_file = out / "report.json";
   OutputSet outputs(out, {centerline_file, tube_file, report_file});  // checked now, replaced together
   using nlohmann::json;
-  const auto t_start = std::chrono::steady_clock::now();
+  const Stopwatch t_start;
   const PointCloud pc = read_point_cloud(o.cloud);
   ScanOptions so;
   if (o.diameter > 0.0) so.diameter = o.diameter;
@@ -226,7 +226,7 @@ int run_scan(const ScanCommandOptions& o) {
                     {"fitting", r.timing.fitting_ms},
                     {"spline", r.timing.spline_ms},
                     {"extract", r.timing.total_ms},
-                    {"total", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count()}};
+                    {"total", t_start.ms()}};
 
   const std::string report_text = json_text(j, 2) + "\n";
   const std::string centerline_text = harness_to_xml(h);

@@ -1,21 +1,21 @@
-// `loom simplify SCENE [--dim-pre X] [--out DIR] [--quiet]`: α-SIM per part (issue 4).
+// `loom simplify SCENE [--dim-pre X] [--out DIR] [--quiet]`: α-SIM per part.
 // Writes DIR/<part>.stl and DIR/simplify.json (DESIGN §4 fields, plus status and reason).
 #include "app/commands.hpp"
 #include "app/option_checks.hpp"
 
+#include "core/stopwatch.hpp"
 #include "core/io/atomic_file.hpp"
 #include "core/io/output_set.hpp"
 #include "core/io/file_stems.hpp"
 #include "core/io/mesh_write.hpp"
 #include "core/io/scene_load.hpp"
-#include "core/progress.hpp"
+#include "app/progress_bar.hpp"
 #include "index/simplify/alpha_sim.hpp"
-#include "routing/audit/report_json.hpp"
+#include "core/io/json_text.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -71,7 +71,7 @@ int run_simplify(const SimplifyCommandOptions& o) {
                  scene.parts.size(), dim_pre, unit_name(scene.units),
                  given ? "--dim-pre" : scene.simplify.dim_pre.source.c_str(), opt.alpha_factor * dim_pre,
                  opt.sampling_factor * dim_pre, tolerance, unit_name(scene.units));
-  const auto t_start = std::chrono::steady_clock::now();
+  const Stopwatch t_start;
   std::vector<AlphaSimResult> results;
   const std::vector<Part> simple = simplify_parts(scene.parts, opt, &results);
 
@@ -151,7 +151,7 @@ int run_simplify(const SimplifyCommandOptions& o) {
   if (!o.quiet)
     std::fprintf(stderr, "loom simplify: %zu -> %zu triangles (%.1f%%) in %.2f s; wrote %s\n", before, after,
                  before > 0 ? 100.0 * after / before : 0.0,
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count(),
+                 t_start.seconds(),
                  (out_dir / "simplify.json").string().c_str());
   return 0;
 }

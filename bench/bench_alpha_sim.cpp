@@ -17,6 +17,7 @@
 // alpha_sim_tessellation.csv, alpha_sim_planner_queries.csv, alpha_sim.png,
 // alpha_sim_tessellation.png.
 #include "bench/forwarding_index.hpp"
+#include "core/stopwatch.hpp"
 #include "core/io/mesh_read.hpp"
 #include "core/io/scene_load.hpp"
 #include "core/units.hpp"
@@ -28,7 +29,6 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <algorithm>
@@ -44,11 +44,9 @@
 
 using namespace loom;
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 namespace {
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 /// CPU time (user + system) of the process so far, all threads (s): comparable on a busy
 /// machine, unlike wall time.
@@ -71,10 +69,10 @@ Fastest fastest_of(int runs, F&& f) {
   Fastest out;
   std::vector<double> walls;
   for (int run = 0; run < runs; ++run) {
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     const double cpu0 = cpu_seconds();
     f();
-    const double wall = seconds_since(t0), cpu = cpu_seconds() - cpu0;
+    const double wall = t0.seconds(), cpu = cpu_seconds() - cpu0;
     walls.push_back(wall);
     if (wall < out.sec) {
       out.sec = wall;
@@ -121,12 +119,12 @@ double rate(const ObstacleIndex& idx, const std::vector<Vec3>& pts, double radiu
   double best = 0.0;
   for (int rep = 0; rep < 3; ++rep) {
     double sum = 0.0;
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     for (const Vec3& p : ordered) {
       const ClosestHit h = idx.closest(p, radius);
       sum += h.found() ? h.distance : 0.0;
     }
-    const double s = seconds_since(t0);
+    const double s = t0.seconds();
     volatile double sink = sum;
     (void)sink;
     best = std::max(best, static_cast<double>(pts.size()) / s);
@@ -282,7 +280,7 @@ double replay_ns(const ObstacleIndex& idx, const std::vector<LoggedQuery>& qs) {
   double best = std::numeric_limits<double>::infinity();
   for (int rep = 0; rep < 3; ++rep) {
     double sum = 0.0;
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     for (const LoggedQuery& q : qs) switch (q.kind) {
         case LoggedQuery::kAnyWithin: sum += idx.any_within(q.a, q.r) ? 1.0 : 0.0; break;
         case LoggedQuery::kInside: sum += idx.inside(q.a) ? 1.0 : 0.0; break;
@@ -294,7 +292,7 @@ double replay_ns(const ObstacleIndex& idx, const std::vector<LoggedQuery>& qs) {
         case LoggedQuery::kSegmentWithin: sum += idx.segment_within(q.a, q.b, q.r) ? 1.0 : 0.0; break;
         case LoggedQuery::kKinds: break;
       }
-    const double s = seconds_since(t0);
+    const double s = t0.seconds();
     volatile double sink = sum;
     (void)sink;
     best = std::min(best, 1e9 * s / static_cast<double>(qs.size()));
@@ -371,32 +369,15 @@ void throughput(const fs::path& out_dir, const std::vector<Set>& sets) {
   for (const Set& set : sets)
     for (const auto& p : set.parts) all_tris += p.mesh.triangle_count();
   std::ofstream tp_csv(out_dir / "alpha_sim_throughput.csv");
-  tp_csv << "threads,triangles,seconds,triangles_per_second,measure,cpu_seconds,triangles_per_cpu_second,"
-            "absorb_box_prisms,occt_booleans,edge_on_segments,exact_containment,coarse_interior,runs,median_seconds\n";
-  // Without the measures: as loom runs; then the ablations, each adding one slower path
-  // that AlphaSimOptions still offers — random containment samples and verification
-  // rounds with the whole lattice at L_max (exact_containment and coarse_interior off);
-  // also the samples of triangles seen edge-on tested (edge_on_segments off); also the
-  // general Booleans on OpenCASCADE (occt_booleans); also every prism through OpenCASCADE's
-  // Booleans (absorb_box_prisms off) — the baselines in the same process; last, as loom
-  // runs with the mesh verification.
+  tp_csv << "threads,triangles,seconds,triangles_per_second,measure,cpu_seconds,triangles_per_cpu_second,runs,"
+            "median_seconds\n";
+  // Without the mesh verification, then with it, as loom runs.
   // LOOM_TP_ONE=1 runs the first only (for profiling).
   struct Config {
-    bool measure, absorb, occt, edge_on, exact, coarse;
+    bool measure;
     const char* what;
   };
-  const Config configs[] = {
-      {false, true, false, true, true, true, "without mesh verification"},
-      {false, true, false, true, false, false, "without mesh verification, random containment samples, fine lattice"},
-      {false, true, false, false, false, false,
-       "without mesh verification, random containment samples, fine lattice, edge-on triangles sampled"},
-      {false, true, true, false, false, false,
-       "without mesh verification, random containment samples, fine lattice, OpenCASCADE Booleans, edge-on "
-       "triangles sampled"},
-      {false, false, true, false, false, false,
-       "without mesh verification, random containment samples, fine lattice, every OpenCASCADE Boolean run, "
-       "edge-on triangles sampled"},
-      {true, true, false, true, true, true, "with verification"}};
+  const Config configs[] = {{false, "without mesh verification"}, {true, "with verification"}};
   const std::size_t n_configs = std::getenv("LOOM_TP_ONE") ? 1 : std::size(configs);
   for (std::size_t c = 0; c < n_configs; ++c)
     for (int threads : {1, 2}) {
@@ -409,18 +390,13 @@ void throughput(const fs::path& out_dir, const std::vector<Set>& sets) {
           AlphaSimOptions o;
           o.dim_pre = sets[s].dim_pre;
           o.measure = cf.measure;
-          o.absorb_box_prisms = cf.absorb;
-          o.occt_booleans = cf.occt;
-          o.edge_on_segments = cf.edge_on;
-          o.exact_containment = cf.exact;
-          o.coarse_interior = cf.coarse;
           std::vector<AlphaSimResult> res;
           simplify_parts(sets[s].parts, o, &res);
         });
       });
       const double sec = f.sec, cpu = f.cpu, median = f.median;
       tp_csv << threads << "," << all_tris << "," << sec << "," << all_tris / sec << "," << int(cf.measure) << ","
-             << cpu << "," << all_tris / cpu << "," << int(cf.absorb) << "," << int(cf.occt) << "," << int(cf.edge_on) << "," << int(cf.exact) << "," << int(cf.coarse) << "," << kThroughputRuns << "," << median << "\n";
+             << cpu << "," << all_tris / cpu << "," << kThroughputRuns << "," << median << "\n";
       std::printf("throughput (%s): %d thread(s): %zu triangles in %.3f s = %.3g triangles/s (CPU %.2f s = %.3g "
                   "triangles per CPU second; fastest of %d, median %.3f s = %.3g/s)\n",
                   cf.what, threads, all_tris, sec, all_tris / sec, cpu, all_tris / cpu, kThroughputRuns, median, all_tris / median);
@@ -536,9 +512,9 @@ int main(int argc, char** argv) {
     opt.dim_pre = set.dim_pre;
     std::vector<AlphaSimResult> res;
     const double cpu0 = cpu_seconds();
-    const auto t_set = Clock::now();
+    const Stopwatch t_set;
     const auto simple = simplify_parts(set.parts, opt, &res);
-    const double set_cpu = cpu_seconds() - cpu0, set_wall = seconds_since(t_set);
+    const double set_cpu = cpu_seconds() - cpu0, set_wall = t_set.seconds();
     AABB box;
     for (const auto& p : set.parts) box.extend(p.mesh.bounds());
     const EmbreeIndex original_index(set.parts), simple_index(simple);

@@ -8,6 +8,7 @@
 // build. Modes: --build-only, --quality-only, --queries-only, --micro-only, and
 // --probe TRIS QUALITY (20k closest queries, for callgrind instruction counts).
 // Writes bench/results/index_*.csv and index_*.png (gnuplot). Fixed seeds throughout.
+#include "core/stopwatch.hpp"
 #include "core/io/atomic_file.hpp"
 #include "core/io/mesh_read.hpp"
 #include "index/brute_force_index.hpp"
@@ -21,7 +22,6 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
@@ -38,8 +38,6 @@ using namespace loom::testmesh;
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 /// Process CPU seconds (all threads): rates per CPU-second stay meaningful when other
 /// jobs share the two cores, wall-clock rates do not.
@@ -155,9 +153,9 @@ void build_scaling() {
     }
     double fcl_s = -1;
     if (n <= 1000000) {
-      const auto t = Clock::now();
+      const Stopwatch t;
       const FclIndex f(parts);
-      fcl_s = since(t);
+      fcl_s = t.seconds();
     }
     csv << label << "," << n << "," << best << "," << rate(n, best) / 1e6 << "," << best_cpu << ","
         << rate(n, best_cpu) / 1e6 << "," << static_cast<double>(bytes) / static_cast<double>(n) << "," << fcl_s << ","
@@ -227,9 +225,9 @@ void query_throughput() {
   const auto measure = [&](const std::string& index, const std::string& query, int threads, std::size_t n_q,
                            const auto& f) {
     const double c0 = cpu_now();
-    const auto t = Clock::now();
+    const Stopwatch t;
     f();
-    const double s = since(t), c = cpu_now() - c0;
+    const double s = t.seconds(), c = cpu_now() - c0;
     csv << index << "," << query << "," << threads << "," << n_q << "," << s << "," << rate(n_q, s) << "," << c << ","
         << rate(n_q, c) << "," << load_avg() << "\n";
     std::cout << index << " " << query << ", " << threads << " thread(s): " << rate(n_q, s) << " /s wall, "
@@ -344,9 +342,9 @@ void voxel_tradeoff() {
     vo.resolution = res;
     vo.max_distance = reach;
     vo.max_cells = std::size_t(400) << 20;
-    const auto t = Clock::now();
+    const Stopwatch t;
     const VoxelMap vm(parts, vo, exact);
-    const double build = since(t);
+    const double build = t.seconds();
     double max_err = 0, sum_err = 0;
     std::size_t counted = 0;
     for (std::size_t i = 0; i < pts.size(); ++i) {
@@ -363,14 +361,14 @@ void voxel_tradeoff() {
       std::vector<double> sink(pts.size());
       tbb::task_arena arena(threads);
       const double c0 = cpu_now();
-      const auto tq = Clock::now();
+      const Stopwatch tq;
       arena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pts.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
           for (int rep = 0; rep < kRepeats; ++rep)
             for (std::size_t i = r.begin(); i != r.end(); ++i) sink[i] += vm.distance(pts[i]);
         });
       });
-      lookups[threads - 1] = rate(pts.size() * kRepeats, since(tq));
+      lookups[threads - 1] = rate(pts.size() * kRepeats, tq.seconds());
       lookups_cpu[threads - 1] = rate(pts.size() * kRepeats, cpu_now() - c0);
       benchmark::DoNotOptimize(sink.data());
     }

@@ -7,12 +7,12 @@
 // route_<series>.dat, route.gp and route.png (gnuplot).
 //
 // Usage: bench_route [--quick] [--scene PATH]   (--quick: two planners, two budgets)
+#include "core/stopwatch.hpp"
 #include "core/io/scene_load.hpp"
 #include "index/simplify/alpha_sim.hpp"
 #include "routing/route/route_pipeline.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -92,9 +92,9 @@ int main(int argc, char** argv) {
   ao.dim_pre = scene.simplify.dim_pre.value;
   ao.detect_lost_space = true;
   std::vector<AlphaSimResult> sim_results;
-  const auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch t0;
   auto simplified = std::make_shared<const std::vector<Part>>(simplify_parts(scene.parts, ao, &sim_results));
-  const double simplify_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  const double simplify_ms = t0.ms();
   std::size_t tri_before = 0, tri_after = 0;
   for (const auto& r : sim_results) tri_before += r.triangles_before, tri_after += r.triangles_after;
   std::cout << "alpha-SIM (dim_pre " << ao.dim_pre << "): " << tri_before << " -> " << tri_after << " triangles in "

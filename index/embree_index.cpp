@@ -1,5 +1,6 @@
 #include "index/embree_index.hpp"
 
+#include "core/stopwatch.hpp"
 #include "core/error.hpp"
 #include "index/box_tree.hpp"
 #include "index/triangle_distance.hpp"
@@ -9,7 +10,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <exception>
 #include <stdexcept>
@@ -359,7 +359,7 @@ EmbreeIndex::EmbreeIndex(const std::vector<Part>& parts, const EmbreeOptions& op
   rtcSetDeviceErrorFunction(im.device, device_error, &im);
   rtcSetDeviceMemoryMonitorFunction(im.device, memory_monitor, &im.embree_bytes);
 
-  const auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch t0;
   FlushDenormals ftz;
   // Float re-centred vertices for Embree and the per-triangle degenerate flags, in parallel.
   tbb::parallel_for(std::size_t(0), parts_.size(), [&](std::size_t i) { prepare_part(parts_[i], centre_); });
@@ -387,7 +387,7 @@ EmbreeIndex::EmbreeIndex(const std::vector<Part>& parts, const EmbreeOptions& op
     im.geoms[i] = g;
   }
   rtcCommitScene(im.scene);
-  build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  build_seconds_ = t0.seconds();
   if (rtcGetDeviceError(im.device) != RTC_ERROR_NONE || !im.last_error.empty())
     throw std::runtime_error("embree index: build failed: " + im.last_error);
   im.part_scenes.assign(parts_.size(), nullptr);

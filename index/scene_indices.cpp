@@ -1,9 +1,9 @@
 #include "index/scene_indices.hpp"
 
+#include "core/stopwatch.hpp"
 #include "core/error.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -20,8 +20,6 @@ constexpr double kFallbackVoxelsPerDiagonal = 256.0;
 /// Factor by which the voxel edge grows while the grid exceeds its budget.
 constexpr double kCoarsenFactor = 1.25;
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 /// Cells of the dense distance grid for box `b` at edge `res` with `reach` margin.
 double grid_cells(const AABB& b, double res, double reach) {
@@ -46,16 +44,16 @@ SceneIndices SceneIndices::build(const Scene& scene, const SceneIndicesOptions& 
   for (const Part& p : scene.parts) box.extend(p.mesh.bounds());
   const bool want_voxel = opt.build_voxel && !box.empty();
   ProgressCounter built(opt.progress, "index", 1 + (opt.build_fcl ? 1 : 0) + (want_voxel ? 1 : 0), "indices");
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   out.embree = std::make_shared<EmbreeIndex>(scene.parts, opt.embree);
   built.add();
   out.log.push_back("embree: " + std::to_string(out.embree->triangle_count()) + " triangles in " +
-                    std::to_string(scene.parts.size()) + " parts, built in " + full_precision(seconds_since(t0)) +
+                    std::to_string(scene.parts.size()) + " parts, built in " + full_precision(t0.seconds()) +
                     " s; " + out.embree->accuracy().description);
   if (opt.build_fcl) {
-    const auto t1 = Clock::now();
+    const Stopwatch t1;
     out.fcl = std::make_shared<FclIndex>(scene.parts);
-    out.log.push_back("fcl: OBBRSS models built in " + full_precision(seconds_since(t1)) + " s; " +
+    out.log.push_back("fcl: OBBRSS models built in " + full_precision(t1.seconds()) + " s; " +
                       std::to_string(out.fcl->direct_triangle_count()) +
                       " degenerate/tiny triangles answered by the exact kernels");
     built.add();
@@ -99,10 +97,10 @@ SceneIndices SceneIndices::build(const Scene& scene, const SceneIndicesOptions& 
     vo.max_cells = opt.voxel_max_cells;
     vo.threads = opt.threads;
     try {
-      const auto t2 = Clock::now();
+      const Stopwatch t2;
       out.voxel = std::make_shared<VoxelMap>(scene.parts, vo, out.embree);
       out.log.push_back("voxel: resolution " + full_precision(res) + " (" + rule + "), reach " + full_precision(reach) +
-                        ", built in " + full_precision(seconds_since(t2)) + " s; " + out.voxel->accuracy().description);
+                        ", built in " + full_precision(t2.seconds()) + " s; " + out.voxel->accuracy().description);
     } catch (const InputError& e) {
       out.log.push_back(std::string("voxel: not built: ") + e.what());
     }

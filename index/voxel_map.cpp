@@ -1,5 +1,6 @@
 #include "index/voxel_map.hpp"
 
+#include "core/stopwatch.hpp"
 #include "core/error.hpp"
 #include "core/io/atomic_file.hpp"
 #include "index/embree_index.hpp"
@@ -12,7 +13,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <stdexcept>
@@ -34,8 +34,6 @@ constexpr double kLineOffsets[][2] = {{0.1234567, 0.0765432}, {-0.2113249, 0.159
 /// Relative size of a 2D edge function below which a scan line is said to touch an edge.
 constexpr double kEdgeTouchRel = 1e-10;
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 template <class Body>
 void parallel_range(std::size_t n, int threads, std::size_t grain, const Body& body) {
@@ -153,16 +151,16 @@ VoxelMap::VoxelMap(const std::vector<Part>& parts, const VoxelOptions& opt, std:
   for (const Part& p : parts) box.extend(p.mesh.bounds());
   init_grid(box, parts.empty() ? std::string() : parts.front().source_file);
   if (!exact_) exact_ = std::make_shared<EmbreeIndex>(parts);
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   voxelise(parts);
   fill_tree();
-  stats_.voxelise_seconds = seconds_since(t0);
-  const auto t1 = Clock::now();
+  stats_.voxelise_seconds = t0.seconds();
+  const Stopwatch t1;
   run_edt();
-  stats_.edt_seconds = seconds_since(t1);
-  const auto t2 = Clock::now();
+  stats_.edt_seconds = t1.seconds();
+  const Stopwatch t2;
   refine();
-  stats_.refine_seconds = seconds_since(t2);
+  stats_.refine_seconds = t2.seconds();
 }
 
 void VoxelMap::voxelise(const std::vector<Part>& parts) {
@@ -401,9 +399,9 @@ std::unique_ptr<VoxelMap> VoxelMap::load_bt(const std::string& path, const Voxel
         }
   }
   vm->tree_ = std::move(tree);
-  const auto t1 = Clock::now();
+  const Stopwatch t1;
   vm->run_edt();
-  vm->stats_.edt_seconds = seconds_since(t1);
+  vm->stats_.edt_seconds = t1.seconds();
   for (std::size_t c = 0; c < vm->dist_.size(); ++c) {
     if (vm->dist_[c] > vm->max_distance_) vm->dist_[c] = std::numeric_limits<float>::infinity();
     else vm->part_[c] = 0;

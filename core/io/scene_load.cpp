@@ -1,4 +1,5 @@
 #include "core/io/scene_load.hpp"
+#include "core/stopwatch.hpp"
 
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
@@ -11,7 +12,6 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -145,7 +145,7 @@ void apply_routes(Scene& scene, const std::filesystem::path& routes) {
 }
 
 Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions& opt, SceneLoadReport* report) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch t0;
   const std::string file = toml_path.string();
   require_input_file(toml_path, "scene file");
   std::string text;
@@ -376,7 +376,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
   // Ports and branch points must be finite (checked by the XML reader) and, if the scene has
   // parts, inside the OctoMap-addressable range; that check belongs to the voxel map.
   if (report) {
-    report->load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    report->load_ms = t0.ms();
   }
   return scene;
 }

@@ -1,5 +1,6 @@
 #include "index/simplify/alpha_sim.hpp"
 
+#include "core/stopwatch.hpp"
 #include "core/io/file_stems.hpp"
 
 #include "core/error.hpp"
@@ -33,7 +34,6 @@
 #include <array>
 #include <atomic>
 #include <exception>
-#include <chrono>
 #include <cstring>
 #include <cmath>
 #include <iterator>
@@ -253,11 +253,6 @@ std::vector<Vec3> dense_surface_samples(const Mesh& mesh, double spacing, double
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
 /// True if the projected edge pa–pb lies inside the projection of its two triangles:
 /// exactly two share it and their third corners project strictly to opposite sides.
 /// Such an edge is no part of the projection's outline, and the lattice nodes of the two
@@ -408,10 +403,15 @@ std::vector<Eigen::Matrix3d> axis_rotations(bool all) {
 /// index box (a huge sparse projection) falls back to sorting the lattice points.
 constexpr std::size_t kMaxLatticeBitmapBits = std::size_t(1) << 26;
 
-/// The interior lattice is coarsened (AlphaSimOptions::coarse_interior) only where its
-/// cells' circumradius √2·L_max is below this fraction of α: a Delaunay triangle of the
-/// snapped nodes may be that much larger than the ideal one.
+/// Inside a projection, where a cell of 2·L_max has all nine lattice nodes, only its
+/// corners are sampled (a quarter of the interior points and Delaunay triangles), but only
+/// where those cells' circumradius √2·L_max is below this fraction of α: a Delaunay
+/// triangle of the snapped nodes may be that much larger than the ideal one.
 constexpr double kCoarseCellAlphaMargin = 0.9;
+
+/// Seed offset (from AlphaSimOptions::seed) of the dense samples that the measure pass
+/// checks containment on; the Hausdorff samples use seed + 1.
+constexpr std::uint64_t kMeasureSeedOffset = 12;
 
 /// Triangles seen edge-on (narrower than kEdgeOnWidthShare·tol in projection) are checked
 /// by their longest edge within kEdgeOnTolShare·tol (edge_on_triangles): with the snap
@@ -723,30 +723,18 @@ AlphaSimPlaneSamples sample_projection(const Mesh& mesh,
 struct EdgeOnTriangles {
   std::vector<char> flag;                       ///< per triangle: 1 if seen edge-on
   std::vector<std::array<Vec2, 2>> segments;    ///< their longest projected edges, snapped, unique
-  std::vector<std::array<Vec2, 2>> thin_edges;  ///< edges of the thin others (sampled too), snapped, unique
-  /// The thin edges are checked once the plane's samples have missed (a repair aid: on
-  /// finely tessellated CAD parts they are many, and mostly covered).
-  bool thin_active = false;
 };
 
 /// Triangles whose projection in `pr` is narrower than `width` (twice its area over its
-/// longest edge), and the edges of those narrower than `thin_width`. Such a projection
+/// longest edge). Such a projection
 /// lies within `width` of its longest edge (the foot of the opposite corner falls on that
 /// edge, whose end angles are at most 90°), so the
-/// region covering that edge within tol − width − snap covers every sample of the
-/// triangle within tol: one exact segment test (AlphaShape2D::segment_gaps) replaces the
-/// random samples. A CAD part's faces along an axis are seen edge-on by the other two
+/// region covering that edge within tol − width − snap covers the triangle within tol: one
+/// exact segment test (AlphaShape2D::segment_gaps) replaces the triangle's. A CAD part's faces along an axis are seen edge-on by the other two
 /// planes (~50–90% of a wing part's samples per plane), and their samples all fall on the
 /// outline, where each point test is slowest; hundreds of triangles along an extrusion
 /// share one segment.
-/// A thin projection (a silhouette sliver of a curved surface, between lattice nodes) is
-/// not within tol of one edge: its samples are still tested, but its three edges are
-/// checked exactly too once the plane's samples miss, so that the repair closes whole
-/// slivers at once (random samples found such erosions one or two per round, and the bunny
-/// ended as three convex hulls); not before, since on finely tessellated CAD parts they
-/// are many and covered (the wing's files at 420k triangles: 2.40 → 3.22 s CPU).
-EdgeOnTriangles edge_on_triangles(const Mesh& mesh, const std::vector<Vec2>& proj, double width, double thin_width,
-                                  double snap) {
+EdgeOnTriangles edge_on_triangles(const Mesh& mesh, const std::vector<Vec2>& proj, double width, double snap) {
   EdgeOnTriangles out;
   out.flag.assign(mesh.triangles.size(), 0);
   // The segment pq snapped, ends in lexicographic order (so that equal segments compare equal).
@@ -769,19 +757,13 @@ EdgeOnTriangles edge_on_triangles(const Mesh& mesh, const std::vector<Vec2>& pro
     }
     const Vec2 ab = q[1] - q[0], ac = q[2] - q[0];
     const double twice_area = std::abs(ab.x() * ac.y() - ab.y() * ac.x());
-    if (!(twice_area <= width * std::sqrt(l2))) {
-      if (twice_area <= thin_width * std::sqrt(l2))
-        for (int e = 0; e < 3; ++e) out.thin_edges.push_back(snapped_segment(q[e], q[(e + 1) % 3]));
-      continue;
-    }
+    if (!(twice_area <= width * std::sqrt(l2))) continue;
     out.flag[t] = 1;
     out.segments.push_back(snapped_segment(q[longest], q[(longest + 1) % 3]));
   }
   auto less = [](const auto& x, const auto& y) {
     return std::tie(x[0].x(), x[0].y(), x[1].x(), x[1].y()) < std::tie(y[0].x(), y[0].y(), y[1].x(), y[1].y());
   };
-  std::sort(out.thin_edges.begin(), out.thin_edges.end(), less);
-  out.thin_edges.erase(std::unique(out.thin_edges.begin(), out.thin_edges.end()), out.thin_edges.end());
   std::sort(out.segments.begin(), out.segments.end(), less);
   out.segments.erase(std::unique(out.segments.begin(), out.segments.end()), out.segments.end());
   // Axis-parallel segments on one line (exact after snapping: a face along an axis seen
@@ -812,23 +794,14 @@ EdgeOnTriangles edge_on_triangles(const Mesh& mesh, const std::vector<Vec2>& pro
   return out;
 }
 
-/// The points of `segments` that `shape` leaves farther than tol (see
-/// AlphaShape2D::segment_gaps), spaced ≤ spacing, appended to `gaps`.
-void append_gaps(const AlphaShape2D& shape, const std::vector<std::array<Vec2, 2>>& segments, double tol,
-                 double spacing, std::vector<Vec2>& gaps) {
-  for (const auto& sg : segments) {
+/// The points of the edge-on segments that `shape` leaves farther than tol (see
+/// AlphaShape2D::segment_gaps), spaced ≤ spacing.
+std::vector<Vec2> edge_on_gaps(const AlphaShape2D& shape, const EdgeOnTriangles& eo, double tol, double spacing) {
+  std::vector<Vec2> gaps;
+  for (const auto& sg : eo.segments) {
     const auto g = shape.segment_gaps(sg[0], sg[1], tol, spacing);
     gaps.insert(gaps.end(), g.begin(), g.end());
   }
-}
-
-/// The gaps of the edge-on segments (within segment_tol) and, once active, of the thin
-/// triangles' edges (within thin_tol).
-std::vector<Vec2> edge_on_gaps(const AlphaShape2D& shape, const EdgeOnTriangles& eo, double segment_tol,
-                               double thin_tol, double spacing) {
-  std::vector<Vec2> gaps;
-  append_gaps(shape, eo.segments, segment_tol, spacing, gaps);
-  if (eo.thin_active) append_gaps(shape, eo.thin_edges, thin_tol, spacing, gaps);
   return gaps;
 }
 
@@ -1175,7 +1148,7 @@ void exact_projection(const Mesh& mesh, const std::vector<Vec2>& projected, doub
   const double edge_on_width = kEdgeOnWidthShare * tol, edge_on_tol = kEdgeOnTolShare * tol;
   const double triangle_tol = tol - snap * M_SQRT1_2;
   const double gap_spacing = l_max / 4.0;
-  edge_on = edge_on_triangles(mesh, projected, edge_on_width, 0.0, snap);
+  edge_on = edge_on_triangles(mesh, projected, edge_on_width, snap);
   rep.edge_on_triangles = static_cast<std::size_t>(std::count(edge_on.flag.begin(), edge_on.flag.end(), 1));
   rep.edge_on_segments = edge_on.segments.size();
   std::vector<Vec2> proj(mesh.vertices.size());
@@ -1211,8 +1184,6 @@ void exact_projection(const Mesh& mesh, const std::vector<Vec2>& projected, doub
   std::vector<char> retest_tested(tested.size(), 1), retest_segments(edge_on.segments.size(), 1);
   std::vector<std::array<Vec2, 3>> tested_now;
   EdgeOnTriangles edge_on_now;
-  edge_on_now.thin_edges = edge_on.thin_edges;  // (none in exact mode) all of them
-  edge_on_now.thin_active = edge_on.thin_active;
   auto find_gaps = [&]() {
     tested_now.clear();
     for (std::size_t i = 0; i < tested.size(); ++i)
@@ -1220,7 +1191,7 @@ void exact_projection(const Mesh& mesh, const std::vector<Vec2>& projected, doub
     edge_on_now.segments.clear();
     for (std::size_t i = 0; i < edge_on.segments.size(); ++i)
       if (retest_segments[i]) edge_on_now.segments.push_back(edge_on.segments[i]);
-    std::vector<Vec2> gaps = edge_on_gaps(shape, edge_on_now, edge_on_tol, triangle_tol, gap_spacing);
+    std::vector<Vec2> gaps = edge_on_gaps(shape, edge_on_now, edge_on_tol, gap_spacing);
     const std::vector<Vec2> inside = shape.triangles_gaps(tested_now, triangle_tol, gap_spacing);
     gaps.insert(gaps.end(), inside.begin(), inside.end());
     return gaps;  // in an order independent of the thread schedule (triangles_gaps sorts)
@@ -1344,41 +1315,89 @@ AlphaSimPlaneSamples alpha_sim_plane_samples(const Mesh& mesh, const AlphaSimPri
 
 // ---------------------------------------------------------------------------------------
 
-AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const std::string& step_stem) {
-  const auto t0 = Clock::now();
+namespace {
+
+/// One run of simplify_part: the part, the options and what the stages share. Each stage
+/// returns false when it has settled the result early (original kept, or nothing more to
+/// do); run() calls them in order.
+struct PartSimplification {
+  PartSimplification(const Part& part_in, const AlphaSimOptions& opt_in, const std::string& stem);
+  /// Runs the stages and returns the simplified part with its report.
+  AlphaSimPart run();
+  /// Empty and non-finite input, sheets, and sampling that would not fit in memory.
+  bool check_input();
+  /// α-SIM steps 1–3: samples, α-shape and exact containment repair of each projection.
+  bool build_shapes();
+  /// Step 4: the boundary polygons to extrude, simplified within the tolerance.
+  void outline_polygons();
+  /// Steps 5–6: the prisms intersected and meshed (CGAL, else OpenCASCADE).
+  bool build_mesh();
+  /// Containment of the original in the mesh and the implicit solid, Hausdorff distance,
+  /// lost space.
+  bool measure();
+  /// The STEP file, when asked for.
+  void write_step();
+
+  const Part& part;
+  const AlphaSimOptions& opt;
+  const std::string& step_stem;
+  const Stopwatch t0;
+  std::vector<PlaneSpec> specs;
+  AlphaSimPart out;
+  AlphaSimResult& r = out.result;
+  std::vector<MeshEdge> edges;
+  AABB box;
+  double rounding_reserve = 0.0;
+  double tol = 0.0;  ///< the containment tolerance less the float32 rounding reserve
+  std::vector<std::vector<Vec2>> projected;  ///< the vertices in each plane
+  std::vector<AlphaSimPrism> prisms;
+  std::vector<std::shared_ptr<AlphaShape2D>> shapes;
+  std::shared_ptr<AlphaSimSolid> solid;
+  std::vector<std::vector<PolygonWithHoles2>> polys;
+  TopoDS_Shape result;  ///< OpenCASCADE's solid, when it ran the Booleans
+};
+
+PartSimplification::PartSimplification(const Part& part_in, const AlphaSimOptions& opt_in, const std::string& stem)
+    : part(part_in), opt(opt_in), step_stem(stem) {
   if (!(std::isfinite(opt.dim_pre) && opt.dim_pre > 0.0))
     throw std::invalid_argument("alpha-sim: dim_pre must be finite and > 0, got " + full_precision(opt.dim_pre));
   if (!(opt.sampling_factor > 0.0 && opt.alpha_factor > 0.0))
     throw std::invalid_argument("alpha-sim: sampling_factor and alpha_factor must be > 0");
-  const auto specs = planes_for(opt);
+  specs = planes_for(opt);
 
-  AlphaSimPart out;
-  AlphaSimResult& r = out.result;
   r.name = part.name;
   r.dim_pre = opt.dim_pre;
   r.alpha = opt.alpha_factor * opt.dim_pre;
   r.l_max = opt.sampling_factor * opt.dim_pre;
   r.triangles_before = part.mesh.triangle_count();
   r.faces_before = part.source_faces;
-  const auto edges = unique_edges(part.mesh);
+  edges = unique_edges(part.mesh);
   r.closed_before = closed_mesh(part.mesh, edges);
   r.volume_before = r.closed_before ? std::abs(part.mesh.signed_volume()) : 0.0;
-  const AABB box = part.mesh.bounds();
+  box = part.mesh.bounds();
   const double size = opt.scene_size > 0.0 ? opt.scene_size : box.diagonal();
   r.tolerance = opt.containment_tolerance_factor * (size > 0.0 ? size : 1.0);
   // Rounding the output mesh to float32 (float32_vertices) may move its vertices by
   // rounding_reserve (checked once it is made): the shapes are built and checked within the
   // rest of the tolerance, tol.
-  const double rounding_reserve = float_rounding_reserve(box, opt, r.tolerance);
-  const double tol = r.tolerance - rounding_reserve;
-  auto finish = [&]() {
-    r.time_ms = ms_since(t0);
-    return std::move(out);
-  };
+  rounding_reserve = float_rounding_reserve(box, opt, r.tolerance);
+  tol = r.tolerance - rounding_reserve;
+}
 
+AlphaSimPart PartSimplification::run() {
+  if (check_input() && build_shapes()) {
+    outline_polygons();
+    r.shapes_ms = t0.ms();
+    if (opt.build_mesh && build_mesh() && measure()) write_step();
+  }
+  r.time_ms = t0.ms();
+  return std::move(out);
+}
+
+bool PartSimplification::check_input() {
   if (part.mesh.empty()) {
     keep_original(out, part, AlphaSimStatus::EmptyInput, "the part has no triangles");
-    return finish();
+    return false;
   }
   if (first_non_finite_vertex(part.mesh) >= 0)
     throw std::invalid_argument("alpha-sim: part '" + part.name + "' has a non-finite vertex");
@@ -1406,11 +1425,11 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
                               " (the part is smaller than the cable scale, nothing to simplify): original kept"
                         : "extent along the " + plane + " normal is " + full_precision(*thinnest) + " < " +
                               full_precision(thin) + " (a sheet): original kept");
-    return finish();
+    return false;
   }
 
   // The sample count is known before sampling: refuse what would not fit in memory.
-  std::vector<std::vector<Vec2>> projected(specs.size());  // the vertices in each plane
+  projected.assign(specs.size(), {});  // the vertices in each plane
   {
     std::vector<double> per_plane(specs.size());
     tbb::parallel_for(std::size_t(0), specs.size(), [&](std::size_t k) {
@@ -1425,23 +1444,16 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
                     "sampling at L_max = " + full_precision(r.l_max) + " needs about " +
                         full_precision(std::round(estimate)) + " points in a plane > " +
                         std::to_string(opt.max_cloud_points) + ": original kept (raise dim_pre)");
-      return finish();
+      return false;
     }
   }
+  return true;
+}
 
-  // Random surface points the α-shapes must cover (their Delaunay triangles are kept):
-  // they catch the thin gaps that the regular checks miss, such as slivers between the
-  // nearly coincident silhouettes of a faceted cylinder. Containment is verified below on
-  // an independent set (another seed).
-  std::vector<std::uint32_t> cover_source;
-  const std::vector<Vec3> cover_samples =
-      opt.cover_samples && !opt.exact_containment ? dense_surface_samples(part.mesh, edges, r.l_max, opt.containment_density,
-                                                opt.containment_max_samples, opt.seed + 2, true, &cover_source)
-                        : std::vector<Vec3>();
-
+bool PartSimplification::build_shapes() {
   // 1–2. Sample each projection (L_max), 3. build its α-shape (planes in parallel).
-  std::vector<AlphaSimPrism> prisms(specs.size());
-  std::vector<std::shared_ptr<AlphaShape2D>> shapes(specs.size());
+  prisms.assign(specs.size(), AlphaSimPrism{});
+  shapes.assign(specs.size(), nullptr);
   r.projections.resize(specs.size());
   std::atomic<bool> degenerate{false};
   std::vector<AlphaSimPlaneSamples> plane_samples(specs.size());
@@ -1450,23 +1462,12 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   // faces) would otherwise give sliver triangles and spurious boundary loops.
   // A power of two, so that coordinates on a binary grid (integers, halves) stay exact.
   const double snap = std::exp2(std::floor(std::log2(tol / 4.0)));
-  // Triangles seen edge-on are checked by their longest edge instead of by samples
-  // (kEdgeOnWidthShare, kEdgeOnTolShare).
-  const double edge_on_width = kEdgeOnWidthShare * tol, edge_on_tol = kEdgeOnTolShare * tol;
-  // A thin triangle's edges are checked like its samples, within tol, less their snapping.
-  const double thin_edge_tol = tol - snap * M_SQRT1_2;
-  // Spacing of the points a gap of an edge-on segment adds to the checks.
-  const double edge_on_gap_spacing = r.l_max / 4.0;
-  // Repairs of the gaps of the edge-on segments before the verification rounds.
-  constexpr int kEdgeOnRepairs = 3;
   // Interior lattice cells of 2·L_max (sample_projection) are kept by the α-shape only if
   // their circumradius √2·L_max stays below α, with a margin for the snapping.
-  const bool coarse_interior = opt.coarse_interior && M_SQRT2 * r.l_max < kCoarseCellAlphaMargin * r.alpha;
+  const bool coarse_interior = M_SQRT2 * r.l_max < kCoarseCellAlphaMargin * r.alpha;
   std::vector<EdgeOnTriangles> edge_on(specs.size());
-  // Exact mode: the planes' outline checks, listed only where a repair uses them.
+  // The planes' outline checks, listed only where a repair uses them.
   std::vector<DeferredChecks> deferred(specs.size());
-  // 1 while a plane's shape is unchanged since its edge-on segments were found covered.
-  std::vector<char> edge_on_clean(specs.size(), 0);
   // Gap points of the edge-on segments found so far, per plane: kept covered by every
   // later repair (with the checks).
   std::vector<std::vector<Vec2>> exact_checks(specs.size());
@@ -1485,8 +1486,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       }
     AlphaSimPlaneSamples& smp = plane_samples[k];
     // The exact test finds what centroids and midpoints of interior edges would.
-    smp = sample_projection(part.mesh, edges, projected[k], r.l_max, snap, true, coarse_interior, !opt.exact_containment,
-                            &deferred[k]);
+    smp = sample_projection(part.mesh, edges, projected[k], r.l_max, snap, true, coarse_interior, false, &deferred[k]);
     const std::vector<Vec2>& pts = smp.points;
     rep.points = pts.size();
     auto shape = std::make_shared<AlphaShape2D>(pts, r.alpha, std::min(opt.short_edge_factor * r.l_max, r.alpha));
@@ -1497,29 +1497,9 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     if (shape->kept_triangle_count() == 0) {
       rep.status = ProjectionStatus::Empty;
       shape->keep_all();
-    } else if (opt.exact_containment) {
+    } else {
       exact_projection(part.mesh, projected[k], snap, tol, *shape, smp.checks, deferred[k], edge_on[k], exact_checks[k],
                        opt.torn_fraction, r.l_max, rep);
-    } else {
-      if (opt.edge_on_segments)
-        edge_on[k] = edge_on_triangles(part.mesh, projected[k], edge_on_width, opt.thin_edge_factor * r.l_max, snap);
-      rep.edge_on_triangles = static_cast<std::size_t>(std::count(edge_on[k].flag.begin(), edge_on[k].flag.end(), 1));
-      rep.edge_on_segments = edge_on[k].segments.size();
-      const auto& eo = edge_on[k].flag;
-      smp.checks.reserve(smp.checks.size() + cover_samples.size());
-      for (std::size_t i = 0; i < cover_samples.size(); ++i)
-        if (eo.empty() || cover_source[i] == kNoTriangle || !eo[cover_source[i]])
-          smp.checks.push_back(pr.project(cover_samples[i]));
-      repair_projection(*shape, smp.checks, exact_checks[k], tol, opt.torn_fraction, rep);
-      for (int pass = 0; pass < kEdgeOnRepairs && !is_hull(rep.status); ++pass) {
-        const auto gaps = edge_on_gaps(*shape, edge_on[k], edge_on_tol, thin_edge_tol, edge_on_gap_spacing);
-        if (gaps.empty()) {
-          edge_on_clean[k] = 1;
-          break;
-        }
-        exact_checks[k].insert(exact_checks[k].end(), gaps.begin(), gaps.end());
-        repair_projection(*shape, smp.checks, exact_checks[k], tol, opt.torn_fraction, rep);
-      }
     }
     pr.shape = shape;
     prisms[k] = pr;
@@ -1528,94 +1508,9 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   for (const auto& rep : r.projections) r.sample_points += rep.points;
   if (degenerate) {
     keep_original(out, part, AlphaSimStatus::Thin, "a projection is degenerate (collinear points): original kept");
-    return finish();
+    return false;
   }
 
-  // Verify containment of dense samples on the implicit solid. A plane that misses some
-  // is refined with them (denser sampling where it eroded) and verified again on a fresh
-  // set of samples (another seed), so the final check never uses points it was repaired
-  // with; a plane that still misses after kRefineRounds repairs of its own is replaced by
-  // its convex hull (which contains every projected point). The first repair of a plane's
-  // sample misses also checks its thin triangles' edges (EdgeOnTriangles::thin_active).
-  constexpr int kRefineRounds = 3;
-  std::vector<int> plane_repairs(specs.size(), 0);  // rounds that repaired each plane
-  std::vector<Vec3> samples;
-  std::vector<std::uint32_t> sample_source;
-  // Misses of the samples (a sample of a triangle seen edge-on is left to its segment)
-  // and the gaps of the edge-on segments, per plane; returns the counts of both.
-  auto plane_misses = [&](std::vector<std::vector<Vec2>>& missed, std::vector<std::vector<Vec2>>& gapped) {
-    std::vector<std::size_t> miss(specs.size(), 0);
-    tbb::enumerable_thread_specific<std::vector<std::vector<Vec2>>> local_missed(
-        [&] { return std::vector<std::vector<Vec2>>(specs.size()); });
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, samples.size(), 4096), [&](const auto& rg) {
-      auto& lm = local_missed.local();
-      for (std::size_t i = rg.begin(); i != rg.end(); ++i)
-        for (std::size_t k = 0; k < prisms.size(); ++k) {
-          const std::uint32_t t = sample_source[i];
-          if (t != kNoTriangle && !edge_on[k].flag.empty() && edge_on[k].flag[t]) continue;
-          const Vec2 q = prisms[k].project(samples[i]);
-          if (!prisms[k].shape->contains(q, tol)) lm[k].push_back(q);
-        }
-    });
-    missed.assign(specs.size(), {});
-    gapped.assign(specs.size(), {});
-    tbb::parallel_for(std::size_t(0), specs.size(), [&](std::size_t k) {
-      if (!edge_on_clean[k]) gapped[k] = edge_on_gaps(*prisms[k].shape, edge_on[k], edge_on_tol, thin_edge_tol, edge_on_gap_spacing);
-      edge_on_clean[k] = gapped[k].empty() ? 1 : 0;
-    });
-    for (auto& lm : local_missed)
-      for (std::size_t k = 0; k < specs.size(); ++k) missed[k].insert(missed[k].end(), lm[k].begin(), lm[k].end());
-    for (std::size_t k = 0; k < specs.size(); ++k) {
-      // Deterministic order whatever the thread schedule.
-      std::sort(missed[k].begin(), missed[k].end(), xy_less);
-      miss[k] = missed[k].size() + gapped[k].size();
-    }
-    return miss;
-  };
-  for (int round = 0; !opt.exact_containment; ++round) {
-    // Random points only: the fixed ones (vertices, edge midpoints, centroids) are among
-    // the cover samples, which every repair keeps covered (without cover samples they are
-    // tested here too).
-    samples = dense_surface_samples(part.mesh, edges, r.l_max, opt.containment_density, opt.containment_max_samples,
-                                    opt.seed + 3 * static_cast<std::uint64_t>(round), !opt.cover_samples,
-                                    &sample_source);
-    std::vector<std::vector<Vec2>> missed, gapped;
-    const auto miss = plane_misses(missed, gapped);
-    bool any = false, hull_missed = false;
-    for (std::size_t k = 0; k < specs.size(); ++k) {
-      if (miss[k] == 0) continue;
-      any = true;
-      auto& rep = r.projections[k];
-      if (is_hull(rep.status)) {
-        hull_missed = true;  // already the convex hull
-      } else if (plane_repairs[k]++ < kRefineRounds) {
-        auto& checks = plane_samples[k].checks;
-        deferred[k].list(checks);
-        checks.insert(checks.end(), missed[k].begin(), missed[k].end());
-        if (!missed[k].empty() && !edge_on[k].thin_active) {
-          // Samples missed: the thin triangles' slivers are where (see edge_on_triangles);
-          // their edges are checked from now on, and this repair closes their gaps.
-          edge_on[k].thin_active = true;
-          append_gaps(*shapes[k], edge_on[k].thin_edges, thin_edge_tol, edge_on_gap_spacing, gapped[k]);
-        }
-        exact_checks[k].insert(exact_checks[k].end(), gapped[k].begin(), gapped[k].end());
-        repair_projection(*shapes[k], checks, exact_checks[k], tol, opt.torn_fraction, rep);
-        edge_on_clean[k] = 0;
-      } else {
-        rep.status = ProjectionStatus::Eroded;
-        shapes[k]->keep_all();
-        edge_on_clean[k] = 0;
-      }
-    }
-    if (!any) break;
-    ++r.repair_rounds;
-    if (hull_missed) {
-      keep_original(out, part, AlphaSimStatus::Failed,
-                    "convex hull of a projection misses surface samples: original kept");
-      return finish();
-    }
-  }
-  r.containment_samples = samples.size();
   plane_samples.clear();
   bool hull = false;
   for (std::size_t k = 0; k < specs.size(); ++k) {
@@ -1624,27 +1519,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     rep.area = shapes[k]->area();
     hull = hull || is_hull(rep.status);
   }
-  auto solid = std::make_shared<AlphaSimSolid>(prisms);
-  if (!opt.exact_containment) {
-    // Every sample lies in every 2D shape within tol (checked above, directly or through
-    // the segment of its edge-on triangle), so solid->contains(p, tol) reduces to the
-    // depth ranges: checked here without the 2D queries again.
-    const std::size_t in = tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, samples.size(), 4096), std::size_t(0),
-        [&](const auto& rg, std::size_t acc) {
-          for (std::size_t i = rg.begin(); i != rg.end(); ++i) {
-            bool inside = true;
-            for (const auto& pr : prisms) {
-              const double d = samples[i].dot(pr.n);
-              inside = inside && d >= pr.depth_min - tol && d <= pr.depth_max + tol;
-            }
-            acc += inside ? 1 : 0;
-          }
-          return acc;
-        },
-        std::plus<std::size_t>());
-    r.containment_implicit = samples.empty() ? 1.0 : static_cast<double>(in) / samples.size();
-  }
+  solid = std::make_shared<AlphaSimSolid>(prisms);
   out.solid = solid;
   if (hull) {
     r.status = AlphaSimStatus::HullFallback;
@@ -1655,7 +1530,10 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
         planes += (planes.empty() ? "" : ", ") + rep.plane + " (" + projection_status_name(rep.status) + ")";
     r.reason = "convex hull used for " + planes;
   }
+  return true;
+}
 
+void PartSimplification::outline_polygons() {
   // 4. boundary polygons, merged collinear points (paper: included angle < 1e-6 deg).
   // Vertices within merge_tol (tol/4) of the chord replacing them are merged too: the
   // snapped projections of a straight edge are collinear only up to the snap grid. The
@@ -1668,7 +1546,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   auto merge = [&](std::vector<Vec2>& ring) {
     if (merge_collinear(ring, kCollinearAngle, merge_tol / 2.0) > 0) merge_collinear(ring, kCollinearAngle, merge_tol / 2.0);
   };
-  std::vector<std::vector<PolygonWithHoles2>> polys(specs.size());
+  polys.assign(specs.size(), {});
   for (std::size_t k = 0; k < specs.size(); ++k) {
     polys[k] = shapes[k]->polygons();
     auto& rep = r.projections[k];
@@ -1695,10 +1573,10 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
     rep.polygon_vertices -=
         grow_simplify(polys[k], opt.polygon_growth_factor * opt.dim_pre, opt.merge_convex_corners);
   }
+}
 
-  r.shapes_ms = ms_since(t0);
-  if (!opt.build_mesh) return finish();
-  const auto t_mesh = Clock::now();
+bool PartSimplification::build_mesh() {
+  const Stopwatch t_mesh;
 
   // 5–6. extrude and intersect, mesh the result. Each prism runs a margin past the part
   // so that no cap of one coincides with a face of another.
@@ -1712,8 +1590,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   // prism is left. Slack tol: the result may stand off the exact intersection by that much
   // along an axis (it only grows, so containment holds), where projections of the same
   // part's extent differ by rounding.
-  const ExtrusionReduction reduced =
-      opt.absorb_box_prisms ? reduce_extrusions(extrusions, tol) : ExtrusionReduction{extrusions, 0};
+  const ExtrusionReduction reduced = reduce_extrusions(extrusions, tol);
   r.prisms_absorbed = static_cast<int>(reduced.absorbed);
   // Watertight: no boundary and no misoriented edge. Edges shared by four triangles are
   // allowed: two pieces of the intersection may touch along an edge.
@@ -1727,10 +1604,8 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
   };
   MeshTopology otopo;
   bool watertight = false;
-  const bool occt_asked = opt.occt_booleans && reduced.kept.size() > 2;
   if (!opt.step_dir.empty()) r.booleans_note = "--step";
-  else if (occt_asked) r.booleans_note = "occt_booleans";
-  if (opt.step_dir.empty() && !occt_asked) {
+  if (opt.step_dir.empty()) {
     // One prism is the result; two across each other (the rib's outline and its web) are
     // sliced along their common axis; a third is intersected by exact corefinement (CGAL).
     // No OpenCASCADE (and no STEP asked for).
@@ -1750,7 +1625,6 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       r.booleans_note = e.what();
     }
   }
-  TopoDS_Shape result;
   if (!watertight) {
     try {
       std::vector<TopoDS_Shape> solids(reduced.kept.size());
@@ -1765,15 +1639,15 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
       keep_original(out, part, AlphaSimStatus::Failed,
                     std::string("OpenCASCADE failed: ") + (e.GetMessageString() ? e.GetMessageString() : "?") +
                         ": original kept");
-      return finish();
+      return false;
     } catch (const std::exception& e) {
       keep_original(out, part, AlphaSimStatus::Failed,
                     std::string("OpenCASCADE failed: ") + e.what() + ": original kept");
-      return finish();
+      return false;
     }
     watertight = watertight_mesh(out.mesh, otopo);
   }
-  r.mesh_ms = ms_since(t_mesh);
+  r.mesh_ms = t_mesh.ms();
   if (watertight && out.mesh.signed_volume() < 0.0)
     for (auto& f : out.mesh.triangles) std::swap(f[1], f[2]);
   if (r.float_rounding > rounding_reserve) {
@@ -1781,7 +1655,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
                   "rounding the simplified mesh to float32 (binary STL) moved a vertex by " +
                       full_precision(r.float_rounding) + " > the " + full_precision(rounding_reserve) +
                       " of the containment tolerance kept for it (the part lies far from the origin for its size): original kept");
-    return finish();
+    return false;
   }
   r.closed_after = watertight;
   r.triangles_after = out.mesh.triangle_count();
@@ -1791,17 +1665,21 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
                   "the OpenCASCADE result mesh is not closed (" + std::to_string(otopo.boundary_edges) +
                       " boundary, " + std::to_string(otopo.nonmanifold_edges) + " non-manifold, " +
                       std::to_string(otopo.misoriented_edges) + " misoriented edges): original kept");
-    return finish();
+    return false;
   }
+  return true;
+}
 
-  const auto t_measure = Clock::now();
+bool PartSimplification::measure() {
+  const Stopwatch t_measure;
   if (opt.measure) {
     // Containment of the original surface in the output mesh (what indices will use), on
-    // a whole dense set (fixed and random points) of a seed no verification round used.
-    samples = dense_surface_samples(part.mesh, edges, r.l_max, opt.containment_density, opt.containment_max_samples,
-                                    opt.seed + 3 * static_cast<std::uint64_t>(kRefineRounds + 1), true);
+    // a whole dense set (fixed and random points) of its own seed.
+    const std::vector<Vec3> samples =
+        dense_surface_samples(part.mesh, edges, r.l_max, opt.containment_density, opt.containment_max_samples,
+                              opt.seed + kMeasureSeedOffset, true);
     r.containment_samples = samples.size();
-    if (opt.exact_containment) {
+    {
       // Contained by construction (exact_projection): verified here on the implicit solid,
       // independently of how the shapes were repaired.
       const std::size_t in = tbb::parallel_reduce(
@@ -1825,7 +1703,7 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
                         full_precision(in != samples.size() ? c : ci) + " of the surface samples: original kept");
       r.containment = c;  // report what was measured before falling back
       r.containment_implicit = ci;
-      return finish();
+      return false;
     }
     // One-sided Hausdorff distance: output surface → original surface.
     const EmbreeIndex original = mesh_index(part.mesh, r.closed_before);
@@ -1874,16 +1752,25 @@ AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const s
                           " outside the original fits inside the simplified part: a feature is hidden in every "
                           "projection (split the part); original kept");
         r.lost_space_radius = lost;
-        return finish();
+        return false;
       }
     }
   }
 
-  r.measure_ms = ms_since(t_measure);
+  r.measure_ms = t_measure.ms();
+  return true;
+}
+
+void PartSimplification::write_step() {
   if (!opt.step_dir.empty())
     write_step_atomic(result,
                       opt.step_dir / ((step_stem.empty() ? output_file_stems({part.name})[0] : step_stem) + ".step"));
-  return finish();
+}
+
+}  // namespace
+
+AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const std::string& step_stem) {
+  return PartSimplification(part, opt, step_stem).run();
 }
 
 std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimOptions& opt,
@@ -1973,7 +1860,7 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
     if (e) std::rethrow_exception(e);
   for (std::size_t i = 0; i < parts.size(); ++i) {
     if (source[i] == i) continue;
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     const std::size_t j = source[i];
     Part p = parts[i];
     double rounding = 0.0;
@@ -2012,7 +1899,7 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
     if (!move[i].linear().isIdentity()) res[i].projections = turned_projections(res[j].projections, move[i].linear(), planes_for(o));
     res[i].name = parts[i].name;
     res[i].copy_of = parts[j].name;
-    res[i].time_ms = ms_since(t0);
+    res[i].time_ms = t0.ms();
     res[i].shapes_ms = res[i].mesh_ms = res[i].measure_ms = 0.0;
     simplified.add();
   }

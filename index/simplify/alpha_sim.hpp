@@ -21,6 +21,12 @@
 namespace loom {
 
 /// How a part is simplified. dim_pre is required; every other value has the paper's default.
+/// Containment of every triangle in every projection is made exact (up to rounding): each
+/// triangle's gaps — pieces of it farther than the tolerance from the α-shape
+/// (AlphaShape2D::triangle_gaps; those seen edge-on by their longest edge, segment_gaps) —
+/// are found and repaired, a few passes, then the plane falls back to its hull. The
+/// `measure` pass still verifies dense random samples, against the mesh and the implicit
+/// solid.
 struct AlphaSimOptions {
   double dim_pre = 0.0;          ///< features smaller than this vanish (scene units, > 0)
   double sampling_factor = 0.5;  ///< L_max = sampling_factor·dim_pre (paper §3.2: 0.5)
@@ -33,7 +39,7 @@ struct AlphaSimOptions {
   std::vector<Vec3> extra_planes;  ///< normals of user projection planes (need not be unit)
   /// Scene size used for tolerances (bbox diagonal); ≤ 0: the part's own diagonal.
   double scene_size = 0.0;
-  /// "Inside or on" tolerance = containment_tolerance_factor·scene_size (issue: 1e-6).
+  /// "Inside or on" tolerance = containment_tolerance_factor·scene_size.
   double containment_tolerance_factor = 1e-6;
   /// A projection whose repaired (added) area exceeds this fraction of its final area is
   /// "torn" (α too small for the sampling) and replaced by its convex hull.
@@ -50,35 +56,6 @@ struct AlphaSimOptions {
   /// (at least the vertices, edge midpoints, centroids and two random points per triangle).
   double containment_density = 4.0;
   std::size_t containment_max_samples = 400000;
-  /// Dense samples (vertices, edge midpoints, centroids, random points) are checks of the
-  /// first repair; false leaves only the planes' own checks there (an ablation: the
-  /// verification rounds, which then test the fixed points too, have to do the repair).
-  bool cover_samples = true;
-  /// Containment of every triangle in every projection is made exact (up to rounding):
-  /// after the regular checks, each triangle's gaps — pieces of it farther than the
-  /// tolerance from the α-shape (AlphaShape2D::triangle_gaps; those seen edge-on by their
-  /// longest edge, segment_gaps) — are found and repaired, a few passes, then the plane
-  /// falls back to its hull. No random samples (cover_samples, the verification rounds,
-  /// edge_on_segments and thin_edge_factor apply only when false: the path before the
-  /// twenty-fifth session, kept as the ablation and bench baseline). The `measure` pass
-  /// still verifies dense random samples, against the mesh and the implicit solid.
-  bool exact_containment = true;
-  /// Triangles seen edge-on in a plane (narrower than tol/4 in projection) are checked by
-  /// their longest projected edge, exactly (AlphaShape2D::segment_gaps), instead of by
-  /// their random samples in that plane; false samples them like the others (the ablation
-  /// and bench baseline: the path before the twenty-fourth session).
-  bool edge_on_segments = true;
-  /// Inside a projection, where a cell of 2·L_max has all nine lattice nodes, only its
-  /// corners are sampled (its triangles' circumradius √2·L_max is below α at the default
-  /// factors; not done otherwise): a quarter of the interior points and Delaunay
-  /// triangles. false samples the whole lattice at L_max (the ablation, and the path
-  /// before the twenty-fifth session).
-  bool coarse_interior = true;
-  /// With edge_on_segments: the three edges of a triangle whose projection is narrower
-  /// than thin_edge_factor·L_max (a silhouette sliver) are checked exactly as well, from
-  /// the first verification round in which the plane's samples miss, and their gaps
-  /// repaired with those misses (the triangle's samples are still tested). 0: none.
-  double thin_edge_factor = 0.05;
   /// Most samples in one projection plane (memory bound, ~100 bytes per point).
   std::size_t max_cloud_points = 4000000;
   /// The boundary polygons that are extruded may grow the α-shape (never shrink it) by
@@ -90,15 +67,6 @@ struct AlphaSimOptions {
   /// Convex arcs (a cylinder seen end-on) are also coarsened, outwards (grow_simplify).
   bool merge_convex_corners = true;
   bool build_mesh = true;       ///< prisms ∩ → triangle mesh (else implicit only)
-  /// Prisms whose region is an axis-aligned rectangle are absorbed into the others
-  /// (reduce_extrusions) before any general Boolean; false runs every Boolean (an
-  /// ablation: the solid is the same, within the containment tolerance).
-  bool absorb_box_prisms = true;
-  /// The general Booleans (three prisms with general outlines) run on OpenCASCADE solids
-  /// instead of CGAL's exact corefinement of the prism meshes (mesh_extrusions): the path
-  /// before the twenty-third session, kept as the ablation and bench baseline. STEP output
-  /// always uses OpenCASCADE (it needs the B-rep).
-  bool occt_booleans = false;
   bool measure = true;          ///< containment of the mesh + Hausdorff distance
   /// The output mesh's vertices are rounded to float32 (the binary STL that `loom
   /// simplify` writes holds nothing finer) before the mesh is checked closed and measured,
@@ -126,7 +94,7 @@ struct AlphaSimOptions {
 
 /// What happened to one projection plane.
 enum class ProjectionStatus {
-  Ok,        ///< the α-shape covered every triangle (exact_containment; else every sample)
+  Ok,        ///< the α-shape covered every triangle
   Repaired,  ///< Delaunay triangles were added (or points inserted) so that it does
   Empty,     ///< α too small for the sampling: no triangle kept → convex hull
   Torn,      ///< too much had to be repaired → convex hull
@@ -166,7 +134,7 @@ struct ProjectionReport {
   double hull_area = 0.0;              ///< convex hull area
   std::size_t edge_on_triangles = 0;   ///< triangles seen edge-on: checked by their longest edge, not sampled
   std::size_t edge_on_segments = 0;    ///< the unique edges those checks ran on
-  std::size_t exact_triangles = 0;     ///< the others, tested whole (exact_containment)
+  std::size_t exact_triangles = 0;     ///< the others, tested whole
   std::size_t exact_gaps = 0;          ///< gap points those exact tests found and repaired
   std::size_t polygon_vertices = 0;    ///< boundary vertices after merging collinear ones
   std::size_t polygons = 0;            ///< connected pieces
@@ -186,12 +154,9 @@ struct AlphaSimResult {
   bool closed_before = false, closed_after = false;
   double volume_before = 0.0, volume_after = 0.0;  ///< 0 when the mesh is not closed
   double containment = 1.0;           ///< fraction of dense original samples inside/on the output mesh
-  /// Same against the implicit solid (1 by construction with exact_containment when not
-  /// measured).
+  /// Same against the implicit solid (1 by construction when not measured).
   double containment_implicit = 1.0;
   std::size_t containment_samples = 0;
-  /// Verification rounds that found random samples outside a shape and repaired it.
-  int repair_rounds = 0;
   double hausdorff = 0.0;             ///< max over the output surface of the distance to the original (0 unless measured)
   /// Largest move of an output vertex rounded to float32 (float32_vertices; scene units).
   double float_rounding = 0.0;
@@ -208,7 +173,7 @@ struct AlphaSimResult {
   /// What ran them: "none", "cgal" (exact mesh corefinement) or "opencascade" (B-rep).
   std::string booleans_by = "none";
   /// Why OpenCASCADE ran them where loom's own path was tried first and refused (its
-  /// message), or "--step" / "occt_booleans" when asked; empty otherwise.
+  /// message), or "--step" when asked (STEP output needs the B-rep); empty otherwise.
   std::string booleans_note;
   double measure_ms = 0.0;  ///< mesh containment, Hausdorff, lost-space probe
   std::vector<ProjectionReport> projections;
@@ -282,10 +247,10 @@ struct AlphaSimPlaneSamples {
 /// left out of the points (the corners already cover that cell); every check is kept.
 /// lattice_bitmap = false deduplicates by sorting every point (the reference; same sets).
 /// coarse_interior drops the nodes of odd index, and the cell centres, inside the cells of
-/// spacing 2·l_max whose nine nodes are all met (the interior;
-/// AlphaSimOptions::coarse_interior). all_checks = false leaves out the cell centres, the
-/// centroids and the midpoints of edges inside the projection (exact_containment tests
-/// the triangles whole; the outline's sub-edge midpoints stay).
+/// spacing 2·l_max whose nine nodes are all met (the interior; simplify_part coarsens it).
+/// all_checks = false leaves out the cell centres, the centroids and the midpoints of edges
+/// inside the projection (simplify_part tests the triangles whole; the outline's sub-edge
+/// midpoints stay).
 AlphaSimPlaneSamples alpha_sim_plane_samples(const Mesh& mesh, const AlphaSimPrism& frame, double l_max, double snap,
                                              bool lattice_bitmap = true, bool coarse_interior = false,
                                              bool all_checks = true);

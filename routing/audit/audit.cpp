@@ -1,6 +1,7 @@
 // The audit pipeline: scene → index → checks → AuditReport (DESIGN §4).
 #include "routing/audit/audit.hpp"
 
+#include "core/stopwatch.hpp"
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
 #include "core/io/harness_xml.hpp"
@@ -11,7 +12,6 @@
 #include "routing/curve/cable_geometry.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <map>
 #include <memory>
 #include <optional>
@@ -22,9 +22,6 @@ namespace loom {
 
 namespace {
 
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 /// Node ids at the ends of a segment use, in the cable's direction of travel.
 std::pair<std::string, std::string> use_nodes(const Harness& h, const SegmentUse& u) {
@@ -192,9 +189,9 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
       index = opt.index;
     } else {
       ProgressCounter built(opt.progress, "index", 1, "indices");
-      const auto t0 = std::chrono::steady_clock::now();
+      const Stopwatch t0;
       owned = std::make_unique<EmbreeIndex>(scene.parts);
-      rep.index_ms = ms_since(t0);
+      rep.index_ms = t0.ms();
       built.finish();
       index = owned.get();
     }
@@ -206,9 +203,9 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
   }
   if (scene.has_harness)
     for (auto& n : attach_ports(scene.harness, scene.parts, req.routing_clearance, inputs, index)) rep.notes.push_back(n);
-  const auto t1 = std::chrono::steady_clock::now();
+  const Stopwatch t1;
   rep.result = check_clashes(inputs, scene.parts, index, req);
-  rep.check_ms = ms_since(t1);
+  rep.check_ms = t1.ms();
   rep.notes.insert(rep.notes.end(), rep.result.notes.begin(), rep.result.notes.end());
   return rep;
 }
@@ -278,14 +275,14 @@ void apply_matching_routes(Scene& scene, const std::filesystem::path& routes) {
 }
 
 AuditReport audit_scene_file(const std::filesystem::path& scene_file, const AuditOptions& opt, Scene* loaded) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch t0;
   SceneLoadReport load_rep;
   SceneLoadOptions load_opt;
   load_opt.progress = opt.progress;
   Scene scene = load_scene(scene_file, load_opt, &load_rep);
   if (opt.routes) apply_matching_routes(scene, *opt.routes);
   if (scene.has_harness) check_requested_tolerance(scene.harness, opt.check);
-  const double load_ms = ms_since(t0);
+  const double load_ms = t0.ms();
   AuditReport rep = run_audit(scene, opt);
   rep.load_ms = load_ms;
   rep.notes.insert(rep.notes.begin(), load_rep.notes.begin(), load_rep.notes.end());

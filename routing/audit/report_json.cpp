@@ -2,6 +2,7 @@
 #include "routing/audit/report_json.hpp"
 
 #include "core/io/atomic_file.hpp"
+#include "core/io/json_text.hpp"
 
 #include <cmath>
 
@@ -122,10 +123,6 @@ std::set<std::string> unrouted_cable_ids(const nlohmann::json& report) {
     if (c.is_object() && c.contains("id") && c["id"].is_string() && c.contains("routed") && c["routed"] == false)
       ids.insert(c["id"].get<std::string>());
   return ids;
-}
-
-std::string json_text(const nlohmann::json& j, int indent) {
-  return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 void write_audit_report(const AuditReport& report, const std::filesystem::path& path) {

@@ -13,12 +13,6 @@
 
 namespace loom {
 
-/// `j` as text (indented by `indent`, or compact if < 0). A string that is not valid UTF-8
-/// — a file or part name taken from the file system; harness data is checked when read —
-/// gets U+FFFD for its bad bytes, where nlohmann's dump() would throw type_error 316 (a
-/// message naming nothing, after some outputs were already written).
-std::string json_text(const nlohmann::json& j, int indent = -1);
-
 /// The report as JSON (numbers in scene units, times in milliseconds).
 nlohmann::json audit_report_json(const AuditReport& report);
 

@@ -1,6 +1,6 @@
 #pragma once
 /// Where the router puts the branch points a harness file leaves open, and in which
-/// direction each harness segment leaves a branch point (issue 7). Both are decided before
+/// direction each harness segment leaves a branch point. Both are decided before
 /// planning, from the harness tree, the ports' connector axes and the obstacles.
 
 #include "core/harness.hpp"

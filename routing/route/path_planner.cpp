@@ -1,6 +1,9 @@
 #include "routing/route/path_planner.hpp"
 
 #include "core/scene.hpp"
+#include "core/stopwatch.hpp"
+#include "routing/route/port_check.hpp"
+
 #include "routing/route/tube_validity.hpp"
 
 #include <ompl/base/Goal.h>
@@ -448,7 +451,7 @@ RunOutcome run_planner(TubeContext& ctx, const ob::PlannerPtr& planner, bool opt
                        const Vec3& from, const Vec3& to, double time_limit,
                        const PlanSettings& settings) {
   RunOutcome out;
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   auto pdef = std::make_shared<ob::ProblemDefinition>(ctx.si);
   ob::ScopedState<> s(ctx.space), g(ctx.space);
   set_state_point(s.get(), from);
@@ -475,7 +478,7 @@ RunOutcome run_planner(TubeContext& ctx, const ob::PlannerPtr& planner, bool opt
 
   const ob::PlannerTerminationCondition ptc([conv] { return conv->should_stop(); });
   planner->solve(ptc);
-  out.ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  out.ms = t0.ms();
   out.iterations = conv->iterations();
   out.timed_out = conv->timed_out();
 
@@ -486,15 +489,6 @@ RunOutcome run_planner(TubeContext& ctx, const ob::PlannerPtr& planner, bool opt
   out.path.front() = from;  // the goal tolerance is ~1e-9 of the extent: snap both ends
   out.path.back() = to;
   out.solved = true;
-  return out;
-}
-
-/// Removes consecutive points closer than tol.
-std::vector<Vec3> dedupe(const std::vector<Vec3>& pts, double tol) {
-  std::vector<Vec3> out;
-  for (const auto& p : pts)
-    if (out.empty() || (p - out.back()).norm() > tol) out.push_back(p);
-  if (out.size() == 1 && pts.size() > 1) out.push_back(pts.back());
   return out;
 }
 
@@ -528,7 +522,7 @@ std::vector<Vec3> simplify_to_key_points(const ObstacleIndex& index, TubeContext
     pts.front() = raw.front();
     pts.back() = raw.back();
   }
-  pts = dedupe(pts, kDuplicateRel * ctx.required);
+  pts = dedupe_consecutive(pts, kDuplicateRel * ctx.required);
   if (pts.size() <= 2) return pts;
 
   // Prefix costs of the stretch (our objective).
@@ -582,46 +576,20 @@ bool verify_polyline(const ObstacleIndex& index, const TubeContext& ctx, double 
   return true;
 }
 
-/// Port checks: the port itself, then its stub. Returns false (with the reason) if blocked.
+/// The planner's port check: the port and its stub end inside the planning bounds, then
+/// check_port_exit (no part excused).
 bool check_port(const ObstacleIndex& index, const AABB& bounds, double required, const PortSpec& port,
                 const Vec3& stub_end, bool is_start, PlanResult& r) {
-  const char* which = is_start ? "start" : "goal";
-  int inside_part = -1;
-  const bool in_box = bounds.contains(port.position) && bounds.contains(stub_end);
-  const bool inside = index.inside(port.position, &inside_part);
-  if (!in_box || inside || index.any_within(port.position, required)) {
+  const std::string who = is_start ? "start port" : "goal port";
+  if (!bounds.contains(port.position) || !bounds.contains(stub_end)) {
     r.reason = is_start ? NoPathReason::StartInObstacle : NoPathReason::GoalInObstacle;
     r.blocked_at = port.position;
-    if (!in_box) {
-      r.message = std::string(which) + " port " + fmt_point(port.position) +
-                  " or its stub lies outside the planning bounds";
-      return false;
-    }
-    const ClosestHit hit = index.closest(port.position);
-    r.blocking_part = inside ? inside_part : hit.part;
-    r.message = std::string(which) + " port " + fmt_point(port.position) +
-                (inside ? " is inside part " + std::to_string(inside_part)
-                        : " is " + fmt_len(hit.distance) + " from part " + std::to_string(hit.part) +
-                              ", closer than radius + clearance = " + fmt_len(required));
+    r.message = who + " at " + full_precision(port.position) + " or its stub lies outside the planning bounds";
     return false;
   }
-  if (index.segment_within(port.position, stub_end, required)) {
-    double t = 0.0;
-    const ClosestHit hit = index.segment_closest(port.position, stub_end, required, &t);
-    r.reason = is_start ? NoPathReason::StartPortBlocked : NoPathReason::GoalPortBlocked;
-    r.blocked_at = hit.found() ? hit.point : stub_end;
-    r.blocking_part = hit.part;
-    r.message = std::string(which) + " port " + fmt_point(port.position) + " faces a wall: its stub of length " +
-                fmt_len((stub_end - port.position).norm()) + " comes within " + fmt_len(hit.distance) +
-                " of part " + std::to_string(hit.part) + " at " + fmt_point(r.blocked_at.value_or(stub_end));
-    return false;
-  }
-  return true;
+  return check_port_exit(index, {}, PortExit{who, port.position, stub_end, is_start, {}, 0.0}, required, {}, r);
 }
 
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 /// The part that seals p in a cavity: every one of kEnclosureRays directions (a Fibonacci
 /// sphere) hits a part within `reach`. Returns the part hit by most rays, or -1 as soon as
@@ -659,9 +627,9 @@ void plan_between_stubs(const ObstacleIndex& index, TubeContext& ctx, const ob::
     r.iterations = run.iterations;
     r.time_limited = run.timed_out;
     if (run.solved) {
-      const auto t1 = Clock::now();
+      const Stopwatch t1;
       interior = simplify_to_key_points(index, ctx, run.path, settings.seed);
-      r.simplify_ms = ms_since(t1);
+      r.simplify_ms = t1.ms();
       found = true;
     }
   }
@@ -670,7 +638,7 @@ void plan_between_stubs(const ObstacleIndex& index, TubeContext& ctx, const ob::
   if (!found && settings.diagnosis_fraction > 0.0) {
     // A thin tube tells a missing corridor from a short budget; if its path happens to be
     // clear for the real tube, it is a route.
-    const auto t2 = Clock::now();
+    const Stopwatch t2;
     const double thin = kThinFraction * ctx.required;
     auto thin_ctx = make_context(index, ctx.bounds, thin, PlanObjective{}, mix_seed(settings.seed, 0xD1A6));
     PlanSettings thin_settings = settings;
@@ -713,7 +681,7 @@ void plan_between_stubs(const ObstacleIndex& index, TubeContext& ctx, const ob::
                     " (a longer time limit may still find one)";
       }
     }
-    r.diagnose_ms = ms_since(t2);
+    r.diagnose_ms = t2.ms();
   }
   if (!found) {
     if (r.reason != NoPathReason::NoCorridor && settings.diagnosis_fraction > 0.0) {
@@ -744,7 +712,7 @@ void plan_between_stubs(const ObstacleIndex& index, TubeContext& ctx, const ob::
   key.push_back(start.position);
   key.insert(key.end(), interior.begin(), interior.end());
   key.push_back(goal.position);
-  key = dedupe(key, kDuplicateRel * ctx.required);
+  key = dedupe_consecutive(key, kDuplicateRel * ctx.required);
   if (!verify_polyline(index, ctx, settings.radius, key, r)) {
     r.reason = NoPathReason::InvalidSolution;
     r.message = "the planner's path failed the exact capsule re-check near " +
@@ -760,6 +728,14 @@ void plan_between_stubs(const ObstacleIndex& index, TubeContext& ctx, const ob::
 }  // namespace
 
 // --- public API -------------------------------------------------------------------------
+
+std::vector<Vec3> dedupe_consecutive(const std::vector<Vec3>& pts, double tol) {
+  std::vector<Vec3> out;
+  for (const auto& p : pts)
+    if (out.empty() || (p - out.back()).norm() > tol) out.push_back(p);
+  if (out.size() == 1 && pts.size() > 1) out.push_back(pts.back());
+  return out;
+}
 
 const char* preference_name(PartPreference p) {
   switch (p) {
@@ -812,7 +788,7 @@ std::uint32_t seed_ompl_once(std::uint32_t seed) {
 }
 
 PlanResult plan_path(const ObstacleIndex& index, const PlanRequest& request) {
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   validate_settings(request);
   if (!std::isfinite(request.time_limit) || request.time_limit < 0.0)
     throw std::invalid_argument("plan: time limit must be finite and >= 0");
@@ -838,20 +814,20 @@ PlanResult plan_path(const ObstacleIndex& index, const PlanRequest& request) {
   const bool ok = check_port(index, bounds, required, start, start_end, true, r) &&
                   check_port(index, bounds, required, goal, goal_end, false, r);
   if (!ok) {
-    r.time_ms = ms_since(t0);
+    r.time_ms = t0.ms();
     return r;
   }
   if (request.time_limit == 0.0) {
     r.reason = NoPathReason::Timeout;
     r.message = "time budget is 0 s: ports checked, no planning done";
-    r.time_ms = ms_since(t0);
+    r.time_ms = t0.ms();
     return r;
   }
   auto ctx = make_context(index, bounds, required, request.objective, request.seed);
   const ob::PlannerPtr planner = entry.make(ctx->si, mix_seed(request.seed, 0x91A2));
   plan_between_stubs(index, *ctx, planner, entry.optimizing, request, start, goal, start_end, goal_end,
                      request.time_limit, r);
-  r.time_ms = ms_since(t0);
+  r.time_ms = t0.ms();
   return r;
 }
 
@@ -904,7 +880,7 @@ std::size_t RoadmapPlanner::roadmap_vertices() const {
 }
 
 PlanResult RoadmapPlanner::plan(const PortSpec& start_in, const PortSpec& goal_in, double time_limit) {
-  const auto t0 = Clock::now();
+  const Stopwatch t0;
   if (!std::isfinite(time_limit) || time_limit < 0.0)
     throw std::invalid_argument("RoadmapPlanner: time limit must be finite and >= 0");
   const PortSpec start = validated_port(start_in, "start");
@@ -930,7 +906,7 @@ PlanResult RoadmapPlanner::plan(const PortSpec& start_in, const PortSpec& goal_i
     plan_between_stubs(impl_->index, ctx, impl_->planner, impl_->entry->optimizing, s, start, goal, start_end,
                        goal_end, time_limit, r);
   }
-  r.time_ms = ms_since(t0);
+  r.time_ms = t0.ms();
   return r;
 }
 

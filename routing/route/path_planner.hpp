@@ -115,6 +115,10 @@ enum class NoPathReason {
   InvalidSolution,   ///< the planner's path failed the exact re-check (a bug; never returned as a route)
 };
 
+/// `pts` (world frame) without each point closer than `tol` (scene units) to the point kept
+/// before it; a polyline of two or more points keeps at least its first and last.
+std::vector<Vec3> dedupe_consecutive(const std::vector<Vec3>& pts, double tol);
+
 /// "none" | "start_in_obstacle" | "goal_in_obstacle" | "start_port_blocked" |
 /// "goal_port_blocked" | "no_corridor" | "timeout" | "enclosed" | "invalid_solution".
 const char* reason_name(NoPathReason r);

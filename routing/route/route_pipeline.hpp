@@ -1,5 +1,5 @@
 #pragma once
-/// The main job (issue 7, DESIGN §3–§7): scene → indices (built once) → α-simplified
+/// Routing a scene (DESIGN §3–§7): scene → indices (built once) → α-simplified
 /// planning obstacles → OMPL key points per harness segment in the patent's order (bundles
 /// by cable count, largest first) → unplaced branch points placed → cubic B-splines with
 /// port exit tangents → bend-radius repair/fairing → exact certified audit → repair

@@ -5,6 +5,7 @@
 #include "core/io/harness_xml.hpp"
 #include "core/io/mesh_write.hpp"
 #include "routing/curve/cable_geometry.hpp"
+#include "core/io/json_text.hpp"
 #include "routing/audit/report_json.hpp"
 #include "routing/curve/sweep.hpp"
 

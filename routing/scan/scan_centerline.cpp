@@ -1,4 +1,5 @@
 #include "routing/scan/scan_centerline.hpp"
+#include "core/stopwatch.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -6,9 +7,9 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <random>
 #include <stdexcept>
@@ -82,11 +83,6 @@ constexpr std::size_t kSpacingNeighbours = 16;
 /// Scale steps of the diameter estimate: enough to double from 10⁻⁶ of the cloud's size to
 /// all of it (20) and then settle.
 constexpr int kEstimateIterations = 24;
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 struct CloudAdaptor {
   const std::vector<Vec3>& pts;
@@ -843,39 +839,106 @@ std::optional<double> estimate_tube_diameter(const std::vector<Vec3>& cloud, std
   return coarse_diameter(cloud, tree, seed);
 }
 
-ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptions& opt) {
-  const auto t_start = Clock::now();
+namespace {
+
+/// A block of the cable: an interval of the ordering coordinate, within one run.
+struct Span {
+  double s0, s1;
+  bool run_first, run_last;
+  double run0, run1;  ///< extent of the run (stretch between gaps) the block belongs to
+};
+
+/// One run of extract_centerline: the cloud, the options and what the stages share. Each
+/// stage returns false once it has settled the result (fail()); run() calls them in order.
+class CenterlineExtraction {
+ public:
+  CenterlineExtraction(const std::vector<Vec3>& cloud_in, const ScanOptions& opt_in);
+  /// Runs the stages and returns the result.
+  ScanResult run();
+
+ private:
+  /// The nominal diameter: given, or estimated on a strided subset of the cloud.
+  bool estimate_diameter();
+  /// The ordering coordinate of every point, the blocks along it, and the points bucketed
+  /// into the blocks.
+  bool order_points();
+  /// Block fits: pass 1 (free radius), the diameter check, pass 2 (nominal radius,
+  /// smoothness prior).
+  bool fit_blocks();
+  /// One pass of block fits (in parallel), warm-started from `init` when given.
+  void run_pass(bool free_radius, double radius, const std::vector<std::optional<Vec3>>& priors,
+                const std::vector<FitOut>* init);
+  /// Key points in order along the cable, the spline through them, the gaps along it.
+  bool key_points_and_spline();
+  /// Settles the result with `st` and `msg`; returns false.
+  bool fail(ScanStatus st, std::string msg);
+
+  const ScanOptions& opt;
+  const Stopwatch t_start;
+  Stopwatch t0;
+  ScanResult res;
+  std::vector<Vec3> finite;                    ///< the finite points, when some are not
+  const std::vector<Vec3>* cloud_ptr = nullptr;  ///< the points worked on
+  std::vector<Vec3> sub_storage;
+  const std::vector<Vec3>* sub_ptr = nullptr;  ///< the neighbourhood subset
+  std::unique_ptr<CloudAdaptor> adaptor;
+  std::unique_ptr<KdTree> tree;                ///< over the subset
+  double d = 0.0;                              ///< nominal diameter
+  const bool graph;                            ///< ScanMethod::Graph
+  std::vector<double> s;                       ///< ordering coordinate per point
+  std::vector<char> use;                       ///< per point: takes part in the fits
+  Chain chain;
+  Vec3 axis_dir = Vec3::UnitX();
+  int axis_k = 0;
+  std::vector<Span> spans;
+  std::size_t m = 0;                           ///< blocks
+  std::vector<std::size_t> start;              ///< block b's points: sorted[start[b], start[b + 1])
+  std::vector<Vec3> sorted;
+  std::vector<FitOut> fits;
+  std::vector<Vec3> c0, a0;                    ///< initial centre and direction per block
+  std::vector<FitOut> pass1;
+};
+
+CenterlineExtraction::CenterlineExtraction(const std::vector<Vec3>& cloud_in, const ScanOptions& opt_in)
+    : opt(opt_in), graph(opt_in.method == ScanMethod::Graph) {
   if (opt.diameter && !(std::isfinite(*opt.diameter) && *opt.diameter > 0.0))
     throw std::invalid_argument("extract_centerline: diameter must be positive and finite");
   if (!(std::isfinite(opt.block_length) && opt.block_length >= 0.0))
     throw std::invalid_argument("extract_centerline: block length must be >= 0 and finite");
-  ScanResult res;
   res.method = opt.method;
   res.points = cloud_in.size();
   // Work on finite points only.
-  const std::vector<Vec3>* cloud_ptr = &cloud_in;
-  std::vector<Vec3> finite;
+  cloud_ptr = &cloud_in;
   if (!std::all_of(cloud_in.begin(), cloud_in.end(), [](const Vec3& p) { return p.allFinite(); })) {
     for (const auto& p : cloud_in)
       if (p.allFinite()) finite.push_back(p);
     cloud_ptr = &finite;
   }
-  const std::vector<Vec3>& pts = *cloud_ptr;
-  auto finish = [&](ScanStatus st, std::string msg) {
-    res.status = st;
-    res.message = std::move(msg);
-    res.timing.total_ms = ms_since(t_start);
-    return res;
-  };
-  if (pts.size() < 2 * kMinBlockPoints)
-    return finish(ScanStatus::TooFewPoints, "the cloud has " + std::to_string(pts.size()) + " finite points; at least " +
-                                                std::to_string(2 * kMinBlockPoints) + " are needed");
+}
 
-  auto t0 = Clock::now();
+bool CenterlineExtraction::fail(ScanStatus st, std::string msg) {
+  res.status = st;
+  res.message = std::move(msg);
+  return false;
+}
+
+ScanResult CenterlineExtraction::run() {
+  const std::vector<Vec3>& pts = *cloud_ptr;
+  if (pts.size() < 2 * kMinBlockPoints)
+    fail(ScanStatus::TooFewPoints, "the cloud has " + std::to_string(pts.size()) + " finite points; at least " +
+                                       std::to_string(2 * kMinBlockPoints) + " are needed");
+  else if (estimate_diameter() && order_points() && fit_blocks() && key_points_and_spline())
+    fail(ScanStatus::Ok, "");
+  res.timing.total_ms = t_start.ms();
+  return res;
+}
+
+bool CenterlineExtraction::estimate_diameter() {
+  const std::vector<Vec3>& pts = *cloud_ptr;
+  t0.restart();
   // Neighbourhood statistics (diameter estimate, contraction onto the axis) only need a
   // bounded, evenly strided subset of the cloud.
-  std::vector<Vec3> sub_storage;
-  const std::vector<Vec3>* sub_ptr = &pts;
+  sub_ptr = &pts;
   if (pts.size() > kNeighbourhoodPoints) {
     const double stride = static_cast<double>(pts.size()) / static_cast<double>(kNeighbourhoodPoints);
     sub_storage.reserve(kNeighbourhoodPoints);
@@ -884,30 +947,30 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
     sub_ptr = &sub_storage;
   }
   const std::vector<Vec3>& sub = *sub_ptr;
-  CloudAdaptor ad{sub};
-  KdTree tree(3, ad, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-  double d;
+  adaptor = std::make_unique<CloudAdaptor>(CloudAdaptor{sub});
+  tree = std::make_unique<KdTree>(3, *adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
   if (opt.diameter) {
     d = *opt.diameter;
   } else {
-    const auto tdia = Clock::now();
-    auto est = coarse_diameter(sub, tree, opt.seed);
-    res.timing.diameter_ms = ms_since(tdia);
-    if (!est) return finish(ScanStatus::NotATube, "cannot estimate a diameter: no neighbourhood has a circular cross-section");
+    const Stopwatch tdia;
+    auto est = coarse_diameter(sub, *tree, opt.seed);
+    res.timing.diameter_ms = tdia.ms();
+    if (!est) return fail(ScanStatus::NotATube, "cannot estimate a diameter: no neighbourhood has a circular cross-section");
     d = *est;
     res.diameter_estimated = true;
   }
   res.diameter = d;
+  return true;
+}
 
+bool CenterlineExtraction::order_points() {
+  const std::vector<Vec3>& pts = *cloud_ptr;
   // Ordering coordinate s per point and which points take part.
-  std::vector<double> s(pts.size());
-  std::vector<char> use(pts.size(), 1);
-  Chain chain;
-  Vec3 axis_dir = Vec3::UnitX();
-  int axis_k = 0;
+  s.assign(pts.size(), 0.0);
+  use.assign(pts.size(), 1);
   if (opt.method == ScanMethod::Graph) {
     std::string why;
-    if (!build_chain(pts, sub, tree, d, chain, why)) return finish(ScanStatus::NotATube, why);
+    if (!build_chain(pts, *sub_ptr, *tree, d, chain, why)) return fail(ScanStatus::NotATube, why);
     std::vector<double> dist;
     project_on_chain(pts, chain, d, s, dist);
     for (std::size_t i = 0; i < pts.size(); ++i) use[i] = dist[i] <= kOutlierDistance * d;
@@ -922,7 +985,7 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
   su.reserve(pts.size());
   for (std::size_t i = 0; i < pts.size(); ++i)
     if (use[i]) su.push_back(s[i]);
-  if (su.size() < 2 * kMinBlockPoints) return finish(ScanStatus::TooFewPoints, "too few points near the cable axis");
+  if (su.size() < 2 * kMinBlockPoints) return fail(ScanStatus::TooFewPoints, "too few points near the cable axis");
   std::sort(su.begin(), su.end());
   const double span = su.back() - su.front();
   const double L_nom = opt.block_length > 0.0
@@ -931,12 +994,6 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
                                                    static_cast<double>(su.size()));
   // Runs of the cable separated by gaps (stretches without points longer than a block);
   // each run is split into blocks of about L_nom, so that no block straddles a gap.
-  struct Span {
-    double s0, s1;
-    bool run_first, run_last;
-    double run0, run1;  ///< extent of the run (stretch between gaps) the block belongs to
-  };
-  std::vector<Span> spans;
   {
     const double gap_thr = std::max(L_nom, d);
     std::size_t a = 0;
@@ -955,9 +1012,9 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
       a = i;
     }
   }
-  const std::size_t m = spans.size();
+  m = spans.size();
   // Bucket the points into blocks (counting sort on the block index).
-  std::vector<std::size_t> start(m + 1, 0);
+  start.assign(m + 1, 0);
   std::vector<std::uint32_t> blk_of(pts.size());
   std::vector<double> span_begin(m);
   for (std::size_t b = 0; b < m; ++b) span_begin[b] = spans[b].s0;
@@ -969,19 +1026,71 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
     ++start[b + 1];
   }
   for (std::size_t b = 0; b < m; ++b) start[b + 1] += start[b];
-  std::vector<Vec3> sorted(start[m]);
+  sorted.assign(start[m], Vec3::Zero());
   {
     std::vector<std::size_t> fill(start.begin(), start.end() - 1);
     for (std::size_t i = 0; i < pts.size(); ++i)
       if (use[i]) sorted[fill[blk_of[i]]++] = pts[i];
   }
-  res.timing.ordering_ms = ms_since(t0);
+  res.timing.ordering_ms = t0.ms();
+  return true;
+}
 
+void CenterlineExtraction::run_pass(bool free_radius, double radius, const std::vector<std::optional<Vec3>>& priors,
+                                    const std::vector<FitOut>* init) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t b = r.begin(); b != r.end(); ++b) {
+      const std::size_t cnt = start[b + 1] - start[b];
+      if (cnt < kMinBlockPoints) {
+        fits[b] = FitOut{};
+        continue;
+      }
+      FitConfig cfg;
+      cfg.curved = graph;
+      cfg.robust = graph;
+      cfg.free_radius = free_radius;
+      cfg.radius = radius;
+      cfg.prior = priors[b];
+      cfg.prior_weight = opt.smoothness;
+      const bool warm = init && (*init)[b].ok;
+      FitOut f0;
+      if (warm) {
+        f0 = (*init)[b];
+      } else {
+        f0.c = c0[b];
+        f0.a = a0[b];
+      }
+      const Vec3* bp = sorted.data() + start[b];
+      if (cnt > kFitSubsample) {
+        // Converge on an evenly strided subset, then polish on every point of the block.
+        std::vector<Vec3> few;
+        few.reserve(kFitSubsample + 1);
+        const double stride = static_cast<double>(cnt) / static_cast<double>(kFitSubsample);
+        for (std::size_t k = 0; k < kFitSubsample; ++k) few.push_back(bp[static_cast<std::size_t>(static_cast<double>(k) * stride)]);
+        BlockFitter coarse(few.data(), few.size(), cfg);
+        const FitOut fc = coarse.run(f0, warm);
+        if (fc.ok) {
+          f0 = fc;
+          cfg.max_iter = kPolishIterations;
+        }
+        BlockFitter full(bp, cnt, cfg);
+        fits[b] = full.run(f0, fc.ok || warm);
+      } else {
+        BlockFitter fitter(bp, cnt, cfg);
+        fits[b] = fitter.run(f0, warm);
+      }
+      if (fits[b].ok && (fits[b].c - c0[b]).norm() > kMaxCentreShift * d) fits[b].ok = false;
+      if (fits[b].ok && fits[b].thin) fits[b].ok = false;
+    }
+  });
+}
+
+bool CenterlineExtraction::fit_blocks() {
   // Block fits: pass 1 (free radius when estimating), pass 2 (nominal radius, smoothness prior).
-  t0 = Clock::now();
-  const bool graph = opt.method == ScanMethod::Graph;
-  std::vector<FitOut> fits(m);
-  std::vector<Vec3> c0(m), a0(m);
+  t0.restart();
+  fits.assign(m, FitOut{});
+  c0.assign(m, Vec3::Zero());
+  a0.assign(m, Vec3::Zero());
   for (std::size_t b = 0; b < m; ++b) {
     const double mid = 0.5 * (spans[b].s0 + spans[b].s1), half = 0.5 * (spans[b].s1 - spans[b].s0);
     if (graph) {
@@ -998,54 +1107,6 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
       a0[b] = axis_dir;
     }
   }
-  auto run_pass = [&](bool free_radius, double radius, const std::vector<std::optional<Vec3>>& priors,
-                      const std::vector<FitOut>* init) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t b = r.begin(); b != r.end(); ++b) {
-        const std::size_t cnt = start[b + 1] - start[b];
-        if (cnt < kMinBlockPoints) {
-          fits[b] = FitOut{};
-          continue;
-        }
-        FitConfig cfg;
-        cfg.curved = graph;
-        cfg.robust = graph;
-        cfg.free_radius = free_radius;
-        cfg.radius = radius;
-        cfg.prior = priors[b];
-        cfg.prior_weight = opt.smoothness;
-        const bool warm = init && (*init)[b].ok;
-        FitOut f0;
-        if (warm) {
-          f0 = (*init)[b];
-        } else {
-          f0.c = c0[b];
-          f0.a = a0[b];
-        }
-        const Vec3* bp = sorted.data() + start[b];
-        if (cnt > kFitSubsample) {
-          // Converge on an evenly strided subset, then polish on every point of the block.
-          std::vector<Vec3> few;
-          few.reserve(kFitSubsample + 1);
-          const double stride = static_cast<double>(cnt) / static_cast<double>(kFitSubsample);
-          for (std::size_t k = 0; k < kFitSubsample; ++k) few.push_back(bp[static_cast<std::size_t>(static_cast<double>(k) * stride)]);
-          BlockFitter coarse(few.data(), few.size(), cfg);
-          const FitOut fc = coarse.run(f0, warm);
-          if (fc.ok) {
-            f0 = fc;
-            cfg.max_iter = kPolishIterations;
-          }
-          BlockFitter full(bp, cnt, cfg);
-          fits[b] = full.run(f0, fc.ok || warm);
-        } else {
-          BlockFitter fitter(bp, cnt, cfg);
-          fits[b] = fitter.run(f0, warm);
-        }
-        if (fits[b].ok && (fits[b].c - c0[b]).norm() > kMaxCentreShift * d) fits[b].ok = false;
-        if (fits[b].ok && fits[b].thin) fits[b].ok = false;
-      }
-    });
-  };
   std::vector<std::optional<Vec3>> no_prior(m);
   // Pass 1 fits the radius too, also when a diameter is given: the cloud's own diameter
   // checks the given one (a wrong one moves every fitted axis by the difference of the
@@ -1064,7 +1125,7 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
              " degrees around the fitted axis (a line or a surface, not a tube)";
     else if (opt.diameter)
       why += " (is the given diameter " + std::to_string(*opt.diameter) + " right?)";
-    return finish(ScanStatus::NotATube, why);
+    return fail(ScanStatus::NotATube, why);
   }
   const double fitted_d = median(diam);
   if (res.diameter_estimated) {
@@ -1074,7 +1135,7 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
     res.diameter_spread = 1.4826 * median(dev);
     res.diameter = d;
   } else if (std::abs(fitted_d - d) > kGivenDiameterTolerance * d) {
-    return finish(ScanStatus::NotATube, "the given diameter " + std::to_string(d) +
+    return fail(ScanStatus::NotATube, "the given diameter " + std::to_string(d) +
                                             " does not match the cloud: its cross-sections fit a diameter of " +
                                             std::to_string(fitted_d));
   }
@@ -1089,12 +1150,15 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
       if (acc.norm() > 0) priors[b] = acc.normalized();
     }
   }
-  const std::vector<FitOut> pass1 = fits;
+  pass1 = fits;
   run_pass(false, 0.5 * fitted_d, priors, &pass1);
-  res.timing.fitting_ms = ms_since(t0);
+  res.timing.fitting_ms = t0.ms();
+  return true;
+}
 
+bool CenterlineExtraction::key_points_and_spline() {
   // Key points in order along the cable.
-  t0 = Clock::now();
+  t0.restart();
   double sq = 0.0;
   bool run_open = false;  // a run's start point has been emitted
   std::vector<std::pair<std::size_t, std::size_t>> gap_keys;  // key point indices either side of a gap
@@ -1153,12 +1217,12 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
   res.outliers = res.points - res.inliers;
   res.residual_rms = res.inliers ? std::sqrt(sq / static_cast<double>(res.inliers)) : 0.0;
   if (res.blocks.size() < 2)
-    return finish(res.blocks.empty() ? ScanStatus::TooFewPoints : ScanStatus::NotATube,
+    return fail(res.blocks.empty() ? ScanStatus::TooFewPoints : ScanStatus::NotATube,
                   "fewer than two blocks gave a consistent tube fit");
   try {
     res.centerline = Centerline::interpolate(res.key_points, InterpolationOptions{});
   } catch (const std::invalid_argument& e) {
-    return finish(ScanStatus::NotATube, std::string("interpolation failed: ") + e.what());
+    return fail(ScanStatus::NotATube, std::string("interpolation failed: ") + e.what());
   }
   if (graph && !gap_keys.empty()) {
     // Gaps measured along the recovered curve, between the ends of the scanned stretches.
@@ -1172,8 +1236,14 @@ ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptio
       res.largest_gap = std::max(res.largest_gap, g);
     }
   }
-  res.timing.spline_ms = ms_since(t0);
-  return finish(ScanStatus::Ok, "");
+  res.timing.spline_ms = t0.ms();
+  return true;
+}
+
+}  // namespace
+
+ScanResult extract_centerline(const std::vector<Vec3>& cloud_in, const ScanOptions& opt) {
+  return CenterlineExtraction(cloud_in, opt).run();
 }
 
 }  // namespace loom

@@ -1,5 +1,6 @@
 #include "routing/view/render.hpp"
 
+#include "core/stopwatch.hpp"
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
 #include "core/io/atomic_file.hpp"
@@ -12,7 +13,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <memory>
 #include <set>
@@ -189,7 +189,7 @@ Image render_scene(const Scene& scene, const Harness& harness, const nlohmann::j
                    const RenderOptions& opt, RenderStats* stats) {
   if (opt.width < 1 || opt.height < 1 || opt.width > kMaxSide || opt.height > kMaxSide)
     throw InputError({"", 0, "--render-size"}, "image size must be 1.." + std::to_string(kMaxSide) + " pixels a side");
-  const auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch t0;
   RenderStats st;
 
   // Cable tubes, one part per routed cable; the framing box is the harness's.
@@ -273,7 +273,7 @@ Image render_scene(const Scene& scene, const Harness& harness, const nlohmann::j
   };
   draw("violations", false);
   draw("clashes", true);
-  st.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  st.ms = t0.ms();
   if (stats) *stats = st;
   return img;
 }

@@ -6,6 +6,7 @@
 #include "core/units.hpp"
 #include "routing/curve/cable_geometry.hpp"
 #include "routing/view/render.hpp"
+#include "core/io/json_text.hpp"
 #include "routing/audit/report_json.hpp"
 #include "routing/view/view_assets.hpp"
 

@@ -1,4 +1,4 @@
-// Tests of the OMPL planning core (issue 7): closed-form box scenes built as meshes, planned
+// Tests of the OMPL planning core and the port check: closed-form box scenes built as meshes, planned
 // against BruteForceIndex / EmbreeIndex (exact triangles) and checked against an independent
 // oracle — the closed-form distance to solid axis-aligned boxes, sampled densely (spacing
 // required/50) along every key-point segment. The planner's capsule checks are exact, so the
@@ -9,6 +9,7 @@
 #include "index/brute_force_index.hpp"
 #include "index/embree_index.hpp"
 #include "routing/route/path_planner.hpp"
+#include "routing/route/port_check.hpp"
 #include "routing/route/tube_validity.hpp"
 
 #include <gtest/gtest.h>
@@ -390,6 +391,56 @@ TEST(PathPlanner, StartAndGoalInsideObstacles) {
   EXPECT_FALSE(r.solved());
 }
 
+// A port on the face of its connector (box 0): the connector is excused over the given run
+// of the exit only; a wall (box 1) ahead is measured over the whole exit. Distances are
+// closed-form (Scene::distance of one box).
+TEST(PortCheck, ConnectorIsExcusedOverItsRunOnly) {
+  const Scene s{{{Vec3(0, 0, 0), Vec3(10, 10, 10)}, {Vec3(30, 0, 0), Vec3(31, 10, 10)}}};
+  const std::vector<Part> parts = s.parts();
+  const BruteForceIndex index(parts);
+  std::vector<AABB> boxes;
+  for (const Part& p : parts) boxes.push_back(p.mesh.bounds());
+  const double required = 2.0;
+  const Vec3 port(10.5, 5, 5);  // half a unit off the face: clearly outside
+  const auto name = [&](int q) { return parts[q].name; };
+  const std::vector<NearPart> near = near_port_parts(index, boxes, parts, port, required, 4.0, required);
+  ASSERT_EQ(near.size(), 1u);
+  EXPECT_EQ(near[0].part, 0);
+  EXPECT_EQ(near[0].excused, 4.0);
+
+  PlanResult r;
+  EXPECT_TRUE(check_port_exit(index, boxes, PortExit{"port P", port, Vec3(20, 5, 5), true, near, 0.02}, required,
+                              name, r))
+      << r.message;
+
+  // Nothing excused: the port itself is on a part.
+  r = PlanResult{};
+  EXPECT_FALSE(check_port_exit(index, boxes, PortExit{"port P", port, Vec3(20, 5, 5), true, {}, 0.0}, required,
+                               name, r));
+  EXPECT_EQ(r.reason, NoPathReason::StartInObstacle);
+  EXPECT_EQ(r.message, "port P at (10.5, 5, 5) is 0.5 from part 'box0', closer than radius + clearance = 2");
+
+  // Excused over 1 only: at 1 along the exit the connector is 1.5 away, less than required.
+  r = PlanResult{};
+  EXPECT_FALSE(check_port_exit(index, boxes, PortExit{"port P", port, Vec3(20, 5, 5), false, {{0, 1.0}}, 0.02},
+                               required, name, r));
+  EXPECT_EQ(r.reason, NoPathReason::GoalPortBlocked);
+  EXPECT_EQ(r.blocking_part, 0);
+  ASSERT_TRUE(r.blocked_at.has_value());
+  EXPECT_NEAR(s.distance(Vec3(11.5, 5, 5)), 1.5, 1e-12);
+  EXPECT_NEAR((*r.blocked_at - Vec3(10, 5, 5)).norm(), 0.0, 1e-9);  // the face point nearest x = 11.5
+
+  // An exit that ends 1 short of the wall.
+  r = PlanResult{};
+  EXPECT_FALSE(check_port_exit(index, boxes, PortExit{"port P", port, Vec3(29, 5, 5), true, near, 0.02}, required,
+                               name, r));
+  EXPECT_EQ(r.reason, NoPathReason::StartPortBlocked);
+  EXPECT_EQ(r.blocking_part, 1);
+  EXPECT_EQ(r.message,
+            "port P at (10.5, 5, 5) faces a wall: its straight exit of length 18.5 comes within 1 of part 'box1' "
+            "(needs 2)");
+}
+
 TEST(PathPlanner, PortFacingAWallIsReported) {
   const Scene s{{{Vec3(3, 0, 0), Vec3(5, 100, 100)}}};
   const BruteForceIndex index(s.parts());
@@ -397,6 +448,11 @@ TEST(PathPlanner, PortFacingAWallIsReported) {
   req.start = {Vec3(10, 50, 50), -Vec3::UnitX()};  // stub of 4 ends at x = 6; the tube reaches x = 3
   PlanResult r = plan_path(index, req);
   EXPECT_EQ(r.reason, NoPathReason::StartPortBlocked) << r.message;
+  EXPECT_EQ(r.message.rfind("start port at (10, 50, 50) faces a wall: its straight exit of length 4 comes within 1 of "
+                            "part 0",
+                            0),
+            0u)
+      << r.message;
   ASSERT_TRUE(r.blocked_at.has_value());
   EXPECT_NEAR(r.blocked_at->x(), 5.0, 1e-9);  // on the wall's face, in front of the port
   EXPECT_NEAR(r.blocked_at->y(), 50.0, 1e-9);
