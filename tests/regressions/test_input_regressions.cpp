@@ -29,6 +29,7 @@
 #include "core/io/tessellation_cache.hpp"
 #include "routing/curve/cable_geometry.hpp"
 #include "routing/scan/point_cloud_io.hpp"
+#include "common/shared_data.hpp"
 #include "common/run_loom.hpp"
 
 namespace {
@@ -454,8 +455,8 @@ TEST(Regression, HarnessTableWithoutFileNamedNoLine) {
 // and a product named "bolt#2") gave two pieces the name "bolt#2": the scene then refused a
 // valid file ("duplicate part name 'as1/bolt#2'"), every run, since the cache kept the names.
 TEST(Regression, StepProductNamedLikeASuffixClashed) {
-  const fs::path as1 = fs::path(LOOM_SHARED_DATA) / "stepcode/as1-oc-214.stp";
-  if (!fs::exists(as1)) GTEST_SKIP() << "shared data not present: " << as1;
+  const fs::path as1 = loom::testing::shared_data("stepcode/as1-oc-214.stp");
+  LOOM_SHARED_DATA_OR_SKIP(as1);
   const fs::path d = scratch();
   const std::string text = replaced(slurp(as1), "PRODUCT('l-bracket','l-bracket'", "PRODUCT('bolt#2','bolt#2'");
   write(d / "as1.stp", text);

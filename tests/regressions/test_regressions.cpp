@@ -30,6 +30,7 @@
 #include "routing/curve/sweep.hpp"
 
 #include "common/brute_geometry.hpp"
+#include "common/shared_data.hpp"
 #include "index/index_test_meshes.hpp"
 
 namespace {
@@ -193,6 +194,7 @@ TEST(Regression, ExtrusionPairSlabOneRoundingStepThickKeepsItsMaterial) {
 // equal box bounds by box address, so the intersection points were numbered in heap
 // order. mesh_intersection now sorts its output; here the heap is disturbed between runs.
 TEST(Regression, AlphaSimCorefinementOrderDoesNotFollowTheHeap) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   loom::Part motor;
   motor.name = "motor";
   motor.mesh = loom::read_mesh_file(std::filesystem::path(LOOM_SHARED_DATA) / "occt/motor.stl");
@@ -264,6 +266,7 @@ TEST(Regression, AlphaSimMeshHoldsTheImplicitSolidOfTwoTurnedBoxes) {
 // (AlphaSimOptions::thin_edge_factor), and a plane becomes its hull only after three
 // repairs of its own (the rounds were counted for all planes together).
 TEST(Regression, AlphaSimBunnyIsNotThreeConvexHulls) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   const loom::Part bunny = shared_part("bunny", "trimesh/bunny.ply");
   loom::AlphaSimOptions o;
   o.dim_pre = 0.02 * bunny.mesh.bounds().diagonal();
@@ -318,6 +321,7 @@ TEST(Regression, AlphaSimFacesTouchingThemselvesAreMerged) {
 // containment (AlphaSimOptions::exact_containment, now the default) tests every triangle
 // whole against every shape (AlphaShape2D::triangle_gaps) and repairs what it finds.
 TEST(Regression, AlphaSimRandomSamplesMissedSliversOfTheSurface) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   const loom::Part bunny = shared_part("bunny", "trimesh/bunny.ply");
   auto outside = [&](bool exact) {
     loom::AlphaSimOptions o;
@@ -348,6 +352,7 @@ TEST(Regression, AlphaSimRandomSamplesMissedSliversOfTheSurface) {
 // 152 or 168 triangles, from run to run and within one process. The vertices are now
 // visited in the order of their points. Memory held between the runs moves the heap.
 TEST(Regression, AlphaSimPinchFillsDoNotFollowTheHeap) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   const loom::Part tube = shared_part("tube", "trimesh/tube.obj");
   loom::AlphaSimOptions o;
   o.dim_pre = 0.01 * tube.mesh.bounds().diagonal();

@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "common/run_loom.hpp"
+#include "common/shared_data.hpp"
 
 using namespace loom;
 using namespace loom::alpha_sim_oracle;
@@ -621,6 +622,7 @@ TEST(AlphaSimAdversarialCli, PartFarFromTheOrigin) {
 }
 
 TEST(AlphaSimAdversarial, RealMeshesTurnedByOddAngles) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   for (const char* rel : {"fcl/rob.obj", "trimesh/tube.obj", "occt/shape.stl", "trimesh/featuretype.STL"}) {
     const auto path = std::filesystem::path(LOOM_SHARED_DATA) / rel;
     if (!std::filesystem::exists(path)) continue;
