@@ -1,4 +1,4 @@
-// The bundled wing-section example (issue 2): the generator is deterministic (a fresh run
+// The bundled wing-section example: the generator is deterministic (a fresh run
 // reproduces the committed files byte for byte), the committed scene loads, every port sits
 // on its receptacle facing free space, and for every segment of the harness tree a witness
 // corridor exists that is wider than the segment's bundle plus clearance — so a route

@@ -1,5 +1,5 @@
-// One test per routing bug found by the adversarial review of `loom route`
-// (tests/routing/test_route_adversarial.cpp), inputs written out in full.
+// One test per routing bug of `loom route` on adversarial scenes
+// (tests/routing/route/test_route_adversarial.cpp), inputs written out in full.
 #include "index/index_test_meshes.hpp"
 #include "routing/view/render.hpp"
 #include "routing/route/route_pipeline.hpp"
@@ -44,7 +44,7 @@ Scene box_scene(const std::string& j1, const std::string& j2, double time_limit 
 // Two ports at one point leaving the same way: the stub ends coincide, the segment is
 // "solved" without planning, its hairpin cannot be rounded, and the bend re-plan handed
 // plan_path two equal ends — std::invalid_argument "plan: start and goal ports coincide"
-// (exit 2 naming nothing). Now the hairpin is routed and reported: a bend-radius violation
+// (exit 2 naming nothing). The hairpin is routed and reported: a bend-radius violation
 // and a self contact, exit 1.
 TEST(RouteRegression, TwoPortsAtOnePointAreReportedNotThrown) {
   const Scene sc = box_scene("<port id=\"J1\" x=\"-80\" y=\"5\" z=\"5\" dx=\"1\" dy=\"0\" dz=\"0\"/>",
@@ -72,7 +72,7 @@ TEST(RouteRegression, PortOnAFaceLeavingAlongItsNormalIsRouted) {
 
 // Same with a stub (max(min bend 1, 2r) = 2) shorter than the required distance 4: the stub
 // end lay within 4 of the face, so the port was blocked whatever faced it. A port on its
-// connector now leaves straight until clear of it.
+// connector leaves straight until clear of it.
 TEST(RouteRegression, PortOnAFaceWithAStubShorterThanTheClearanceIsRouted) {
   Scene sc = box_scene("<port id=\"J1\" x=\"-20\" y=\"5\" z=\"5\" dx=\"-1\" dy=\"0\" dz=\"0\"/>",
                        "<port id=\"J2\" x=\"90\" y=\"5\" z=\"5\" dx=\"-1\" dy=\"0\" dz=\"0\"/>");
@@ -86,7 +86,7 @@ TEST(RouteRegression, PortOnAFaceWithAStubShorterThanTheClearanceIsRouted) {
 // stub check measured every part from `required` along the exit, where the face is only
 // required·cos 45° away, and called the port blocked ("faces a wall ... comes within
 // 2.8354981925580561 of part 'box' (needs 4)", exit 3), though the audit excuses the part a
-// port sits on over its straight exit and the exit's end is 7.07 from the face. Now the part
+// port sits on over its straight exit and the exit's end is 7.07 from the face. The part
 // the port sits on is excused over the exit (not crossed), every other part checked.
 TEST(RouteRegression, PortOnAFaceLeavingAtAnAngleIsRouted) {
   const Scene sc = box_scene(

@@ -1,4 +1,4 @@
-// α-SIM (issue 4): the 2D α-shape, the simplified solid and its failure modes, checked
+// α-SIM: the 2D α-shape, the simplified solid and its failure modes, checked
 // against closed forms (plates, L-bracket, cylinder), an independent containment oracle
 // (BruteForceIndex winding numbers) and real meshes from ../shared/data.
 #include "core/io/mesh_read.hpp"
@@ -1737,7 +1737,7 @@ RC_GTEST_PROP(AlphaSimProperty, TheMeshHoldsTheImplicitSolid, ()) {
   RC_ASSERT(sp.result.closed_after);
   // Where pieces touch (a 2-manifold cannot hold them), OpenCASCADE runs the Booleans, and
   // its result has lost pieces of the intersection that hold no surface of the part (known
-  // limit, DESIGN-NOTES): only CGAL's result is held to this.
+  // limit, docs/simplify.md): only CGAL's result is held to this.
   RC_TAG(sp.result.booleans_by);
   RC_ASSERT((sp.result.booleans_by == "opencascade") == !sp.result.booleans_note.empty());  // the fallback says why
   if (sp.result.booleans_by == "cgal") RC_ASSERT(implicit_points_outside_the_mesh(sp, sp.result.tolerance, 20000) == 0u);

@@ -1,4 +1,4 @@
-// Point cloud reading (issue 8): PLY ascii/binary LE/BE, XYZ, PCD ascii/binary/compressed,
+// Point cloud reading: PLY ascii/binary LE/BE, XYZ, PCD ascii/binary/compressed,
 // the real PCL sample clouds, malformed files with located errors.
 #include "routing/scan/point_cloud_io.hpp"
 
