@@ -173,7 +173,7 @@ TEST(CliDemo, RoutesAndAuditsTheWingSection) {
   EXPECT_TRUE(std::filesystem::exists(out / "report.json"));
 }
 
-// --- progress bars and --render-size (issue 9) ----------------------------------------
+// --- progress bars and --render-size ----------------------------------------
 
 /// Runs `loom ARGS` on a pseudo-terminal (stdin, stdout and stderr are the terminal), as a
 /// person at a shell would; returns exit status and everything the terminal received.
@@ -301,7 +301,7 @@ TEST(CliSimplify, BadDimPreIsExitTwoAndWritesNothing) {
   }
 }
 
-// Regressions (2026-11-21): options whose "not given" value was a sentinel inside the
+// Regressions: options whose "not given" value was a sentinel inside the
 // option (NaN, < 0, 0) took a bad given value for "use the scene's": `simplify --dim-pre
 // nan`, `route --time-limit nan|-1`, `route --seed -5`, `audit --spacing 0` and
 // `audit --tolerance 0` ran with defaults and exit 0 (`scan --diameter nan` passed CLI11's
@@ -327,7 +327,7 @@ TEST(CliRegression, GivenOptionValuesAreCheckedNotTakenForDefaults) {
   }
 }
 
-// Regressions (2026-11-22, session 19, a scripted sweep of bad inputs): numbers far beyond
+// Regressions: numbers far beyond
 // any scene (a transform scale or translation of 1e300, a clearance of 1e300, a route's
 // control point at x = 1e300) were accepted — the audit of that route ran out of memory —
 // and a vertex pushed past single precision's useful range by a transform passed too.
@@ -364,10 +364,10 @@ TEST(CliRegression, NumbersBeyondAnySceneAreRefused) {
   EXPECT_NE(d.out.find("'diameter'"), std::string::npos) << d.out;
 }
 
-// Regression (2026-11-22, session 19): a tessellation deflection of 1e-9 mm (given, or the
+// Regression: a tessellation deflection of 1e-9 mm (given, or the
 // default r/10 of a cable 1e-300 mm thick) made OpenCASCADE's mesher throw
 // Standard_NumericError, which nothing caught: the process aborted. A deflection below 1e-6
-// of the file's size is now refused before meshing, and OpenCASCADE's own exceptions
+// of the file's size is refused before meshing, and OpenCASCADE's own exceptions
 // become input errors naming the file.
 TEST(CliRegression, TessellationFinerThanTheFileCanHoldIsExitTwo) {
   const auto dir = fresh_dir("deflection");
@@ -381,13 +381,13 @@ TEST(CliRegression, TessellationFinerThanTheFileCanHoldIsExitTwo) {
   EXPECT_NE(r.out.find("below 1e-6 of the file's size"), std::string::npos) << r.out;
 }
 
-// Regression (2026-11-22, session 19): a part named with 100,000 characters made `simplify
+// Regression: a part named with 100,000 characters made `simplify
 // --step` fail to create its files ("File name too long") after other parts' files were
 // written, and the exception, thrown inside a TBB task, cancelled the nested loops of the
 // parts other threads were simplifying (UBSan: a member call on a null shape). OpenCASCADE's
 // STEP writer also printed its statistics on stdout under --quiet, and two parts' STEP
 // files written at once by different threads failed now and then ("cannot write STEP
-// file": the writer is not thread-safe). Stems are now cut to a valid length (with a hash
+// file": the writer is not thread-safe). Stems are cut to a valid length (with a hash
 // of the whole name), exceptions wait until every part is done, one STEP file is written
 // at a time, and stdout stays empty.
 TEST(CliRegression, LongPartNamesGiveValidFilesAndQuietStaysQuiet) {
@@ -414,10 +414,10 @@ TEST(CliRegression, LongPartNamesGiveValidFilesAndQuietStaysQuiet) {
   EXPECT_EQ(step, 2);
 }
 
-// --- hostile inputs (session of 2026-11-27, a sweep of bad inputs of every kind) ---------
+// --- hostile inputs: bad values of every kind ------------------------------------------
 
 // `--threads 0` and `--threads -1` ran with all cores, and `route --seed 5000000000` ran
-// with another seed (cut to 32 bits): each is now exit 2 naming the option and its range,
+// with another seed (cut to 32 bits): each is exit 2 naming the option and its range,
 // before any work.
 TEST(CliOptions, ThreadsAndSeedOutOfRangeAreUsageErrors) {
   const auto out = fresh_dir("threads_seed");
@@ -468,7 +468,7 @@ TEST(CliOptions, SpacingFarBelowTheCableNamesTheCableAndTheOption) {
 
 // An output path that is a directory failed only when its turn came: `audit` had written
 // nothing of use, `route` had left routed.xml, report.json and cables.ply beside a missing
-// view. Every target is now checked before any work, and nothing is written.
+// view. Every target is checked before any work, and nothing is written.
 TEST(CliOutputs, ATargetThatIsADirectoryStopsTheCommandBeforeAnyOutput) {
   namespace fs = std::filesystem;
   const std::vector<std::tuple<std::string, std::string, std::vector<std::string>>> cases = {
@@ -620,7 +620,7 @@ TEST(CliScan, CompareMeasuresBothWays) {
 
 // File names are bytes: one that is not UTF-8 (a Latin-1 name) made nlohmann's dump()
 // throw type_error 316 — `scan` had then written centerline.xml and tube.ply but no
-// report, `audit` nothing, both exit 2 naming nothing. Reports now carry U+FFFD for the
+// report, `audit` nothing, both exit 2 naming nothing. Reports carry U+FFFD for the
 // bad bytes.
 TEST(CliNames, NonUtf8FileNamesGiveCompleteReports) {
   const auto dir = fresh_dir("latin1");

@@ -1,4 +1,4 @@
-// The command-line contract under hostile use (review of 2026-11-27): report.json as DESIGN
+// The command-line contract under hostile use: report.json as DESIGN
 // §4 lists it, exit statuses, determinism across thread counts and runs, `--routes` files
 // that are not routes, option misuse and output paths. Every test runs the real `loom`
 // (LOOM_EXE) on scenes of a few cables around the unit box of tests/data/audit.

@@ -12,6 +12,7 @@
 #include <IGESControl_Writer.hxx>
 #include <STEPControl_Writer.hxx>
 #include <gtest/gtest.h>
+#include "common/shared_data.hpp"
 
 #include <cstring>
 #include <fstream>
@@ -296,6 +297,7 @@ TEST_F(TempDir, NestingDeeperThanTheLimitIsRefused) {
 }
 
 TEST(RealMeshes, CountsMatchTheirSources) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   struct Case {
     const char* file;
     std::size_t triangles;
@@ -309,12 +311,14 @@ TEST(RealMeshes, CountsMatchTheirSources) {
 }
 
 TEST(RealMeshes, GlbLoads) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   Mesh m = read_mesh_file(kData / "trimesh/CesiumMilkTruck.glb");
   EXPECT_GT(m.triangle_count(), 1000u);
   EXPECT_EQ(first_non_finite_vertex(m), -1);
 }
 
 TEST(RealCad, StepAssemblyKeepsProductNames) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   TessellationParams tp;
   tp.linear_deflection = 0.5;
   auto parts = read_cad_file(kData / "stepcode/as1-oc-214.stp", tp, true);
@@ -340,6 +344,7 @@ TEST(RealCad, StepAssemblyKeepsProductNames) {
 }
 
 TEST(RealCad, StepAndStlOfTheSamePartAgree) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   // featuretype.STEP and featuretype.STL are the same part (trimesh notes). The STEP file
   // carries its units (OpenCASCADE converts to mm); the STL has none and was written in
   // inches, so it is scaled by 25.4 here: a scene would say transform.scale = 25.4.
@@ -360,6 +365,7 @@ TEST(RealCad, StepAndStlOfTheSamePartAgree) {
 }
 
 TEST(RealCad, FinerDeflectionMoreTriangles) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   TessellationParams coarse, fine;
   coarse.linear_deflection = 1.0;
   fine.linear_deflection = 0.05;
@@ -369,6 +375,7 @@ TEST(RealCad, FinerDeflectionMoreTriangles) {
 }
 
 TEST(RealCad, CacheReturnsTheSameMeshes) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   const fs::path dir = fs::temp_directory_path() / "loom_tess_cache_test";
   fs::remove_all(dir);
   ::setenv("LOOM_CACHE_DIR", dir.c_str(), 1);
@@ -396,6 +403,7 @@ TEST(RealCad, CacheReturnsTheSameMeshes) {
 // std::bad_alloc on every run until the cache is deleted): it is a miss, re-tessellated
 // and stored again.
 TEST(RealCad, CorruptCacheEntryIsAMiss) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   const fs::path dir = fs::temp_directory_path() / "loom_tess_cache_corrupt";
   fs::remove_all(dir);
   ::setenv("LOOM_CACHE_DIR", dir.c_str(), 1);

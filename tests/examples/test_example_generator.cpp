@@ -1,4 +1,4 @@
-// The bundled wing-section example (issue 2): the generator is deterministic (a fresh run
+// The bundled wing-section example: the generator is deterministic (a fresh run
 // reproduces the committed files byte for byte), the committed scene loads, every port sits
 // on its receptacle facing free space, and for every segment of the harness tree a witness
 // corridor exists that is wider than the segment's bundle plus clearance — so a route
@@ -17,6 +17,7 @@
 #include <rapidcheck/gtest.h>
 
 #include "common/brute_geometry.hpp"
+#include "common/shared_data.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -251,7 +252,7 @@ TEST(ExampleGenerator, EverySegmentHasACorridorWiderThanItsBundle) {
 
 TEST(RealMeshesExample, LoadsWithPortsAndBranchPointClearOfEveryPart) {
   const fs::path toml = fs::path(LOOM_SOURCE_DIR) / "examples" / "real-meshes" / "scene.toml";
-  if (!fs::exists(fs::path(LOOM_SHARED_DATA) / "fcl" / "env.obj")) GTEST_SKIP() << "../shared/data is not beside the repository";
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data("fcl/env.obj"));
   loom::SceneLoadOptions opt;
   opt.use_cache = false;
   const loom::Scene s = loom::load_scene(toml, opt);

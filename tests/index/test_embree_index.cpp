@@ -11,6 +11,7 @@
 #include "core/error.hpp"
 
 #include <gtest/gtest.h>
+#include "common/shared_data.hpp"
 #include <rapidcheck/gtest.h>
 
 #include <tbb/parallel_for.h>
@@ -571,6 +572,7 @@ TEST(EmbreeIndex, RejectsBadMeshes) {
 }
 
 TEST(EmbreeIndex, RealMeshFromSharedData) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   Mesh m = read_obj(std::string(LOOM_SHARED_DATA) + "/fcl/env.obj");
   ASSERT_GT(m.triangle_count(), 1000u);
   weld_identical_vertices(m);

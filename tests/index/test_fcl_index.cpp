@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 
 #include <gtest/gtest.h>
+#include "common/shared_data.hpp"
 #include <rapidcheck/gtest.h>
 
 #include <random>
@@ -136,6 +137,7 @@ TEST(FclIndex, SmallTrianglesJustAboveTheThresholdStayInFcl) {
 }
 
 TEST(FclIndex, RealMeshFromSharedData) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   Mesh m = read_obj(std::string(LOOM_SHARED_DATA) + "/fcl/rob.obj");
   ASSERT_GT(m.triangle_count(), 100u);
   weld_identical_vertices(m);

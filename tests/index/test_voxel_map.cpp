@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 
 #include <gtest/gtest.h>
+#include "common/shared_data.hpp"
 #include <octomap/OcTree.h>
 #include <rapidcheck/gtest.h>
 
@@ -198,6 +199,7 @@ TEST(VoxelMap, SaveLoadRoundTripAndEdtOracle) {
 }
 
 TEST(VoxelMap, RealOctomapFile) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   const std::string path = std::string(LOOM_SHARED_DATA) + "/octomap/geb079.bt";
   const auto vm = VoxelMap::load_bt(path, VoxelOptions{0.0, 0.0});
   ASSERT_GT(vm->resolution(), 0.0);

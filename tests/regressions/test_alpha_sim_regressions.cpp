@@ -1,4 +1,4 @@
-// α-SIM regressions found by the adversarial tests (tests/index/test_alpha_sim_adversarial.cpp):
+// α-SIM regressions on hostile input (see tests/index/simplify/test_alpha_sim_adversarial.cpp):
 // one test per bug, inputs written out at full precision. The oracle (alpha_sim_oracle.hpp)
 // is independent of loom's indices.
 #include "core/io/mesh_read.hpp"
@@ -48,11 +48,11 @@ Mesh through_stl(const Mesh& m, const std::string& stem) {
 
 }  // namespace
 
-// 2026-11-27: a part 1e5 from the origin came out "ok", containment 1.0,
+// A part 1e5 from the origin came out "ok", containment 1.0,
 // but the binary STL that `loom simplify` writes rounds the computed vertices of the
 // simplified mesh to float32 (by up to 2e-3 here, tolerance 1e-5): 10% of the original's
 // samples lay outside the file, triangles collapsed (triangles_after and volume_after no
-// longer described the file). The mesh is now rounded to float32 before it is checked and
+// longer described the file). The mesh is rounded to float32 before it is checked and
 // measured (AlphaSimOptions::float32_vertices): here the rounding breaks containment, the
 // measure finds it and the original is kept, with the reason.
 TEST(AlphaSimRegression, FarPartStlContainsTheOriginal) {
@@ -66,11 +66,11 @@ TEST(AlphaSimRegression, FarPartStlContainsTheOriginal) {
       << alpha_sim_status_name(sp.result.status) << ": " << sp.result.reason;
 }
 
-// 2026-11-27: a translated copy of a part near the origin, placed 1e5
+// A translated copy of a part near the origin, placed 1e5
 // away, got the first part's simplified mesh moved (copy_of) — vertices that are not
 // float32, which the binary STL rounds by up to ~4e-3 (tolerance 1e-5): four of the copy's
 // 22 triangles collapsed in the file (18 read back, 22 reported), and nothing bounded its
-// containment. A copy's moved mesh is now rounded too and must stay within the share of
+// containment. A copy's moved mesh is rounded too and must stay within the share of
 // the tolerance kept for rounding (else the copy is simplified on its own: here the
 // original is kept).
 TEST(AlphaSimRegression, FarCopyStlContainsTheCopy) {
@@ -91,7 +91,7 @@ TEST(AlphaSimRegression, FarCopyStlContainsTheCopy) {
   }
 }
 
-// 2026-11-27: `loom simplify --dim-pre 1e-300` (a valid finite > 0
+// `loom simplify --dim-pre 1e-300` (a valid finite > 0
 // value) on a part with a face seen edge-on in a projection: L_max² underflowed to 0, the
 // sample estimate of that plane was 0/0 = NaN, `NaN > max_cloud_points` is false, and the
 // part went on to be sampled at L_max = 5e-301 (lattice indices converted from ~1e301 to

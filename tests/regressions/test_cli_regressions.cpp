@@ -1,4 +1,4 @@
-// Regressions of the command-line contract review (2026-11-27): one test per bug found in
+// Regressions of the command-line contract: one test per bug in
 // `loom audit|route|render` options, `--routes` files and outputs, inputs written out in
 // full. Every test runs the real executable (LOOM_EXE) on tiny scenes.
 #include <gtest/gtest.h>
@@ -70,7 +70,7 @@ void write_scene(const fs::path& dir, const std::vector<TestCable>& cables) {
 
 // `--threads 100000` (audit and route) made a TBB task arena of 10⁵ slots and the process
 // died of a segmentation fault in tbb::task_arena::terminate, leaving a staging directory
-// behind in --out. `--threads` now takes 1..1024 (exit 2 naming the range, no output).
+// behind in --out. `--threads` takes 1..1024 (exit 2 naming the range, no output).
 TEST(CliRegression, HugeThreadCountIsAUsageErrorNotACrash) {
   const fs::path dir = scratch("threads");
   for (const std::string& cmd :
@@ -86,7 +86,7 @@ TEST(CliRegression, HugeThreadCountIsAUsageErrorNotACrash) {
 // `audit --routes FILE` replaced the scene's harness with whatever FILE held: a cable of the
 // scene missing from FILE went unchecked (exit 0), a cable the scene does not have was
 // audited, and a cable joining other ports or of another diameter was taken as routed.
-// Each is now exit 2 naming the routes file, the line and the cable (audit and render).
+// Each is exit 2 naming the routes file, the line and the cable (audit and render).
 TEST(CliRegression, RoutesFileOfAnotherHarnessIsRefusedNamingFileLineAndCable) {
   const fs::path dir = scratch("routes");
   write_scene(dir, {{"C1", "J1", "J2"}, {"C2", "J3", "J4"}});
@@ -126,7 +126,7 @@ TEST(CliRegression, RoutesFileOfAnotherHarnessIsRefusedNamingFileLineAndCable) {
 
 // `audit --method discrete --tolerance T` (or `--no-index --tolerance T`) ignored T, and
 // `audit --spacing L` with the certified method ignored L, both without a word: each is
-// now exit 2 naming the option and the method it belongs to, before any output.
+// exit 2 naming the option and the method it belongs to, before any output.
 TEST(CliRegression, AccuracyOptionOfTheOtherMethodIsRefused) {
   const fs::path dir = scratch("method_options");
   const std::string scene = kAuditData + "/clean.toml";
@@ -148,7 +148,7 @@ TEST(CliRegression, AccuracyOptionOfTheOtherMethodIsRefused) {
 
 // `audit --tolerance 1e9` (or anything at or above a cable's radius) ran and reported the
 // audit "certified" to a tolerance at which a cable lying on a part's surface may be
-// missed. A requested tolerance must now lie below the thinnest cable's radius (exit 2).
+// missed. A requested tolerance must lie below the thinnest cable's radius (exit 2).
 TEST(CliRegression, ToleranceNotBelowTheThinnestCableRadiusIsRefused) {
   const fs::path dir = scratch("tolerance");
   for (const std::string t : {"1", "1e9"}) {  // clash.toml: one cable of radius 1 through the box
@@ -182,7 +182,7 @@ TEST(CliRegression, BadRenderSizeMakesNoOutputDirectory) {
 // An audit of a harness whose branch point has no position yet checked none of its cables,
 // said so in report.json ("routed": false, a reason) and exited 0, "ran and found nothing":
 // a CI gate on the exit status passed a harness nobody had checked. Cables left unchecked
-// now give exit 3, as `route` gives for cables it could not route (DESIGN §4).
+// give exit 3, as `route` gives for cables it could not route (DESIGN §4).
 TEST(CliRegression, AnAuditThatLeftCablesUncheckedWasExitZero) {
   const fs::path dir = scratch("unchecked");
   write_scene(dir, {});

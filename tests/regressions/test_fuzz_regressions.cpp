@@ -1,8 +1,8 @@
-// One test per reader finding of the mutational fuzzing campaign against the loom executable
+// One test per reader bug exposed by mutational fuzzing of the loom executable
 // (crashes, hangs and silently wrong readings of hostile mesh, STEP, TOML and harness files).
-// Each input is written out here (or generated, where it is large); each test failed before
-// its fix. Inputs that crashed or hung the process are run through the command line under
-// `timeout`, so that the old behaviour fails the test instead of killing or stalling it.
+// Each input is written out here (or generated, where it is large); each test fails on a reader
+// with that bug. Inputs that crashed or hung the process are run through the command line under
+// `timeout`, so that a crash or hang fails the test instead of killing or stalling it.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -233,7 +233,7 @@ TEST(FuzzRegression, MeshNodeFanOutExpandedExponentially) {
 
 // 40,000 one-triangle `o` objects took 4.7 s of CPU where the same triangles in one object
 // took 0.4 s, growing quadratically (100,000: 28 s): Assimp looks each object (and `usemtl`
-// material) name up in a list. Assimp now gets those statements as comments, byte for byte.
+// material) name up in a list. Assimp gets those statements as comments, byte for byte.
 TEST(FuzzRegression, ObjManyObjectsLoadedQuadratically) {
   const std::string text = "o a\nv 0 0 0\n  usemtl m1\nv 1 0 0\nv 0 1 0 \\\no x\nf 1 2 3\nobj\ng grp\n";
   const std::string served = loom::obj_text_for_assimp(text);

@@ -1,5 +1,5 @@
-// Regressions of the curve-geometry review (centerline, fairing, sweep, tube validity,
-// cable geometry): one test per bug found, inputs written out.
+// Regressions of the curve geometry (centerline, fairing, sweep, tube validity,
+// cable geometry): one test per bug, inputs written out.
 #include "core/centerline.hpp"
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
@@ -86,7 +86,7 @@ loom::Part box_part(const Vec3& lo, const Vec3& hi) {
 
 // Bug: sweeping a tube around a bend tighter than its radius (κ·r > 1) — or a kink of a
 // polyline — turned the inner side of the mesh inside out (inverted, crossing facets) and
-// said nothing: SweepResult had no way to tell. Now it reports the fold and where.
+// said nothing: SweepResult had no way to tell. It reports the fold and where.
 TEST(GeometryRegression, TubeFoldingAroundATightBendIsReported) {
   const double r = 2.0;
   const Centerline tight = arc(1.0, 0.5 * M_PI);  // bend radius 1 < r: the tube folds
@@ -181,7 +181,7 @@ TEST(GeometryRegression, CableThroughAnUnclampedExactSplineFollowsItsSegments) {
 // Bug: join() glued consecutive segment curves by dropping the next piece's first control
 // point, whatever the gap: an exact <bspline> stopping 5 mm short of its branch point was
 // silently bent over to meet the previous piece, so the cable's audited curve was not the
-// file's segment. Now a gap beyond rounding is a clear error naming the harness and cable.
+// file's segment. A gap beyond rounding is a clear error naming the harness and cable.
 // (The branch point has no position here: with one, the curve's end is checked against it
 // first, GeometryRegression.ExactSplineAwayFromItsPortsIsAClearError.)
 TEST(GeometryRegression, CableWhoseSegmentsDoNotMeetIsAClearError) {
@@ -220,7 +220,7 @@ TEST(GeometryRegression, CableWhoseSegmentsDoNotMeetIsAClearError) {
 // Bug: the tube of a zero-length centerline (an exact <bspline> whose control points
 // coincide) was five coincident rings: a closed but flat mesh of zero volume, two discs
 // facing away from each other. The cable is the ball of radius r around its one point
-// (DESIGN §5); now its tube is that ball's sphere mesh (as at a junction).
+// (DESIGN §5); its tube is that ball's sphere mesh (as at a junction).
 TEST(GeometryRegression, ZeroLengthCableSweepsToItsBall) {
   const Vec3 p(1, 2, 3);
   const double r = 0.5, tol = 0.01;
@@ -244,7 +244,7 @@ TEST(GeometryRegression, ZeroLengthCableSweepsToItsBall) {
 
 // Bug: an exact <bspline> was taken as the segment wherever it lay: one 495 mm away from
 // both its ports was audited (exit 0, "clean") as the cable between them. A segment's
-// exact curve must now start at its from-node and end at its to-node where the file places
+// exact curve must start at its from-node and end at its to-node where the file places
 // them (within rounding); otherwise the harness is refused naming the file, cable, segment,
 // node and gap.
 TEST(GeometryRegression, ExactSplineAwayFromItsPortsIsAClearError) {

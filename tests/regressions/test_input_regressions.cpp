@@ -1,8 +1,7 @@
-// One test per bad-input bug found by the sweep of hostile inputs of 2026-11-27 (every
-// input kind truncated, empty, garbage, huge, non-finite, non-UTF-8, deeply nested; every
-// option given bad values). Each input is written out in full; each test failed before its
-// fix. The readers' own catalogues of checks are in tests/core/test_*_io.cpp,
-// tests/routing/test_point_cloud_io.cpp and tests/app/test_cli.cpp (CliOptions, CliRender,
+// One test per bad-input bug (every input kind truncated, empty, garbage, huge, non-finite,
+// non-UTF-8, deeply nested; every option given bad values). Each input is written out in
+// full, and each test fails on a loom that mishandles it. The readers' own catalogues of checks are in tests/core/test_*_io.cpp,
+// tests/routing/scan/test_point_cloud_io.cpp and tests/app/test_cli.cpp (CliOptions, CliRender,
 // CliRoutes, CliNames).
 #include <gtest/gtest.h>
 
@@ -30,6 +29,7 @@
 #include "routing/curve/cable_geometry.hpp"
 #include "routing/scan/point_cloud_io.hpp"
 #include "common/run_loom.hpp"
+#include "common/shared_data.hpp"
 
 namespace {
 
@@ -133,7 +133,7 @@ TEST(Regression, DeepMeshNodeNestingOverflowedTheStack) {
 
 // A PLY header declaring 4e9 vertices in a 200-byte file: Assimp allocated them up front
 // (48 GB; "cannot read mesh: std::bad_alloc" where memory ran short, and a machine with
-// that much memory was swept clean). The counts are now checked against the file's size.
+// that much memory was swept clean). The counts are checked against the file's size.
 TEST(Regression, MeshHeaderCountsWereAllocatedUnchecked) {
   const fs::path d = scratch();
   write(d / "m.ply", replaced(kPlyTriangle, "element vertex 3", "element vertex 4000000000") + "3 0 1 2\n");
@@ -143,7 +143,7 @@ TEST(Regression, MeshHeaderCountsWereAllocatedUnchecked) {
 
 // A PLY face whose list length field says 10⁸ (or 4·10⁹) in a 100-byte file: Assimp
 // allocated the list before reading it (830 MB; "cannot read mesh: std::bad_alloc" for
-// 4·10⁹, naming no element). Every list length is now checked against the bytes left.
+// 4·10⁹, naming no element). Every list length is checked against the bytes left.
 TEST(Regression, PlyListLengthWasAllocatedUnchecked) {
   const fs::path d = scratch();
   std::string bin = replaced(replaced(kPlyTriangle, "ascii", "binary_little_endian"), "0 0 0\n1 0 0\n0 1 0\n", "");
@@ -244,7 +244,7 @@ TEST(Regression, NonUtf8HarnessTextBrokeTheReports) {
 
 // A file name that is not UTF-8 (a Latin-1 "c\xff.xyz") reached report.json: nlohmann's
 // dump() threw type_error 316 after `scan` had written centerline.xml and tube.ply, exit 2
-// with a message naming nothing. Reports now carry U+FFFD for the bad bytes, and scan makes
+// with a message naming nothing. Reports carry U+FFFD for the bad bytes, and scan makes
 // every output's text before it writes the first.
 TEST(Regression, NonUtf8FileNameBrokeTheReports) {
   const fs::path d = scratch();
@@ -337,7 +337,7 @@ TEST(Regression, RenderReportOfTheWrongShapeWasTakenOrNamedNothing) {
   }
 }
 
-// --- input adversarial review (2026-11-27, second sweep) -----------------------------------
+// --- special files, links and cache entries as inputs --------------------------------------
 
 // A STEP part that is a FIFO, or a link to /dev/zero, hung `loom info` for ever: the
 // tessellation cache hashed the file's bytes for its key before the reader checked that it
@@ -355,7 +355,7 @@ TEST(Regression, CadCacheHashedADeviceBeforeCheckingIt) {
 }
 
 // Assimp opens the files a mesh refers to itself: a glTF buffer uri naming a FIFO blocked
-// `loom info` for ever (an OBJ's mtllib naming one too). Only regular files are opened now;
+// `loom info` for ever (an OBJ's mtllib naming one too). Only regular files are opened;
 // the glTF is refused naming the reference, the OBJ loads without its materials.
 TEST(Regression, MeshReferenceToAFifoHung) {
   const fs::path d = scratch();
@@ -454,8 +454,8 @@ TEST(Regression, HarnessTableWithoutFileNamedNoLine) {
 // and a product named "bolt#2") gave two pieces the name "bolt#2": the scene then refused a
 // valid file ("duplicate part name 'as1/bolt#2'"), every run, since the cache kept the names.
 TEST(Regression, StepProductNamedLikeASuffixClashed) {
-  const fs::path as1 = fs::path(LOOM_SHARED_DATA) / "stepcode/as1-oc-214.stp";
-  if (!fs::exists(as1)) GTEST_SKIP() << "shared data not present: " << as1;
+  const fs::path as1 = loom::testing::shared_data("stepcode/as1-oc-214.stp");
+  LOOM_SHARED_DATA_OR_SKIP(as1);
   const fs::path d = scratch();
   const std::string text = replaced(slurp(as1), "PRODUCT('l-bracket','l-bracket'", "PRODUCT('bolt#2','bolt#2'");
   write(d / "as1.stp", text);

@@ -2,7 +2,7 @@
 // case replays without the generator or seed that found it. Name: area, what broke.
 // Bugs of the command line are replayed where the command runs: tests/app/test_cli.cpp,
 // CliRegression.* (e.g. given option values taken for "use the default").
-// A sweep of bad inputs: CliRegression.NumbersBeyondAnySceneAreRefused,
+// Bad-input regressions replayed elsewhere: CliRegression.NumbersBeyondAnySceneAreRefused,
 // .TessellationFinerThanTheFileCanHoldIsExitTwo, .LongPartNamesGiveValidFilesAndQuietStaysQuiet
 // (tests/app/test_cli.cpp) and ClashCheck.ARouteWigglingAtTheToleranceIsRefusedNotFlattened
 // (tests/routing/test_clash_check.cpp).
@@ -30,6 +30,7 @@
 #include "routing/curve/sweep.hpp"
 
 #include "common/brute_geometry.hpp"
+#include "common/shared_data.hpp"
 #include "index/index_test_meshes.hpp"
 
 namespace {
@@ -47,7 +48,7 @@ loom::Part shared_part(const char* name, const char* rel) {
   return p;
 }
 
-// 2026-11-21: SweepProperty (RapidCheck, random seed) found a step
+// SweepProperty (RapidCheck, random seed) found a step
 // where the double-reflection normal turned 1e-7 rad more than the tangent (0.0217073 vs
 // 0.0217072). Not a sweep bug: double reflection approximates the rotation-minimising
 // frame with an O(turn³) local error; the property's bound was too tight. The frame must
@@ -75,10 +76,10 @@ TEST(Regression, SweepDoubleReflectionTurnsWithinThirdOrderOfTheTangent) {
   EXPECT_GT(worst_excess, 1e-9);
 }
 
-// 2026-11-21: BoxPairs.EqualsBruteForce (RapidCheck) aborted the process in
+// BoxPairs.EqualsBruteForce (RapidCheck) aborted the process in
 // Embree's BVH builder (assertion `diag[dim] > 0.0f`, heuristic_openmerge_array.h) on two
 // equal point boxes: re-centred on their own centre, they rounded to float boxes of zero
-// size (denormals flushed). The broad phase now pads every float box outwards by a normal
+// size (denormals flushed). The broad phase pads every float box outwards by a normal
 // float length, so no set of boxes has zero extent.
 TEST(Regression, BoxPairsTwoEqualPointBoxesDoNotAbortTheBuilder) {
   for (const Vec3& p : {Vec3(0, 0, 0), Vec3(1, 1, 1), Vec3(0.1, -2.5, 7.0)}) {
@@ -104,7 +105,7 @@ loom::Part unit_box_part() {
   return p;
 }
 
-// 2026-11-22: the new segment_closest_approx test (brute force oracle) found
+// The segment_closest_approx test (brute force oracle) found
 // that a segment through a surface was "not found" with max_radius 0: the search keeps a
 // hit only if it beats best² = radius², and 0 does not beat 0. A hit equal to the caller's
 // radius counts while nothing has been found (brute force already did so).
@@ -116,7 +117,7 @@ TEST(Regression, EmbreeSegmentThroughASurfaceIsFoundWithRadiusZero) {
   EXPECT_TRUE(e.segment_closest_on_part(Vec3(0.5, 0.5, -1.0), Vec3(0.5, 0.5, 2.0), 0, 0.0).found());
 }
 
-// 2026-11-22: the first segment_closest_approx
+// The first segment_closest_approx
 // shrank the search sphere to max_radius / (1 + ε) before any hit, so a surface between
 // the two was lost and "nothing within max_radius" came out wrong (the audit's approximate
 // run then ended a contact stretch early, ClashApproximate.InsideAHull…). A short segment
@@ -148,7 +149,7 @@ TEST(Regression, EmbreeApproximateSegmentQueryKeepsTheCallersRadiusUntilAHit) {
 // strictly inside. Its midpoint equalled one end, the edge ending there was not counted as
 // crossing it, the slab came out empty, and the solid got an internal crack of width
 // 4e-16 (two full cross-sections facing away from each other), measured as a Hausdorff
-// distance of 1.11 against 0.25. Spanning is now decided from the edges' ends.
+// distance of 1.11 against 0.25. Spanning is decided from the edges' ends.
 TEST(Regression, ExtrusionPairSlabOneRoundingStepThickKeepsItsMaterial) {
   using loom::Extrusion;
   using loom::PolygonWithHoles2;
@@ -187,12 +188,13 @@ TEST(Regression, ExtrusionPairSlabOneRoundingStepThickKeepsItsMaterial) {
   EXPECT_GT(pm.mesh.signed_volume(), 0.0);
 }
 
-// 2026-11-26: α-SIM's CGAL corefinement (the third prism) gave the same solid
+// α-SIM's CGAL corefinement (the third prism) gave the same solid
 // with its vertices and triangles in a different order about one run in three
 // (AlphaSim.DeterministicAcrossRuns under ctest). CGAL's box intersection breaks ties of
 // equal box bounds by box address, so the intersection points were numbered in heap
-// order. mesh_intersection now sorts its output; here the heap is disturbed between runs.
+// order. mesh_intersection sorts its output; here the heap is disturbed between runs.
 TEST(Regression, AlphaSimCorefinementOrderDoesNotFollowTheHeap) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   loom::Part motor;
   motor.name = "motor";
   motor.mesh = loom::read_mesh_file(std::filesystem::path(LOOM_SHARED_DATA) / "occt/motor.stl");
@@ -213,14 +215,14 @@ TEST(Regression, AlphaSimCorefinementOrderDoesNotFollowTheHeap) {
   }
 }
 
-// 2026-11-26: two turned boxes apart (AlphaSimProperty, comparing CGAL's
+// Two turned boxes apart (AlphaSimProperty, comparing CGAL's
 // corefinement with OpenCASCADE's Booleans as its oracle): OpenCASCADE's result, 424 mm³
 // (528 in another run), lost a piece of the prisms' intersection that the implicit solid
 // holds (~12k of 400k random points inside the implicit solid and outside the mesh);
 // CGAL's is 580.5 mm³ and holds it. The lost piece holds no surface of the boxes, so the
 // containment check passed: the error was silent. With the outlines not grown
-// (polygon_growth_factor 0) both give 580.48. CGAL runs the Booleans unless STEP output is
-// asked for; this checks that its mesh holds the implicit solid on this input.
+// (polygon_growth_factor 0) both give 580.48. The default path is CGAL's; this checks
+// that its mesh holds the implicit solid on this input (it fails with occt_booleans).
 TEST(Regression, AlphaSimMeshHoldsTheImplicitSolidOfTwoTurnedBoxes) {
   loom::Part boxes;
   boxes.name = "boxes";
@@ -259,10 +261,12 @@ TEST(Regression, AlphaSimMeshHoldsTheImplicitSolidOfTwoTurnedBoxes) {
 // one to six fresh random samples 1.2–70× the tolerance outside a shape, in slivers that
 // silhouette triangles (seen nearly edge-on) project to between the lattice nodes; each
 // repair closed the points found, the next round found others, and after three rounds
-// the plane became its hull. The slivers' edges are now checked exactly (segment_gaps)
-// and every triangle is tested whole against every shape (AlphaShape2D::triangle_gaps), so
-// no plane depends on random samples to be repaired.
+// the plane became its hull. The slivers' edges are checked exactly (segment_gaps)
+// and closed in the first repair of a plane's sample misses
+// (AlphaSimOptions::thin_edge_factor), and a plane becomes its hull only after three
+// repairs of its own (the rounds were counted for all planes together).
 TEST(Regression, AlphaSimBunnyIsNotThreeConvexHulls) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   const loom::Part bunny = shared_part("bunny", "trimesh/bunny.ply");
   loom::AlphaSimOptions o;
   o.dim_pre = 0.02 * bunny.mesh.bounds().diagonal();
@@ -281,7 +285,7 @@ TEST(Regression, AlphaSimBunnyIsNotThreeConvexHulls) {
 // do: after the third outline's
 // corefinement, faces whose boundary touches itself (a vertex used twice, or two copies of
 // a vertex at one point) kept every triangle and vertex, since their boundary could not be
-// walked as loops. merge_face_vertices now gives the triangulation the boundary's chords
+// walked as loops. merge_face_vertices gives the triangulation the boundary's chords
 // between kept vertices as constraints, which needs no loops (the wing's files at that
 // tessellation: 1,344 -> 980 triangles).
 TEST(Regression, AlphaSimFacesTouchingThemselvesAreMerged) {
@@ -308,39 +312,46 @@ TEST(Regression, AlphaSimFacesTouchingThemselvesAreMerged) {
 
 }  // namespace
 
-// A random-sample verification (4 samples per L_max², fresh ones each round) passed shapes
-// that did not hold every triangle of the part: on the bunny at dim_pre = 4% of its
-// diagonal the implicit solid left 4 of 209,916 points of a lattice on the triangles
-// (L_max/4 apart, corners and edges included) outside by more than the tolerance: slivers
-// the random samples, a few per L_max², never fell in. Every triangle is now tested whole
-// against every shape (AlphaShape2D::triangle_gaps) and what is found is repaired.
+// The random-sample verification (4 samples per L_max², fresh ones
+// each round) passed shapes that did not hold every triangle of the part. On the bunny at
+// dim_pre = 4% of its diagonal the implicit solid left 4 of 209,916 points of a lattice
+// on the triangles (L_max/4 apart, corners and edges included) outside by more than the
+// tolerance: slivers the random samples, a few per L_max², never fell in. Exact
+// containment (AlphaSimOptions::exact_containment, the default) tests every triangle
+// whole against every shape (AlphaShape2D::triangle_gaps) and repairs what it finds.
 TEST(Regression, AlphaSimRandomSamplesMissedSliversOfTheSurface) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   const loom::Part bunny = shared_part("bunny", "trimesh/bunny.ply");
-  loom::AlphaSimOptions o;
-  o.dim_pre = 0.04 * bunny.mesh.bounds().diagonal();
-  const loom::AlphaSimPart sp = loom::simplify_part(bunny, o);
-  EXPECT_EQ(sp.result.status, loom::AlphaSimStatus::Ok) << sp.result.reason;
-  EXPECT_DOUBLE_EQ(sp.result.containment, 1.0);
-  ASSERT_TRUE(sp.solid);
-  std::size_t out = 0, points = 0;
-  for (const auto& f : bunny.mesh.triangles) {
-    const loom::Vec3 a = bunny.mesh.vertices[f[0]], b = bunny.mesh.vertices[f[1]], c = bunny.mesh.vertices[f[2]];
-    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
-    const int n = std::max(1, static_cast<int>(std::ceil(longest / (sp.result.l_max / 4.0))));
-    for (int i = 0; i <= n; ++i)
-      for (int j = 0; i + j <= n; ++j, ++points)
-        out += sp.solid->contains(a + (b - a) * (double(i) / n) + (c - a) * (double(j) / n), sp.result.tolerance) ? 0 : 1;
-  }
-  EXPECT_GT(points, 200000u);
-  EXPECT_EQ(out, 0u);
+  auto outside = [&](bool exact) {
+    loom::AlphaSimOptions o;
+    o.dim_pre = 0.04 * bunny.mesh.bounds().diagonal();
+    o.exact_containment = exact;
+    o.coarse_interior = exact;  // sampled containment, or exact (the default)
+    const loom::AlphaSimPart sp = loom::simplify_part(bunny, o);
+    EXPECT_EQ(sp.result.status, loom::AlphaSimStatus::Ok) << sp.result.reason;
+    EXPECT_DOUBLE_EQ(sp.result.containment, 1.0);  // the mesh's own samples pass either way
+    std::size_t out = 0;
+    for (const auto& f : bunny.mesh.triangles) {
+      const loom::Vec3 a = bunny.mesh.vertices[f[0]], b = bunny.mesh.vertices[f[1]], c = bunny.mesh.vertices[f[2]];
+      const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+      const int n = std::max(1, static_cast<int>(std::ceil(longest / (sp.result.l_max / 4.0))));
+      for (int i = 0; i <= n; ++i)
+        for (int j = 0; i + j <= n; ++j)
+          out += sp.solid->contains(a + (b - a) * (double(i) / n) + (c - a) * (double(j) / n), sp.result.tolerance) ? 0 : 1;
+    }
+    return out;
+  };
+  EXPECT_GT(outside(false), 0u);
+  EXPECT_EQ(outside(true), 0u);
 }
 
 // fill_pinches visited the pinched vertices in the order of their
 // handles (heap addresses), and filling around one vertex changes its neighbours, so the
 // same part came out differently as the heap moved: the tube at 1% of its diagonal gave
-// 152 or 168 triangles, from run to run and within one process. The vertices are now
+// 152 or 168 triangles, from run to run and within one process. The vertices are
 // visited in the order of their points. Memory held between the runs moves the heap.
 TEST(Regression, AlphaSimPinchFillsDoNotFollowTheHeap) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   const loom::Part tube = shared_part("tube", "trimesh/tube.obj");
   loom::AlphaSimOptions o;
   o.dim_pre = 0.01 * tube.mesh.bounds().diagonal();
@@ -356,14 +367,14 @@ TEST(Regression, AlphaSimPinchFillsDoNotFollowTheHeap) {
   }
 }
 
-// 2026-11-26: with one ray per inside test (what α-SIM wanted for its
+// With one ray per inside test (what α-SIM wanted for its
 // watertight output, 3× fewer rays), α-SIM's containment check found 0.9999931 of the
 // motor's samples inside (CgalBooleansGiveTheSolidOfOpenCascade). Embree's float ray test
 // put crossings that lie 1e-5..6e-3 of a triangle's width from a shared edge (more than the
 // barycentric grazing margin, 1e-6) on the neighbouring triangle, whose exact test then
 // missed, or on neither: the crossing was lost and the parity flipped. The majority of
 // three rays had hidden it. A crossing within the float rounding of the ray test (the
-// culling pad, over the cosine of the incidence) of an edge now grazes, and when every ray
+// culling pad, over the cosine of the incidence) of an edge grazes, and when every ray
 // grazes the winding number decides. Four points that one ray classified wrongly: a fine
 // sphere (96 × 48) with a box 4000 units away, so the index centre is 2000 away from it.
 TEST(Regression, EmbreeOneRayInsideKeepsCrossingsNearSharedEdges) {
@@ -389,11 +400,11 @@ TEST(Regression, EmbreeOneRayInsideKeepsCrossingsNearSharedEdges) {
   for (const auto& c : cases) EXPECT_EQ(e.inside(c.p), c.inside) << c.p.transpose();
 }
 
-// 2026-11-26: a direct test of chord flattening (tests/routing/test_chord_plan)
+// A direct test of chord flattening (tests/routing/test_chord_plan)
 // found chords up to 2.9× longer than the longest allowed (kMaxChordRadii · r, which keeps
 // the self rule |s − t| ≥ πr sharp): a span was cut into its arc length / hmax chords
 // uniformly in u, so where the speed varies along the span the fast end's chords were
-// longer. Now the count comes from a bound on |C'| over the span (length_chords). One
+// longer. The count comes from a bound on |C'| over the span (length_chords). One
 // span whose speed grows from 3 to 294: 50 chords before, the last ~5.9 long.
 TEST(Regression, ChordsStayWithinTheLongestAllowedWhereTheSpeedVaries) {
   const Centerline c(3, {0, 0, 0, 0, 1, 1, 1, 1}, {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0), Vec3(100, 0, 0)});
@@ -405,7 +416,7 @@ TEST(Regression, ChordsStayWithinTheLongestAllowedWhereTheSpeedVaries) {
   EXPECT_EQ(static_cast<double>(ch.size()), loom::planned_chords(c, eps, hmax, 0.0));
 }
 
-// --- 2026-11-27, adversarial tests of the certified audit (tests/routing/test_clash_adversarial.cpp).
+// --- the certified audit on adversarial routes (tests/routing/audit/test_clash_adversarial.cpp).
 
 namespace {
 
@@ -439,7 +450,7 @@ loom::ClashResult regression_audit(const std::vector<loom::CableInput>& cables, 
 // apart, were in contact. Beside a fold that is where the contact is deepest: a V of 60°
 // (legs of 10 r, chords ending at the corner) touches itself at clearance
 // π r sin 30° − 2 r = −0.429 r exactly π r from the corner along both legs, and the audit
-// reported −2e-16 (the 45° V: −0.586 for −0.798). Now such a pair is measured at its
+// reported −2e-16 (the 45° V: −0.586 for −0.798). Such a pair is measured at its
 // closest points at least π r apart (on the band's edge |s − t| = π r).
 TEST(Regression, SelfContactBesideAFoldWasExcusedWithTheFold) {
   const double r = 1.0, tol = 0.01, theta = M_PI / 3.0;
@@ -457,7 +468,7 @@ TEST(Regression, SelfContactBesideAFoldWasExcusedWithTheFold) {
 // The certified structure pass kept one inside part, the first the index named: a cable
 // whose axis lay inside two overlapping closed parts (a keep-out zone drawn around a box)
 // clashed with one of them only — or, crossing into the inner one, had the outer one's
-// stretch cut in two. Now every closed part holding the axis is tracked.
+// stretch cut in two. Every closed part holding the axis is tracked.
 TEST(Regression, CableInsideTwoOverlappingClosedPartsClashedWithOneOnly) {
   const std::vector<loom::Part> parts{loom::testmesh::box_part("a", Vec3(-100, -100, -100), Vec3(60, 100, 100)),
                                       loom::testmesh::box_part("b", Vec3(-60, -100, -100), Vec3(100, 100, 100))};
@@ -485,7 +496,7 @@ TEST(Regression, InsideStretchEndedAtTheLastProvenClearSample) {
 // contact. Where two cables part at a junction still touching, the clash is deepest just
 // outside the junction's ball: B leaving A at 5° from a branch point J of radius 3 touches
 // it at clearance −0.252 r on the ball's edge, and the audit reported −0.167 r (leaving a
-// bundle segment without a junction, −0.5 r: missed). Now such a pair is measured at its
+// bundle segment without a junction, −0.5 r: missed). Such a pair is measured at its
 // closest points outside the excused region.
 TEST(Regression, ContactLeavingAJunctionWasExcusedWithItsClosestPoints) {
   const double r = 1.0, tol = 0.01, slope = std::tan(5.0 * M_PI / 180.0), jr = 3.0;
@@ -515,7 +526,7 @@ TEST(Regression, ContactLeavingAJunctionWasExcusedWithItsClosestPoints) {
 // closest point of the first chord past the exit is often the exit's end itself: the rest
 // of that chord, not excused, went unmeasured. A cable leaving a box face along its normal,
 // attached over s ∈ [0, 3], is 2.0 from the box just past the exit with 3.0 required; the
-// violation was not reported at all. Chords now end where attachments do, and a chord is
+// violation was not reported at all. Chords end where attachments do, and a chord is
 // excused only if it lies within the range.
 TEST(Regression, ClearanceJustPastAPortExitWasExcusedWithTheExit) {
   const std::vector<loom::Part> parts{loom::testmesh::box_part("box", Vec3(0, 0, 0), Vec3(10, 10, 10))};
@@ -552,7 +563,7 @@ TEST(Regression, AnExitThroughThePlateItsPortSitsOnWasExcused) {
   EXPECT_LT(res.clashes[0].s, 1.0 + 0.01) << in;
 }
 
-// 2026-11-27: EmbreeIndex's one-ray inside test is documented exact on a watertight mesh,
+// EmbreeIndex's one-ray inside test is documented exact on a watertight mesh,
 // but Embree's float ray test can report neither of two triangles when the ray passes
 // within its rounding of their common edge (embree issue #387), and only reported
 // triangles were checked for grazing. Here α-SIM's own simplified mesh of a sliver
@@ -560,7 +571,7 @@ TEST(Regression, AnExitThroughThePlateItsPortSitsOnWasExcused) {
 // winding number 1), the first ray passes 3e-8 from the edge 10–11, Embree reports no
 // crossing at all and the point came out outside; 57 of 200,000 points on the sliver did
 // (α-SIM then called its mesh "contains only 0.9991 of the samples" and kept the original).
-// A missed crossing can as well make an outside point inside. Each ray now runs through
+// A missed crossing can as well make an outside point inside. Each ray runs through
 // the candidate's whole box both ways: a closed part crosses a line an even number of
 // times, so an odd count shows a crossing Embree missed and the ray is discarded.
 TEST(Regression, EmbreeInsideRayMissedACrossingAtASharedEdge) {
@@ -618,7 +629,7 @@ TEST(Regression, EmbreeInsideRayMissedACrossingAtASharedEdge) {
 // A cable with two tight corners far apart got one bend-radius violation, at the tighter
 // (the report's "one entry per contiguous stretch" held for clashes only): mending it and
 // auditing again showed the second. A polyline with corners at s = 10 and s = 60 (radius 0,
-// minimum 5) now gives a violation at each.
+// minimum 5) gives a violation at each.
 TEST(Regression, OnlyTheTightestBendOfACableWasReported) {
   const std::vector<loom::Part> parts{loom::testmesh::box_part("box", Vec3(0, 0, -100), Vec3(10, 10, -90))};
   loom::CableInput c =

@@ -9,6 +9,7 @@
 #include "index/index_test_meshes.hpp"
 
 #include <gtest/gtest.h>
+#include "common/shared_data.hpp"
 #include <rapidcheck/gtest.h>
 
 #include <algorithm>
@@ -254,6 +255,7 @@ void expect_inside_grid_agrees(const AlphaShape2D& s, const std::vector<Vec2>& p
 }  // namespace
 
 TEST(AlphaShape2D, InsideGridAgreesWithPointLocation) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   // Annulus on a grid: the inside grid's cells fall on the sample lattice, so boundary
   // edges and samples lie exactly on cell borders.
   std::vector<Vec2> annulus;
@@ -1126,6 +1128,7 @@ TEST(AlphaSim, UserPlaneTightensADiagonalPart) {
 class AlphaSimReal : public ::testing::TestWithParam<std::pair<const char*, double>> {};
 
 TEST_P(AlphaSimReal, ContainsTheOriginal) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   const std::filesystem::path file = std::filesystem::path(LOOM_SHARED_DATA) / GetParam().first;
   Part p = make_part(file.filename().string(), read_mesh_file(file));
   const double dim = GetParam().second * p.mesh.bounds().diagonal();
@@ -1173,6 +1176,7 @@ INSTANTIATE_TEST_SUITE_P(SharedData, AlphaSimReal,
                                            std::make_pair("trimesh/bunny.ply", 0.04)));
 
 TEST(AlphaSim, LatticeBitmapGivesTheSortedSampleSets) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   // The lattice nodes and cell centres are deduplicated on a bitmap; the reference sorts
   // every point (lattice_bitmap = false). Same sets, sorted and unique, on real parts.
   for (const char* name : {"occt/motor.stl", "trimesh/featuretype.STL", "fcl/env.obj"}) {
@@ -1202,6 +1206,7 @@ TEST(AlphaSim, LatticeBitmapGivesTheSortedSampleSets) {
 }
 
 TEST(AlphaSim, SampleSetsAreSortedOnEverySnapGrid) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   // Points and checks on the snap grid are sorted by packed 64-bit grid keys where the
   // grid indices span less than 2^32, by their coordinates otherwise: both orders must be
   // the lexicographic one, without repeats, and every coordinate a multiple of snap.
@@ -1351,6 +1356,7 @@ TEST(AlphaSim, CoarseInteriorKeepsTheCornersOfFullCellsOnly) {
 // ---------------------------------------------------------- determinism, indices
 
 TEST(AlphaSim, DeterministicAcrossRuns) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   Part p = make_part("motor", read_mesh_file(std::filesystem::path(LOOM_SHARED_DATA) / "occt/motor.stl"));
   auto o = options(0.06 * p.mesh.bounds().diagonal());
   const auto a = simplify_part(p, o);
@@ -1486,6 +1492,7 @@ TEST(AlphaSim, AbsorbedBoxPrismsGiveTheSolidOfEveryBoolean) {
 }
 
 TEST(AlphaSim, CgalBooleansGiveTheSolidOfOpenCascade) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   // Parts left with three general outlines (a sphere; the motor, featuretype and bunny at
   // the bench's 2% of the diagonal): CGAL's exact corefinement of the prism meshes against
   // OpenCASCADE's Booleans of the same prisms (the oracle, an independent implementation).
@@ -1709,7 +1716,7 @@ RC_GTEST_PROP(AlphaSimProperty, TheMeshHoldsTheImplicitSolid, ()) {
   RC_ASSERT(sp.result.closed_after);
   // Where pieces touch (a 2-manifold cannot hold them), OpenCASCADE runs the Booleans, and
   // its result has lost pieces of the intersection that hold no surface of the part (known
-  // limit, DESIGN-NOTES): only CGAL's result is held to this.
+  // limit, docs/simplify.md): only CGAL's result is held to this.
   RC_TAG(sp.result.booleans_by);
   RC_ASSERT((sp.result.booleans_by == "opencascade") == !sp.result.booleans_note.empty());  // the fallback says why
   if (sp.result.booleans_by == "cgal") RC_ASSERT(implicit_points_outside_the_mesh(sp, sp.result.tolerance, 20000) == 0u);

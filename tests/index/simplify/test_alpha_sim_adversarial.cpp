@@ -1,4 +1,4 @@
-// α-SIM adversarial review: hostile but valid parts (thin sheets, needles, cavities,
+// α-SIM on adversarial input: hostile but valid parts (thin sheets, needles, cavities,
 // through-holes oblique to the axes, tori, odd rotations, faces on the projection planes,
 // open / non-manifold / duplicated / degenerate / misoriented input, huge offsets, several
 // shells, blocked projections) checked by an oracle written here, independent of loom's
@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "common/run_loom.hpp"
+#include "common/shared_data.hpp"
 
 using namespace loom;
 using namespace loom::alpha_sim_oracle;
@@ -302,8 +303,8 @@ TEST(AlphaSimAdversarial, DimPreFarBelowThePartIsBounded) {
 
 TEST(AlphaSimAdversarial, DimPreJustAboveTheSampleLimitIsBounded) {
   // A sphere of radius 50 at dim_pre 0.2: ~6e5 samples, below max_cloud_points (0.13
-  // would be above it: too_fine). It ends in bounded time (2–4 s, ~350 MB on the review's
-  // machine) — here kept as the original ("blocked": the three cylinders' corners leave
+  // would be above it: too_fine). It ends in bounded time (2–4 s, ~350 MB on a
+  // 2-core machine) — here kept as the original ("blocked": the three cylinders' corners leave
   // balls of radius 4.7 outside the sphere). Bounded time is CTest's timeout's to judge.
   check_part("sphere-fine", turned(sphere({0, 0, 0}, 50, 96, 48), 17, 45), opts(0.2), 2);
 }
@@ -621,6 +622,7 @@ TEST(AlphaSimAdversarialCli, PartFarFromTheOrigin) {
 }
 
 TEST(AlphaSimAdversarial, RealMeshesTurnedByOddAngles) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   for (const char* rel : {"fcl/rob.obj", "trimesh/tube.obj", "occt/shape.stl", "trimesh/featuretype.STL"}) {
     const auto path = std::filesystem::path(LOOM_SHARED_DATA) / rel;
     if (!std::filesystem::exists(path)) continue;
@@ -635,7 +637,7 @@ TEST(AlphaSimAdversarial, RealMeshesTurnedByOddAngles) {
 
 TEST(AlphaSimAdversarial, ThinPlatesTurnedAtRandom) {
   // Plates 0.001–0.3 thick at random angles, on the axis planes and with two user planes
-  // (where, in 2026-11-27's review, about a quarter of them came out of OpenCASCADE's
+  // (where about a quarter of them can come out of OpenCASCADE's
   // Booleans wrong — "mesh intersection: the first mesh intersects itself" sent them there —
   // and the measure kept the original: a reported fallback, which check_part accepts).
   std::mt19937_64 rng(11);

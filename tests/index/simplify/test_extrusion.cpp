@@ -1,4 +1,4 @@
-// Extrusions (α-SIM's prisms, issue 4): the direct mesh against closed-form volumes and
+// Extrusions (α-SIM's prisms): the direct mesh against closed-form volumes and
 // topology, and the absorption of axis boxes against a point-membership oracle (a point is
 // in an intersection of extrusions iff it is in each: depth range and even-odd rings).
 #include "index/simplify/extrusion.hpp"

@@ -1,5 +1,5 @@
-// Removing the vertices a polyhedral mesh does not need (α-SIM after exact corefinement,
-// issue 4): closed forms (subdivided boxes), the tolerance along a crease, refusals, and
+// Removing the vertices a polyhedral mesh does not need (α-SIM after exact corefinement):
+// closed forms (subdivided boxes), the tolerance along a crease, refusals, and
 // corefined random solids against their own volume and corners.
 #include "index/simplify/face_vertices.hpp"
 

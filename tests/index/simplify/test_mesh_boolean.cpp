@@ -1,4 +1,4 @@
-// Exact mesh intersection (CGAL corefinement, α-SIM's general Boolean, issue 4) against
+// Exact mesh intersection (CGAL corefinement, α-SIM's general Boolean) against
 // closed forms: boxes whose faces coincide (the degenerate case corefinement must get
 // right), a box turned 45° (an octagonal prism), spheres (volume against the inscribed
 // polyhedra), and refusals.

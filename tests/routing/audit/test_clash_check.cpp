@@ -513,7 +513,7 @@ TEST(ClashCheck, BadInputIsRejected) {
   EXPECT_TRUE(check_clashes({}, parts, &idx, req).clashes.empty());
 }
 
-// Regression (2026-11-22, session 19, a sweep of bad inputs): a route wiggling on the scale
+// Regression: a route wiggling on the scale
 // of the tolerance (2,000 key points 1 µm apart, or a fine tolerance on a tight zigzag) made
 // the certified audit flatten it into chords without end. It is refused up front, naming
 // the cable and the chord count, before any chord is made.
@@ -552,12 +552,12 @@ TEST(ClashCheck, AFarTooLongRouteIsRefusedForItsLength) {
   }
 }
 
-// Regression (2026-11-25, session 20): key points far closer together than the cable is
+// Regression: key points far closer together than the cable is
 // thick (2,000 points 1 µm apart on one bundle segment of the wing harness, shared by 11
 // cables) gave every cable a chord per knot span, and the pair pass's broad phase 26,000
 // mutually overlapping chord blocks: 288 million candidate pairs, 34 s and 4.6 GB for an
 // audit that takes 0.3 s without them. Runs of short spans whose control points stay within
-// the chord error are now one chord (ChordPlan). The findings must still match the oracle,
+// the chord error are one chord (ChordPlan). The findings must still match the oracle,
 // with about as many chords as the same curves need without the dense points.
 TEST(ClashCheck, DenseKeyPointsAuditLikeTheOracleWithFewChords) {
   auto route = [](double z, int dense) {
@@ -622,11 +622,11 @@ std::string refusal(const std::vector<CableInput>& cables, const std::vector<Par
   return "";
 }
 
-// Regression (2026-11-25, sessions 20–21): a route folding back on itself thousands of
+// Regression: a route folding back on itself thousands of
 // times (2,000 zigzags of 50 mm on a wing-harness segment shared by 11 cables) made the
 // certified pair pass enumerate ~10⁹ overlapping chord-block pairs (Embree's allocation
 // failed at 17 GB; at 20,000 zigzags the process was killed at 24 GB) and the discrete
-// grid store contacts until 20 GB. Both now bound their work before doing it
+// grid store contacts until 20 GB. Both bound their work before doing it
 // (ClashLimits) and refuse with a message naming a cable; this scene is refused by the
 // default limits in about a second.
 TEST(ClashLimits, ARouteFoldingBackThousandsOfTimesIsRefusedBeforeItsPairsAreMade) {
@@ -1141,8 +1141,8 @@ TEST(AuditCli, BadInputExitsTwoAndWritesNothing) {
   EXPECT_EQ(loom_audit(kAuditData + "clean.toml --routes " + kAuditData + "missing.xml", "noroutes").status, 2);
 }
 
-// Regression (sessions 20–21): the CLI ran out of memory on a route folding back on
-// itself thousands of times; it now exits 2 with the reason and writes no report.
+// Regression: the CLI ran out of memory on a route folding back on
+// itself thousands of times; it exits 2 with the reason and writes no report.
 TEST(AuditCli, ARouteFoldingBackOnItselfExitsTwoAndWritesNothing) {
   const fs::path dir = fs::temp_directory_path() / ("loom-test-fold-" + std::to_string(::getpid()));
   fs::create_directories(dir);

@@ -1,4 +1,4 @@
-// Adversarial review of loom's curve geometry: interpolation, curvature, bend radius, arc
+// loom's curve geometry on adversarial input: interpolation, curvature, bend radius, arc
 // length, fairing and the tube sweep on hostile inputs (offsets of 1e6, a 1e-6 scale,
 // spacing from 1 mm to 1 km, nearly coincident points, reversals, opposing end tangents,
 // closed loops), against independent oracles: OpenCASCADE's own interpolation

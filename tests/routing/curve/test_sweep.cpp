@@ -240,9 +240,9 @@ TEST(Sweep, TriangleBudgetIsHeldBeforeTheMeshIsMade) {
   EXPECT_EQ(loom::sweep_tube(c, 1.0, opt).mesh.triangle_count(), opt.max_triangles);
 }
 
-// Regression (2026-11-25, session 20): a route with 200,000 key points 10 nm apart made the
+// Regression: a route with 200,000 key points 10 nm apart made the
 // render's tube sweep place at least four rings per knot span (15 GB, 50 s). A run of
-// intervals that stays within half the axial tolerance of a straight tube is now crossed in
+// intervals that stays within half the axial tolerance of a straight tube is crossed in
 // one step; the tube must stay within the chord tolerance of the exact one.
 TEST(Sweep, DenseKeyPointsAreCrossedInFewRingsWithinTolerance) {
   auto route = [](int dense) {

@@ -1,10 +1,11 @@
-// Point cloud reading (issue 8): PLY ascii/binary LE/BE, XYZ, PCD ascii/binary/compressed,
+// Point cloud reading: PLY ascii/binary LE/BE, XYZ, PCD ascii/binary/compressed,
 // the real PCL sample clouds, malformed files with located errors.
 #include "routing/scan/point_cloud_io.hpp"
 
 #include "core/error.hpp"
 
 #include <gtest/gtest.h>
+#include "common/shared_data.hpp"
 #include <liblzf/lzf.h>
 #include <rapidcheck/gtest.h>
 
@@ -106,6 +107,7 @@ std::vector<std::uint8_t> lzf_compress_naive(const std::vector<std::uint8_t>& in
 // ---- the real PCL clouds --------------------------------------------------------------
 
 TEST(PointCloudIo, RealPclAsciiCloudsMatchTheirHeaders) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   for (const char* name : {"bunny.pcd", "bun0.pcd", "bun4.pcd", "curve3d.pcd"}) {
     const auto pc = read_point_cloud(kPcl / name);
     EXPECT_EQ(pc.format, PointCloudFormat::PcdAscii) << name;
@@ -121,6 +123,7 @@ TEST(PointCloudIo, RealPclAsciiCloudsMatchTheirHeaders) {
 }
 
 TEST(PointCloudIo, RealPclCompressedCloudsDecompress) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   const auto milk = read_point_cloud(kPcl / "milk.pcd");
   EXPECT_EQ(milk.format, PointCloudFormat::PcdBinaryCompressed);
   EXPECT_EQ(milk.declared, pcd_header_number(kPcl / "milk.pcd", "POINTS"));
@@ -141,6 +144,7 @@ TEST(PointCloudIo, RealPclCompressedCloudsDecompress) {
 }
 
 TEST(PointCloudIo, RealPlyWithExtraPropertiesAndFaces) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   const auto pc = read_point_cloud(fs::path(LOOM_SHARED_DATA) / "trimesh" / "bunny.ply");
   EXPECT_EQ(pc.format, PointCloudFormat::PlyAscii);
   EXPECT_EQ(pc.points.size(), 8171u);

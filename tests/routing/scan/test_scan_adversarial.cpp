@@ -1,4 +1,4 @@
-// Adversarial review of `loom scan` (DESIGN §4): clouds of tubes around closed-form
+// `loom scan` on adversarial clouds (DESIGN §4): clouds of tubes around closed-form
 // centerlines (straight, arc, helix, S-bend, tight U-bends) with fixed-seed noise, uneven
 // density, gaps, outliers and one-sided views, against an independent oracle (dense
 // polyline of the true axis, Hausdorff both ways); hostile but valid clouds must give a

@@ -1,4 +1,4 @@
-// Centerline extraction from scanned cables (issue 8): clouds sampled from known tubes,
+// Centerline extraction from scanned cables: clouds sampled from known tubes,
 // the recovered centerline compared with the true axis (closed-form curves, dense
 // polyline oracle, fixed seeds).
 #include "routing/scan/scan_centerline.hpp"

@@ -1,4 +1,4 @@
-// render.png (issue 9): the camera's projection against the closed-form look-at/perspective
+// render.png: the camera's projection against the closed-form look-at/perspective
 // matrices, the picture against a brute-force ray/triangle oracle, clash markers where the
 // report puts them, and the PNG file.
 #include "index/index_test_meshes.hpp"

@@ -1,4 +1,4 @@
-// view.html (issue 9): decimation invariants, the page's data against the scene and report,
+// view.html: decimation invariants, the page's data against the scene and report,
 // and the page itself opened in headless Chromium as a person would (WebGL pixels, the clash
 // list, a click selecting a clash, a screenshot).
 #include "index/index_test_meshes.hpp"
