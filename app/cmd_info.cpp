@@ -83,6 +83,10 @@ nlohmann::json info_json(const Scene& scene, const SceneLoadReport& rep) {
     json order = json::array();
     for (int s : topo.routing_order()) order.push_back(h.segments[s].from + " -> " + h.segments[s].to);
     harness["routing_order"] = order;
+    json degrees = json::object();
+    for (const auto& [deg, n] : topo.nodes_by_degree()) degrees[std::to_string(deg)] = n;
+    harness["nodes_by_degree"] = degrees;
+    harness["notes"] = topo.notes();
   }
   j["harness"] = harness;
   j["settings"] = {{"routing",
@@ -123,6 +127,10 @@ void print_text(const Scene& scene, const SceneLoadReport& rep) {
     for (const auto& c : h.cables)
       std::printf("  cable %-8s %-10s -> %-10s d=%.2f %s  min bend %.1f %s\n", c.id.c_str(), c.ports[0].c_str(),
                   c.ports[1].c_str(), c.physical.diameter, u, c.physical.min_bend_radius, u);
+    std::string degrees;
+    for (const auto& [deg, n] : topo.nodes_by_degree())
+      degrees += (degrees.empty() ? "" : ", ") + std::to_string(n) + " of degree " + std::to_string(deg);
+    std::printf("  nodes by degree (segments joined): %s\n", degrees.empty() ? "none" : degrees.c_str());
     for (const auto& b : h.branches) {
       if (b.position)
         std::printf("  branch %-8s at [%.1f %.1f %.1f]\n", b.id.c_str(), b.position->x(), b.position->y(),
@@ -153,6 +161,8 @@ void print_text(const Scene& scene, const SceneLoadReport& rep) {
   line("tessellation.angular_deg", scene.tessellation.angular_deflection_deg);
   std::printf("  %-30s %s\n", "routing.planner", scene.routing.planner.c_str());
   for (const auto& n : rep.notes) std::printf("note: %s\n", n.c_str());
+  if (scene.has_harness)
+    for (const auto& n : HarnessTopology(h).notes()) std::printf("note: %s\n", n.c_str());
 }
 
 }  // namespace

@@ -1,8 +1,9 @@
 #pragma once
 /// The harness model of the parametric-model patent (seed: cable-assembly-parametric-
 /// model-xml): four sets — physical attributes, electrical attributes, structure
-/// (ports and branch points, each branch point joined to exactly three nodes) and
-/// branch paths (ordered path points per segment). Lengths in Harness::units.
+/// (ports and branch points) and branch paths (ordered path points per segment). The
+/// patent's branch points join exactly three nodes; here a node joins any number (two: a
+/// pass-through point). Lengths in Harness::units.
 
 #include "core/geometry.hpp"
 #include "core/units.hpp"
@@ -39,8 +40,9 @@ struct Port {
   int line = 0;
 };
 
-/// A branch point of the harness tree; joined to exactly three nodes. The position
-/// may be absent on input, in which case the router places it.
+/// A branch point of the harness tree, joined to any number of nodes (3 in the patent, 2
+/// for a pass-through point). The position may be absent on input, in which case the
+/// router places it.
 struct BranchPoint {
   std::string id;
   std::optional<Vec3> position;

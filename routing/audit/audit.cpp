@@ -12,6 +12,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -30,6 +32,33 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 std::pair<std::string, std::string> use_nodes(const Harness& h, const SegmentUse& u) {
   const Segment& s = h.segments[static_cast<std::size_t>(u.segment)];
   return u.reversed ? std::make_pair(s.to, s.from) : std::make_pair(s.from, s.to);
+}
+
+/// The cable's turn at each node between two of its pieces (NodeTurn): the angle between
+/// the tangent arriving at the node and the one leaving it, taken up within the node's
+/// breakout, or within the shorter of the two pieces where that is shorter.
+std::vector<NodeTurn> node_turns(const HarnessTopology& topo, std::size_t cable, const std::vector<CablePiece>& pieces) {
+  const Harness& h = topo.harness();
+  const auto& chain = topo.cable_chain(static_cast<int>(cable));
+  std::vector<NodeTurn> out;
+  for (std::size_t k = 0; k + 1 < pieces.size() && k + 1 < chain.size(); ++k) {
+    const Centerline& a = pieces[k].curve;
+    const Centerline& b = pieces[k + 1].curve;
+    Vec3 da[2], db[2];
+    a.evaluate(a.u_max(), 1, da, true);
+    b.evaluate(b.u_min(), 1, db);
+    NodeTurn t;
+    t.node = use_nodes(h, chain[k]).second;
+    t.s = pieces[k + 1].s0;
+    t.point = db[0];
+    // A zero tangent (a degenerate end) has no direction: no turn is judged there.
+    t.turn = da[1].norm() > 0.0 && db[1].norm() > 0.0 ? std::atan2(da[1].cross(db[1]).norm(), da[1].dot(db[1])) : 0.0;
+    const double reach = std::min({breakout_length(topo, t.node), a.length(), b.length()});
+    const double half_tan = std::tan(0.5 * t.turn);
+    t.radius = half_tan > 0.0 ? reach / half_tan : std::numeric_limits<double>::infinity();
+    out.push_back(t);
+  }
+  return out;
 }
 
 /// Relative widening of the port's query box over the largest per-part reach (rounding only).
@@ -152,10 +181,14 @@ std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCa
         // (the router leaves it straight for breakout_length); allow contact over twice
         // that, the run-out of two tubes diverging at their minimum bend radius.
         if (h.find_branch(n) >= 0) rad = std::max(rad, 2.0 * breakout_length(topo, n));
-        in.junctions.push_back({n, *pos, rad});
+        // Every node but the two ends of the chain is one the cable passes through.
+        const bool passes = !(k == 0 && n == nodes.first) && !(k + 1 == chain.size() && n == nodes.second);
+        in.junctions.push_back({n, *pos, rad, passes});
       }
     }
-    for (auto& piece : curves.pieces(static_cast<int>(c))) in.bend_pieces.emplace_back(piece.s0, std::move(piece.curve));
+    auto pieces = curves.pieces(static_cast<int>(c));
+    in.node_turns = node_turns(topo, c, pieces);
+    for (auto& piece : pieces) in.bend_pieces.emplace_back(piece.s0, std::move(piece.curve));
     ac.routed = true;
     ac.check_index = static_cast<int>(out.size());
     cables.push_back(ac);
