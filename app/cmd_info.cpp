@@ -2,6 +2,7 @@
 #include "app/commands.hpp"
 
 #include "core/harness_topology.hpp"
+#include "core/io/kbl_read.hpp"
 #include "core/io/scene_load.hpp"
 #include "core/progress.hpp"
 #include "routing/audit/report_json.hpp"
@@ -52,7 +53,9 @@ nlohmann::json info_json(const Scene& scene, const SceneLoadReport& rep) {
                       {"type", c.physical.type},
                       {"color", c.physical.color},
                       {"diameter", c.physical.diameter},
-                      {"min_bend_radius", c.physical.min_bend_radius}});
+                      {"min_bend_radius", c.physical.min_bend_radius},
+                      {"cross_section", c.physical.cross_section},
+                      {"cores", c.cores.size()}});
   harness["cables"] = cables;
   json ports = json::array();
   for (const auto& p : h.ports)
@@ -87,6 +90,13 @@ nlohmann::json info_json(const Scene& scene, const SceneLoadReport& rep) {
     for (const auto& [deg, n] : topo.nodes_by_degree()) degrees[std::to_string(deg)] = n;
     harness["nodes_by_degree"] = degrees;
     harness["notes"] = topo.notes();
+    if (h.kbl) {
+      json counts = json::object(), ignored = json::object();
+      for (const auto& [what, n] : h.kbl->counts) counts[what] = n;
+      for (const auto& [what, n] : h.kbl->ignored) ignored[what] = n;
+      harness["kbl"] = {{"version", h.kbl->version}, {"counts", counts}, {"not_used", ignored},
+                        {"clamps", h.clamps.size()}, {"notes", h.kbl->notes}};
+    }
   }
   j["harness"] = harness;
   j["settings"] = {{"routing",
@@ -104,6 +114,16 @@ nlohmann::json info_json(const Scene& scene, const SceneLoadReport& rep) {
   j["notes"] = rep.notes;
   j["load_ms"] = rep.load_ms;
   return j;
+}
+
+/// What a KBL file held: what loom read from it, what it does not use, what it noticed.
+void print_kbl(const KblOrigin& k) {
+  std::string read, unused;
+  for (const auto& [what, n] : k.counts) read += (read.empty() ? "" : ", ") + std::to_string(n) + " " + what;
+  for (const auto& [what, n] : k.ignored) unused += (unused.empty() ? "" : ", ") + what + " " + std::to_string(n);
+  std::printf("  KBL %s: %s\n", k.version.c_str(), read.c_str());
+  std::printf("  not used by loom: %s\n", unused.empty() ? "nothing" : unused.c_str());
+  for (const auto& n : k.notes) std::printf("  kbl: %s\n", n.c_str());
 }
 
 void print_text(const Scene& scene, const SceneLoadReport& rep) {
@@ -131,6 +151,7 @@ void print_text(const Scene& scene, const SceneLoadReport& rep) {
     for (const auto& [deg, n] : topo.nodes_by_degree())
       degrees += (degrees.empty() ? "" : ", ") + std::to_string(n) + " of degree " + std::to_string(deg);
     std::printf("  nodes by degree (segments joined): %s\n", degrees.empty() ? "none" : degrees.c_str());
+    if (h.kbl) print_kbl(*h.kbl);
     for (const auto& b : h.branches) {
       if (b.position)
         std::printf("  branch %-8s at [%.1f %.1f %.1f]\n", b.id.c_str(), b.position->x(), b.position->y(),

@@ -307,7 +307,15 @@ void apply_matching_routes(Scene& scene, const std::filesystem::path& routes) {
   std::optional<Harness> designed;
   if (scene.has_harness) designed = std::move(scene.harness);
   apply_routes(scene, routes);
-  if (designed) check_routes_match(*designed, scene.harness);
+  if (!designed) return;
+  check_routes_match(*designed, scene.harness);
+  // Routes of a harness read from KBL, with its segments between the same nodes, can be
+  // written back into that file (routed.kbl).
+  const auto& a = designed->segments;
+  const auto& b = scene.harness.segments;
+  bool same = designed->kbl && a.size() == b.size();
+  for (std::size_t k = 0; same && k < a.size(); ++k) same = a[k].from == b[k].from && a[k].to == b[k].to;
+  if (same) scene.harness.kbl = designed->kbl;
 }
 
 AuditReport audit_scene_file(const std::filesystem::path& scene_file, const AuditOptions& opt, Scene* loaded) {
