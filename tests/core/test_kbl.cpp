@@ -11,6 +11,7 @@
 #include "core/io/kbl_curve.hpp"
 #include "core/io/kbl_read.hpp"
 #include "core/io/kbl_write.hpp"
+#include "routing/audit/audit.hpp"
 
 #include <gtest/gtest.h>
 
@@ -215,6 +216,25 @@ TEST_P(KblSample, RoundTripIsTheIdentity) {
   std::ostringstream os;
   original.save(os, "\t", pugi::format_default, pugi::encoding_utf8);
   EXPECT_EQ(text, os.str());
+}
+
+// The harness alone: whatever the topology (nodes of any degree, segments leaving a node
+// tangent, splices on stubs), no clash comes from it; folds through a node are bends.
+TEST_P(KblSample, TheHarnessAloneCausesNoClash) {
+  Scene sc;
+  sc.name = "harness only";
+  sc.harness = read_harness_kbl(kDir + GetParam());
+  sc.has_harness = true;
+  AuditOptions o;
+  o.check.threads = 1;
+  const AuditReport r = run_audit(sc, o);
+  EXPECT_EQ(r.result.cables.size(), sc.harness.cables.size());
+  for (const auto& c : r.result.clashes)
+    ADD_FAILURE() << clash_kind_name(c.kind) << " " << r.check_ids[static_cast<std::size_t>(c.cable)] << " at s = " << c.s
+                  << ", clearance " << c.clearance;
+  int bends = 0;
+  for (const auto& v : r.result.violations) bends += v.kind == ViolationKind::BendRadius;
+  std::printf("%s: %d bend-radius violations (the file's own curves and folds through nodes)\n", GetParam().c_str(), bends);
 }
 
 INSTANTIATE_TEST_SUITE_P(Shared, KblSample, ::testing::ValuesIn(kWithGeometry), [](const ::testing::TestParamInfo<std::string>& p) {

@@ -180,5 +180,39 @@ TEST_P(NodeDegree, AContactAwayFromTheNodeIsStillAClash) {
 
 INSTANTIATE_TEST_SUITE_P(Ways, NodeDegree, ::testing::Values(4, 8, 16));
 
+/// A trunk P0 → H and two legs from H: straight on to P1 along +x, and to P2 leaving H tangent
+/// to it (1 mm off the axis 40 mm out) before it turns away; `back_at` > 0 makes P2's leg come
+/// back to 1 mm off the axis at x = back_at. Cables P0–P1 and P0–P2 (d 4, bend 10).
+Harness tangent_legs(double back_at) {
+  Harness h = star({-Vec3::UnitX(), Vec3::UnitX(), Vec3(120, 80, 0).normalized()}, {{0, 1}, {0, 2}});
+  h.ports[2].position = back_at > 0 ? Vec3(back_at, 80, 0) : Vec3(120, 80, 0);
+  h.segments[2].path = {Vec3(40, 1, 0), Vec3(80, 20, 0)};
+  if (back_at > 0) h.segments[2].path.push_back(Vec3(back_at, 1, 0));
+  return h;
+}
+
+// Legs that leave a node tangent to each other (a splice on a stub laid along the trunk)
+// run together until they part, 46 mm out here, beyond twice the breakout (20 mm): their
+// cables touch there by design. Where the legs meet again, it is a clash.
+TEST(NodeDegreeTangent, LegsLeavingTogetherTouchOnlyUntilTheyPart) {
+  const Harness h = tangent_legs(0.0);
+  const HarnessTopology topo(h);
+  ASSERT_LT(min_distance(topo, 0, 1), 1.0);  // the oracle: they do touch
+  EXPECT_LT(2.0 * breakout_length(topo, "H"), 40.0);
+  for (ClashMethod m : {ClashMethod::Certified, ClashMethod::Discrete}) {
+    const AuditReport r = audit(h, m);
+    EXPECT_TRUE(r.result.clashes.empty()) << clash_method_name(m) << ": " << r.result.clashes.size() << " clashes, first at "
+                                          << r.result.clashes[0].s;
+  }
+  const Harness back = tangent_legs(150.0);
+  for (ClashMethod m : {ClashMethod::Certified, ClashMethod::Discrete}) {
+    const AuditReport r = audit(back, m);
+    bool far = false;
+    for (const auto& c : r.result.clashes) far = far || (c.kind == ClashKind::CableCable && c.point.x() > 140.0);
+    EXPECT_TRUE(far) << clash_method_name(m);
+    for (const auto& c : r.result.clashes) EXPECT_GT(c.point.x(), 100.0) << clash_method_name(m) << " at x " << c.point.x();
+  }
+}
+
 }  // namespace
 }  // namespace loom
