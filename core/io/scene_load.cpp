@@ -5,6 +5,7 @@
 #include "core/io/harness_xml.hpp"
 #include "core/io/input_file.hpp"
 #include "core/io/kbl_read.hpp"
+#include "core/io/kbl_vec.hpp"
 #include "core/io/mesh_read.hpp"
 #include "core/io/tessellation_cache.hpp"
 
@@ -132,11 +133,12 @@ std::filesystem::path resolve(const std::filesystem::path& base, const std::stri
   return p.is_absolute() ? p : base / p;
 }
 
-/// The harness file by its extension: KBL (.kbl), else loom's harness XML.
+/// The harness file by its extension: KBL (.kbl), VEC (.vec), else loom's harness XML.
 Harness read_harness_file(const std::filesystem::path& p) {
   std::string ext = p.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (ext == ".kbl") return read_harness_kbl(p);
+  if (ext == ".vec") return read_harness_vec(p);
   return read_harness_xml(p);
 }
 

@@ -10,6 +10,7 @@
 #include "core/harness_topology.hpp"
 #include "core/io/kbl_curve.hpp"
 #include "core/io/kbl_read.hpp"
+#include "core/io/kbl_vec.hpp"
 #include "core/io/kbl_write.hpp"
 #include "routing/audit/audit.hpp"
 
@@ -258,6 +259,18 @@ void expect_refused(const std::string& file, const std::vector<std::string>& nee
 TEST(KblFiles, ModelSampleHasNoGeometryAndIsRefusedNamingTheContainer) {
   expect_refused(kDir + "kbl-model-sample.kbl",
                  {"kbl-model-sample.kbl:2", "<kbl:KBL_container id=\"ID000\">", "no <Node> and no <Segment>"});
+}
+
+// The VEC guideline example holds topology only: refused, saying what it holds and lacks.
+TEST(KblFiles, VecRoutingExamplesIsRefusedSayingWhatIsMissing) {
+  try {
+    read_harness_vec(kDir + "routing-examples.vec");
+    FAIL() << "expected a refusal";
+  } catch (const InputError& e) {
+    for (const char* n : {"routing-examples.vec:1", "<vec:VecContent>", "VEC 2.1.0 with 8 TopologyNode, 8 TopologySegment, 4 Routing",
+                          "no 3D geometry", "KBL 2.3/2.4 files (.kbl)"})
+      EXPECT_NE(std::string(e.what()).find(n), std::string::npos) << n << "\n" << e.what();
+  }
 }
 
 TEST(KblFiles, BatteriePlusIsOneRingTerminalCable) {
