@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "core/io/atomic_file.hpp"
+#include "core/io/kbl_write.hpp"
 #include "core/io/output_set.hpp"
 #include "app/progress_bar.hpp"
 #include "routing/audit/audit.hpp"
@@ -121,6 +122,7 @@ int run_audit_command(const AuditFlags& f) {
   parse_render_size(f.render_size, "--render-size", render);
   auto targets = view_output_files(f.out);
   targets.push_back(std::filesystem::path(f.out) / "report.json");
+  targets.push_back(std::filesystem::path(f.out) / kRoutedKblName);  // written for a KBL harness
   OutputSet outputs(f.out, targets);  // every target checked before any work; all replaced together
   ProgressBar bar(stderr, f.quiet || f.json);
   opt.progress = bar.fn();
@@ -131,6 +133,7 @@ int run_audit_command(const AuditFlags& f) {
   const nlohmann::json report = audit_report_json(rep);
   write_view_outputs(outputs.staging(), scene, scene.harness, report, render);  // view.html, render.png
   write_audit_report(rep, outputs.staging() / "report.json");
+  if (scene.harness.kbl) write_harness_kbl(scene.harness, outputs.staging() / kRoutedKblName);
   outputs.commit();
   if (f.json)
     std::cout << json_text(report, 2) << "\n";

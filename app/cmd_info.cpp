@@ -2,6 +2,7 @@
 #include "app/commands.hpp"
 
 #include "core/harness_topology.hpp"
+#include "core/io/kbl_read.hpp"
 #include "core/io/scene_load.hpp"
 #include "app/progress_bar.hpp"
 #include "core/io/json_text.hpp"
@@ -52,7 +53,9 @@ nlohmann::json info_json(const Scene& scene, const SceneLoadReport& rep) {
                       {"type", c.physical.type},
                       {"color", c.physical.color},
                       {"diameter", c.physical.diameter},
-                      {"min_bend_radius", c.physical.min_bend_radius}});
+                      {"min_bend_radius", c.physical.min_bend_radius},
+                      {"cross_section", c.physical.cross_section},
+                      {"cores", c.cores.size()}});
   harness["cables"] = cables;
   json ports = json::array();
   for (const auto& p : h.ports)
@@ -83,6 +86,17 @@ nlohmann::json info_json(const Scene& scene, const SceneLoadReport& rep) {
     json order = json::array();
     for (int s : topo.routing_order()) order.push_back(h.segments[s].from + " -> " + h.segments[s].to);
     harness["routing_order"] = order;
+    json degrees = json::object();
+    for (const auto& [deg, n] : topo.nodes_by_degree()) degrees[std::to_string(deg)] = n;
+    harness["nodes_by_degree"] = degrees;
+    harness["notes"] = topo.notes();
+    if (h.kbl) {
+      json counts = json::object(), ignored = json::object();
+      for (const auto& [what, n] : h.kbl->counts) counts[what] = n;
+      for (const auto& [what, n] : h.kbl->ignored) ignored[what] = n;
+      harness["kbl"] = {{"version", h.kbl->version}, {"counts", counts}, {"not_used", ignored},
+                        {"clamps", h.clamps.size()}, {"notes", h.kbl->notes}};
+    }
   }
   j["harness"] = harness;
   j["settings"] = {{"routing",
@@ -100,6 +114,16 @@ nlohmann::json info_json(const Scene& scene, const SceneLoadReport& rep) {
   j["notes"] = rep.notes;
   j["load_ms"] = rep.load_ms;
   return j;
+}
+
+/// What a KBL file held: what loom read from it, what it does not use, what it noticed.
+void print_kbl(const KblOrigin& k) {
+  std::string read, unused;
+  for (const auto& [what, n] : k.counts) read += (read.empty() ? "" : ", ") + std::to_string(n) + " " + what;
+  for (const auto& [what, n] : k.ignored) unused += (unused.empty() ? "" : ", ") + what + " " + std::to_string(n);
+  std::printf("  KBL %s: %s\n", k.version.c_str(), read.c_str());
+  std::printf("  not used by loom: %s\n", unused.empty() ? "nothing" : unused.c_str());
+  for (const auto& n : k.notes) std::printf("  kbl: %s\n", n.c_str());
 }
 
 void print_text(const Scene& scene, const SceneLoadReport& rep) {
@@ -123,6 +147,11 @@ void print_text(const Scene& scene, const SceneLoadReport& rep) {
     for (const auto& c : h.cables)
       std::printf("  cable %-8s %-10s -> %-10s d=%.2f %s  min bend %.1f %s\n", c.id.c_str(), c.ports[0].c_str(),
                   c.ports[1].c_str(), c.physical.diameter, u, c.physical.min_bend_radius, u);
+    std::string degrees;
+    for (const auto& [deg, n] : topo.nodes_by_degree())
+      degrees += (degrees.empty() ? "" : ", ") + std::to_string(n) + " of degree " + std::to_string(deg);
+    std::printf("  nodes by degree (segments joined): %s\n", degrees.empty() ? "none" : degrees.c_str());
+    if (h.kbl) print_kbl(*h.kbl);
     for (const auto& b : h.branches) {
       if (b.position)
         std::printf("  branch %-8s at [%.1f %.1f %.1f]\n", b.id.c_str(), b.position->x(), b.position->y(),
@@ -153,6 +182,8 @@ void print_text(const Scene& scene, const SceneLoadReport& rep) {
   line("tessellation.angular_deg", scene.tessellation.angular_deflection_deg);
   std::printf("  %-30s %s\n", "routing.planner", scene.routing.planner.c_str());
   for (const auto& n : rep.notes) std::printf("note: %s\n", n.c_str());
+  if (scene.has_harness)
+    for (const auto& n : HarnessTopology(h).notes()) std::printf("note: %s\n", n.c_str());
 }
 
 }  // namespace

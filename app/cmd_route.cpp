@@ -62,7 +62,8 @@ void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
   // Without a budget every run differs: said once in report.json; the rest is worth a line.
   for (const auto& n : rep.unreproducible)
     if (rep.iterations > 0) std::printf("  not reproducible: %s\n", n.c_str());
-  std::printf("  wrote %s/{routed.xml, report.json, cables.ply}\n", out.string().c_str());
+  std::printf("  wrote %s/{routed.xml, report.json, cables.ply%s}\n", out.string().c_str(),
+              rep.routed.kbl ? ", routed.kbl" : "");
 }
 
 }  // namespace

@@ -1,12 +1,14 @@
 #pragma once
 /// The harness model of the parametric-model patent (seed: cable-assembly-parametric-
 /// model-xml): four sets — physical attributes, electrical attributes, structure
-/// (ports and branch points, each branch point joined to exactly three nodes) and
-/// branch paths (ordered path points per segment). Lengths in Harness::units.
+/// (ports and branch points) and branch paths (ordered path points per segment). The
+/// patent's branch points join exactly three nodes; here a node joins any number (two: a
+/// pass-through point). Lengths in Harness::units.
 
 #include "core/geometry.hpp"
 #include "core/units.hpp"
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,13 +21,21 @@ struct CablePhysical {
   std::string color;           ///< free text colour name
   double diameter = 0.0;       ///< outer diameter (> 0), harness units
   double min_bend_radius = 0.0;  ///< smallest allowed centerline bend radius (≥ 0; 0 = unchecked)
+  double cross_section = 0.0;  ///< conductor cross-section, harness units squared (0 = not given)
+};
+
+/// One core of a multicore cable: it runs inside the cable's jacket from end to end.
+struct CableCore {
+  std::string id;          ///< e.g. the core's wire number
+  CablePhysical physical;  ///< its own type, colour, diameter (0 = not given), cross-section
 };
 
 /// One cable: an electrical connection between two ports.
 struct Cable {
   std::string id;
   std::string ports[2];  ///< the two port ids it connects (electrical attributes)
-  CablePhysical physical;
+  CablePhysical physical;  ///< of the whole cable (a multicore: its jacket)
+  std::vector<CableCore> cores;  ///< a multicore's cores (empty for a single wire)
   int line = 0;          ///< line in the source file (0 if built in code)
   /// Radius of the cable (diameter / 2).
   double radius() const { return 0.5 * physical.diameter; }
@@ -39,8 +49,9 @@ struct Port {
   int line = 0;
 };
 
-/// A branch point of the harness tree; joined to exactly three nodes. The position
-/// may be absent on input, in which case the router places it.
+/// A branch point of the harness tree, joined to any number of nodes (3 in the patent, 2
+/// for a pass-through point). The position may be absent on input, in which case the
+/// router places it.
 struct BranchPoint {
   std::string id;
   std::optional<Vec3> position;
@@ -72,7 +83,17 @@ struct Segment {
   int line = 0;
 };
 
-/// The harness as read from XML: four sets plus the order elements appeared in.
+/// A fixed support of the harness (a clip or fixing): the bundle is held at this point.
+struct Clamp {
+  std::string id;
+  Vec3 position = Vec3::Zero();
+  int segment = -1;  ///< index into Harness::segments of the segment it holds (−1: not given)
+  int line = 0;
+};
+
+struct KblOrigin;  // core/io/kbl_read.hpp
+
+/// The harness as read from a file: four sets plus the order elements appeared in.
 struct Harness {
   std::string name;
   Unit units = Unit::Millimetre;
@@ -80,7 +101,11 @@ struct Harness {
   std::vector<Port> ports;
   std::vector<BranchPoint> branches;
   std::vector<Segment> segments;
+  std::vector<Clamp> clamps;  ///< fixed supports given by the file
   std::string source_file;  ///< the file it was read from (for messages)
+  /// Set when the harness was read from a KBL file: that file's text, the KBL ids of loom's
+  /// nodes, segments and cables, and what the reader did not use (writing back: kbl_write).
+  std::shared_ptr<const KblOrigin> kbl;
 
   /// Index of a port by id, or -1.
   int find_port(const std::string& id) const;

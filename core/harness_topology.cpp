@@ -54,12 +54,12 @@ HarnessTopology::HarnessTopology(const Harness& h) : h_(&h) {
     adj[b->second].push_back({a->second, static_cast<int>(s)});
   }
   const int n_ports = static_cast<int>(h.ports.size());
-  for (std::size_t i = 0; i < h.branches.size(); ++i) {
-    const int deg = static_cast<int>(adj[n_ports + i].size());
-    if (deg != 3)
-      throw InputError(at(h, h.branches[i].line, "branch '" + h.branches[i].id + "'"),
-                       "a branch point must connect exactly 3 nodes, this one connects " +
-                           std::to_string(deg));
+  // Nodes of any degree: a branch point joins as many nodes as the harness needs (the
+  // patent's exactly-3 rule is reported by notes(), not enforced); two is a pass-through.
+  for (const auto& [id, k] : node) {
+    std::vector<int>& inc = incident_[id];
+    for (const auto& [v, seg] : adj[k]) inc.push_back(seg);
+    std::sort(inc.begin(), inc.end());
   }
   // Cycle check: a forest has (nodes - components) edges. Find components by BFS, and
   // report the first edge that closes a loop.
@@ -176,10 +176,30 @@ std::vector<int> HarnessTopology::bundles() const {
   return out;
 }
 
-std::vector<int> HarnessTopology::incident_segments(const std::string& id) const {
-  std::vector<int> out;
-  for (std::size_t s = 0; s < h_->segments.size(); ++s)
-    if (h_->segments[s].from == id || h_->segments[s].to == id) out.push_back(static_cast<int>(s));
+const std::vector<int>& HarnessTopology::incident_segments(const std::string& id) const {
+  static const std::vector<int> none;
+  const auto it = incident_.find(id);
+  return it == incident_.end() ? none : it->second;
+}
+
+std::vector<std::string> HarnessTopology::notes() const {
+  std::vector<std::string> out;
+  for (const auto& b : h_->branches) {
+    const std::size_t n = incident_segments(b.id).size();
+    if (n == 3) continue;
+    const std::string where = h_->source_file + (b.line > 0 ? ":" + std::to_string(b.line) : std::string()) +
+                              " branch '" + b.id + "' joins " + std::to_string(n) + (n == 1 ? " node" : " nodes");
+    if (n == 2) out.push_back(where + ": a pass-through point (the patent's branch points join exactly 3)");
+    else if (n < 2) out.push_back(where + ": a dead end, no cable passes it (the patent's branch points join exactly 3)");
+    else out.push_back(where + " (the patent's branch points join exactly 3; loom routes and audits nodes of any degree)");
+  }
+  return out;
+}
+
+std::map<int, int> HarnessTopology::nodes_by_degree() const {
+  std::map<int, int> out;
+  for (const auto& p : h_->ports) ++out[static_cast<int>(incident_segments(p.id).size())];
+  for (const auto& b : h_->branches) ++out[static_cast<int>(incident_segments(b.id).size())];
   return out;
 }
 

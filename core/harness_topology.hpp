@@ -5,7 +5,9 @@
 
 #include "core/harness.hpp"
 
+#include <map>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace loom {
@@ -17,9 +19,9 @@ struct SegmentUse {
 };
 
 /// Derived, validated view of a Harness. Construction throws InputError for every
-/// structural fault: unknown node ids, branch points with ≠ 3 connections, cycles,
-/// disconnected cables, duplicate segments, a given segment diameter below that of a cable
-/// the segment carries.
+/// structural fault: unknown node ids, cycles, disconnected cables, duplicate segments, a
+/// given segment diameter below that of a cable the segment carries. Nodes may join any
+/// number of segments (notes() names the branch points that break the patent's 3-way rule).
 class HarnessTopology {
  public:
   /// Validates `h` (which must outlive this object) and derives chains and bundles.
@@ -41,8 +43,14 @@ class HarnessTopology {
   /// The patent's routing order over segments that carry cables: bundles by cable count,
   /// largest first (ties: file order), then single-cable segments in file order.
   const std::vector<int>& routing_order() const { return order_; }
-  /// Segment indices incident to a node id (port or branch point).
-  std::vector<int> incident_segments(const std::string& node) const;
+  /// Segment indices incident to a node id (port or branch point), ascending; empty for an
+  /// unknown id. Its size is the node's degree.
+  const std::vector<int>& incident_segments(const std::string& node) const;
+  /// One line per branch point that does not join exactly 3 nodes (the patent's rule): a
+  /// pass-through point (2), a dead end (0 or 1), or an N-way node; "file:line branch ..." .
+  std::vector<std::string> notes() const;
+  /// Number of nodes (ports and branch points) by degree (segments joined).
+  std::map<int, int> nodes_by_degree() const;
 
  private:
   const Harness* h_;
@@ -50,6 +58,7 @@ class HarnessTopology {
   std::vector<std::vector<int>> carried_;
   std::vector<double> diameter_;
   std::vector<int> order_;
+  std::unordered_map<std::string, std::vector<int>> incident_;
 };
 
 /// Bundle diameter rule of DESIGN §3: D = 1.2·√(Σ dᵢ²).

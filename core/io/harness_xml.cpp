@@ -512,7 +512,7 @@ Harness parse_harness_xml(const std::string& text, const std::string& name_for_e
   check_markup(text, name_for_errors);
   Reader r(text, name_for_errors);
   Harness h = r.read(doc);
-  HarnessTopology topo(h);  // validates ids, branch degree, cycles, connectivity
+  HarnessTopology topo(h);  // validates ids, cycles, connectivity (nodes of any degree)
   (void)topo;
   return h;
 }

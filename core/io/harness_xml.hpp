@@ -10,7 +10,7 @@
 namespace loom {
 
 /// Reads and validates a harness file (elements, attributes, numbers, ids). Structural
-/// checks that need the whole tree (cycles, ≠ 3 connections, disconnected cables) are done
+/// checks that need the whole tree (cycles, disconnected cables) are done
 /// by HarnessTopology, which this calls too. Throws InputError naming file, line, element.
 Harness read_harness_xml(const std::filesystem::path& path);
 /// Same, from text; `name_for_errors` stands in for the file name in messages.

@@ -5,6 +5,8 @@
 #include "core/harness_topology.hpp"
 #include "core/io/harness_xml.hpp"
 #include "core/io/input_file.hpp"
+#include "core/io/kbl_read.hpp"
+#include "core/io/kbl_vec.hpp"
 #include "core/io/mesh_read.hpp"
 #include "core/io/tessellation_cache.hpp"
 #include "core/io/toml_checks.hpp"
@@ -12,6 +14,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -132,6 +135,15 @@ std::filesystem::path resolve(const std::filesystem::path& base, const std::stri
   return p.is_absolute() ? p : base / p;
 }
 
+/// The harness file by its extension: KBL (.kbl), VEC (.vec), else loom's harness XML.
+Harness read_harness_file(const std::filesystem::path& p) {
+  std::string ext = p.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".kbl") return read_harness_kbl(p);
+  if (ext == ".vec") return read_harness_vec(p);
+  return read_harness_xml(p);
+}
+
 }  // namespace
 
 void apply_routes(Scene& scene, const std::filesystem::path& routes) {
@@ -185,7 +197,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
     if (!hf) r.fail(ht, "harness.file", "missing harness file name");
     if (hf->empty()) r.fail(ht->get("file"), "harness.file", "empty file name");
     try {
-      scene.harness = read_harness_xml(resolve(base, *hf));
+      scene.harness = read_harness_file(resolve(base, *hf));
     } catch (const InputError& e) {
       if (e.where().file.empty() || e.where().line == 0) {
         // Point at the scene entry as well so the user sees where the path came from.

@@ -12,6 +12,8 @@
 #include "routing/curve/cable_geometry.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -27,6 +29,89 @@ namespace {
 std::pair<std::string, std::string> use_nodes(const Harness& h, const SegmentUse& u) {
   const Segment& s = h.segments[static_cast<std::size_t>(u.segment)];
   return u.reversed ? std::make_pair(s.to, s.from) : std::make_pair(s.from, s.to);
+}
+
+/// The cable's turn at each node between two of its pieces (NodeTurn): the angle between
+/// the tangent arriving at the node and the one leaving it, taken up within the node's
+/// breakout, or within the shorter of the two pieces where that is shorter.
+std::vector<NodeTurn> node_turns(const HarnessTopology& topo, std::size_t cable, const std::vector<CablePiece>& pieces) {
+  const Harness& h = topo.harness();
+  const auto& chain = topo.cable_chain(static_cast<int>(cable));
+  std::vector<NodeTurn> out;
+  for (std::size_t k = 0; k + 1 < pieces.size() && k + 1 < chain.size(); ++k) {
+    const Centerline& a = pieces[k].curve;
+    const Centerline& b = pieces[k + 1].curve;
+    Vec3 da[2], db[2];
+    a.evaluate(a.u_max(), 1, da, true);
+    b.evaluate(b.u_min(), 1, db);
+    NodeTurn t;
+    t.node = use_nodes(h, chain[k]).second;
+    t.s = pieces[k + 1].s0;
+    t.point = db[0];
+    // A zero tangent (a degenerate end) has no direction: no turn is judged there.
+    t.turn = da[1].norm() > 0.0 && db[1].norm() > 0.0 ? std::atan2(da[1].cross(db[1]).norm(), da[1].dot(db[1])) : 0.0;
+    const double reach = std::min({breakout_length(topo, t.node), a.length(), b.length()});
+    const double half_tan = std::tan(0.5 * t.turn);
+    t.radius = half_tan > 0.0 ? reach / half_tan : std::numeric_limits<double>::infinity();
+    out.push_back(t);
+  }
+  return out;
+}
+
+/// Step of the walk that finds where two bundles leaving a node part, in their radii sum.
+constexpr double kRunTogetherStep = 0.25;
+/// Most steps of that walk along one segment (a longer segment is walked in longer steps).
+constexpr int kRunTogetherMaxSteps = 4000;
+
+/// How far from the node the bundles of two of its segments run together before they part:
+/// the Euclidean distance from the node of the first point of one segment's curve that lies
+/// at least the sum of their radii from the other's (either way round, the larger). Why: a
+/// file may let segments leave a node tangent to each other (a splice on a stub laid along
+/// the trunk), and their cables then touch for as long as the bundles do, by design; where
+/// the segments part and meet again, that contact is beyond this distance and a clash.
+double run_together_radius(const HarnessTopology& topo, SegmentCurves& curves, const std::string& node) {
+  const Harness& h = topo.harness();
+  const auto& inc = topo.incident_segments(node);
+  const auto at = h.node_position(node);
+  if (!at) return 0.0;
+  // Each segment's curve from the node outwards, as points a fixed step apart.
+  auto samples = [&](int s, double step) {
+    std::vector<Vec3> pts;
+    const bool backwards = h.segments[static_cast<std::size_t>(s)].to == node;
+    const auto& c = curves.segment(s, backwards);
+    if (!c) return pts;
+    const double len = c->length();
+    step = std::max(step, len / kRunTogetherMaxSteps);
+    for (double t = 0.0; t < len; t += step) pts.push_back(c->position(c->parameter_at_length(t)));
+    pts.push_back(c->position(c->u_max()));
+    return pts;
+  };
+  double out = 0.0;
+  for (std::size_t i = 0; i < inc.size(); ++i)
+    for (std::size_t j = i + 1; j < inc.size(); ++j) {
+      const int a = inc[i], b = inc[j];
+      if (topo.segment_cables(a).empty() || topo.segment_cables(b).empty()) continue;
+      const double reach = 0.5 * (topo.segment_diameter(a) + topo.segment_diameter(b));
+      const auto pa = samples(a, kRunTogetherStep * reach), pb = samples(b, kRunTogetherStep * reach);
+      for (const auto& [p, q] : {std::pair(&pa, &pb), std::pair(&pb, &pa)}) {
+        // A segment that never parts from the other runs with it to its end.
+        double parted = p->empty() ? 0.0 : (p->back() - *at).norm();
+        for (const Vec3& x : *p) {
+          double d = std::numeric_limits<double>::infinity();
+          for (std::size_t k = 0; k + 1 < q->size(); ++k) {
+            const Vec3 e = (*q)[k + 1] - (*q)[k];
+            const double t = e.squaredNorm() > 0.0 ? std::clamp((x - (*q)[k]).dot(e) / e.squaredNorm(), 0.0, 1.0) : 0.0;
+            d = std::min(d, (x - (*q)[k] - t * e).norm());
+          }
+          if (d >= reach) {
+            parted = (x - *at).norm();
+            break;
+          }
+        }
+        out = std::max(out, parted);
+      }
+    }
+  return out;
 }
 
 /// Relative widening of the port's query box over the largest per-part reach (rounding only).
@@ -111,6 +196,7 @@ std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCa
   HarnessTopology topo(h);
   SegmentCurves curves(topo);
   std::vector<CableInput> out;
+  std::map<std::string, double> junction_radius;  // per node, once
   cables.clear();
   for (std::size_t c = 0; c < h.cables.size(); ++c) {
     AuditCable ac;
@@ -132,7 +218,7 @@ std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCa
     const auto& chain = topo.cable_chain(static_cast<int>(c));
     for (std::size_t k = 0; k < chain.size(); ++k) {
       const SegmentUse& u = chain[k];
-      const auto seg = segment_centerline(h, u.segment);
+      const auto& seg = curves.segment(u.segment, false);
       const double len = seg ? seg->length() : 0.0;
       // Only bundle segments excuse contacts (a single-cable segment is never shared).
       if (topo.is_bundle(u.segment)) in.segments.push_back({u.segment, s, s + len});
@@ -143,16 +229,25 @@ std::vector<CableInput> audit_cable_inputs(const Harness& h, std::vector<AuditCa
           continue;
         const auto pos = h.node_position(n);
         if (!pos) continue;
-        double rad = 0.0;
-        for (int inc : topo.incident_segments(n)) rad = std::max(rad, topo.segment_diameter(inc));
-        // At a branch point cables run bundled along the breakout before they separate
-        // (the router leaves it straight for breakout_length); allow contact over twice
-        // that, the run-out of two tubes diverging at their minimum bend radius.
-        if (h.find_branch(n) >= 0) rad = std::max(rad, 2.0 * breakout_length(topo, n));
-        in.junctions.push_back({n, *pos, rad});
+        auto known = junction_radius.find(n);
+        if (known == junction_radius.end()) {
+          double rad = 0.0;
+          for (int inc : topo.incident_segments(n)) rad = std::max(rad, topo.segment_diameter(inc));
+          // At a branch point cables run bundled along the breakout before they separate
+          // (the router leaves it straight for breakout_length); allow contact over twice
+          // that, the run-out of two tubes diverging at their minimum bend radius.
+          if (h.find_branch(n) >= 0) rad = std::max(rad, 2.0 * breakout_length(topo, n));
+          known = junction_radius.emplace(n, std::max(rad, run_together_radius(topo, curves, n))).first;
+        }
+        const double rad = known->second;
+        // Every node but the two ends of the chain is one the cable passes through.
+        const bool passes = !(k == 0 && n == nodes.first) && !(k + 1 == chain.size() && n == nodes.second);
+        in.junctions.push_back({n, *pos, rad, passes});
       }
     }
-    for (auto& piece : curves.pieces(static_cast<int>(c))) in.bend_pieces.emplace_back(piece.s0, std::move(piece.curve));
+    auto pieces = curves.pieces(static_cast<int>(c));
+    in.node_turns = node_turns(topo, c, pieces);
+    for (auto& piece : pieces) in.bend_pieces.emplace_back(piece.s0, std::move(piece.curve));
     ac.routed = true;
     ac.check_index = static_cast<int>(out.size());
     cables.push_back(ac);
@@ -271,7 +366,15 @@ void apply_matching_routes(Scene& scene, const std::filesystem::path& routes) {
   std::optional<Harness> designed;
   if (scene.has_harness) designed = std::move(scene.harness);
   apply_routes(scene, routes);
-  if (designed) check_routes_match(*designed, scene.harness);
+  if (!designed) return;
+  check_routes_match(*designed, scene.harness);
+  // Routes of a harness read from KBL, with its segments between the same nodes, can be
+  // written back into that file (routed.kbl).
+  const auto& a = designed->segments;
+  const auto& b = scene.harness.segments;
+  bool same = designed->kbl && a.size() == b.size();
+  for (std::size_t k = 0; same && k < a.size(); ++k) same = a[k].from == b[k].from && a[k].to == b[k].to;
+  if (same) scene.harness.kbl = designed->kbl;
 }
 
 AuditReport audit_scene_file(const std::filesystem::path& scene_file, const AuditOptions& opt, Scene* loaded) {

@@ -33,9 +33,10 @@ constexpr double kChordShareOfTolerance = 0.5;
 /// tolerance (e.g. 200,000 key points 1 µm apart) and flattening it would not end.
 constexpr double kMaxChordsPerCable = 1e7;
 
-/// The smallest bend radius of cable c (per bend piece where it has them) into `sum`, and a
-/// bend-radius violation into `out` for every stretch bending tighter than the cable's
-/// minimum (Centerline::bend_stretches_below), at its tightest point.
+/// The smallest bend radius of cable c (per bend piece where it has them, and at the nodes
+/// it passes) into `sum`, and a bend-radius violation into `out` for every stretch bending
+/// tighter than the cable's minimum (Centerline::bend_stretches_below), at its tightest
+/// point, and for every node turn tighter than it (NodeTurn).
 void check_bend(const Context& ctx, std::size_t c, CableCheckSummary& sum, std::vector<Violation>& out) {
   const CableInput& in = ctx.cables[c];
   BendExtremum b = in.bend_pieces.empty() ? in.curve.min_bend_radius() : BendExtremum{};
@@ -49,6 +50,8 @@ void check_bend(const Context& ctx, std::size_t c, CableCheckSummary& sum, std::
       }
     }
   }
+  for (const NodeTurn& t : in.node_turns)
+    if (t.radius < b.radius) b.radius = t.radius, b.s = t.s;
   sum.min_bend_radius = b.radius;
   sum.min_bend_s = b.s;
   if (!(ctx.req.check_bend && in.min_bend_radius > 0.0 && b.radius < in.min_bend_radius)) return;
@@ -68,6 +71,17 @@ void check_bend(const Context& ctx, std::size_t c, CableCheckSummary& sum, std::
   };
   if (in.bend_pieces.empty()) add(in.curve, 0.0);
   for (const auto& [s0, piece] : in.bend_pieces) add(piece, s0);
+  for (const NodeTurn& t : in.node_turns) {
+    if (!(t.radius < in.min_bend_radius)) continue;
+    Violation v;
+    v.kind = ViolationKind::BendRadius;
+    v.cable = static_cast<int>(c);
+    v.value = t.radius;
+    v.limit = in.min_bend_radius;
+    v.s = t.s;
+    v.point = t.point;
+    out.push_back(v);
+  }
 }
 
 }  // namespace

@@ -57,6 +57,23 @@ struct CableJunction {
   std::string node;     ///< node id (shared ids identify the same junction)
   Vec3 position = Vec3::Zero();
   double radius = 0.0;  ///< contacts with both points within this distance of the node are excused
+  /// The cable passes through the node between two of its segments (not one of its ends):
+  /// its own contacts within `radius` of it are its turn there, judged as a bend (NodeTurn).
+  bool passes = false;
+};
+
+/// Where a cable passes a node between two harness segments, at any node degree. The
+/// wires splay inside the node's breakout, so the direction change between the segments is
+/// not a kink of one cable; it is a bend that the breakout takes up: the tightest arc
+/// tangent to both directions within `reach` of the node has radius reach / tan(turn / 2).
+/// A turn of up to 90° always fits (the breakout is at least the largest bend radius); a
+/// fold back through the node does not, and is reported as a bend, not a self clash.
+struct NodeTurn {
+  std::string node;         ///< node id
+  double s = 0.0;           ///< arc length of the node along the cable, scene units
+  Vec3 point = Vec3::Zero();  ///< the node's position on the centerline
+  double turn = 0.0;        ///< angle between the arriving and the leaving tangent, radians
+  double radius = 0.0;      ///< reach / tan(turn / 2), scene units (infinity for no turn)
 };
 
 /// A part a cable end is attached to: the connector (or the box it is mounted on) that its
@@ -86,9 +103,11 @@ struct CableInput {
   std::vector<CableSegmentRange> segments;  ///< the harness segments it runs through, in order
   std::vector<CableJunction> junctions;     ///< nodes on its route (for junction excuses)
   /// Pieces over which bends are judged: (arc length where the piece starts, its curve).
-  /// Empty: the whole `curve`. Where two harness segments meet at a branch point the wires
-  /// splay inside the breakout, so the direction change there is not a bend of one cable.
+  /// Empty: the whole `curve`. Where two harness segments meet at a node the wires splay
+  /// inside the breakout, so the direction change there is judged as a NodeTurn instead.
   std::vector<std::pair<double, Centerline>> bend_pieces;
+  /// The direction changes between bend pieces, one per node the cable passes (NodeTurn).
+  std::vector<NodeTurn> node_turns;
   /// Parts its ports sit on (never keep-out parts): not checked against over the ranges given.
   std::vector<PartAttachment> attachments;
 };

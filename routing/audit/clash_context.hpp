@@ -115,6 +115,14 @@ inline bool excused(const CableInput& a, double s, const Vec3& p, const CableInp
   return false;
 }
 
+/// True when a self contact of cable c between points p and q lies within the radius of a
+/// node it passes through: its turn at the node, judged as a bend (NodeTurn), not a clash.
+inline bool self_excused_at_node(const CableInput& c, const Vec3& p, const Vec3& q) {
+  for (const auto& j : c.junctions)
+    if (j.passes && (p - j.position).norm() <= j.radius && (q - j.position).norm() <= j.radius) return true;
+  return false;
+}
+
 /// Certified cable–structure pass of one cable (sphere tracing + exact chords): its clashes
 /// and clearance violations appended, its smallest clearance written into `sum`.
 void certified_structure(Context& ctx, int cable, CableCheckSummary& sum, std::vector<ClashEntry>& clashes,

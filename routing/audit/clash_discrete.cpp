@@ -126,7 +126,7 @@ void discrete_cable_pairs(Context& ctx, const std::vector<DiscreteSamples>& ds, 
     if (!(d < limit)) return;
     const double s = mid ? 0.5 * (ds[a].s[k] + ds[a].s[k + 1]) : ds[a].s[k];
     const double t = ds[b].s[m];
-    if (!self && excused(cables[a], s, p, cables[b], t, q)) return;
+    if (self ? self_excused_at_node(cables[a], p, q) : excused(cables[a], s, p, cables[b], t, q)) return;
     const double ha = ds[a].spacing, hb = ds[b].spacing;
     local.push_back(PairContact::ordered(a, s, s - ha, s + ha, p, b, t, t - hb, t + hb, q, d));
     if (local.size() > ctx.req.limits.max_pair_contacts) refuse_contacts(ctx, local, "samples");

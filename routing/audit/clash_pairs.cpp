@@ -92,7 +92,9 @@ std::int64_t narrow_phase(const Context& ctx, const CableChords& A, std::size_t 
         r = *apart;
         s = sa0 + r.s * (sa1 - sa0);
         t = tb0 + r.t * (tb1 - tb0);
-      } else if (!self && excused(ca, s, r.p, cb, t, r.q)) {
+      }
+      if (self && self_excused_at_node(ca, r.p, r.q)) continue;  // the node's turn: a bend
+      if (!self && excused(ca, s, r.p, cb, t, r.q)) {
         // Excused there: the closest points of the two chords outside the excused region instead.
         const auto boxes =
             excused_boxes(ca, A.ch.p[ka], A.ch.p[ka + 1], sa0, sa1, cb, B.ch.p[kb], B.ch.p[kb + 1], tb0, tb1);

@@ -1,5 +1,6 @@
 #include "routing/curve/cable_geometry.hpp"
 
+#include "core/bspline_ops.hpp"
 #include "core/error.hpp"
 
 #include <algorithm>
@@ -16,127 +17,6 @@ double derived_stub_length(double radius, double min_bend_radius) {
 }
 
 namespace {
-
-/// The curve traversed backwards: u ↦ (a + b) − u.
-Centerline reversed(const Centerline& c) {
-  const auto& k = c.knots();
-  const double a = k.front(), b = k.back();
-  std::vector<double> knots(k.size());
-  for (std::size_t i = 0; i < k.size(); ++i) knots[i] = a + b - k[k.size() - 1 - i];
-  std::vector<Vec3> cps(c.control_points().rbegin(), c.control_points().rend());
-  return Centerline(c.degree(), std::move(knots), std::move(cps));
-}
-
-/// A degree-1 curve as an exact cubic: each linear piece becomes a cubic Bézier with
-/// control points at thirds; interior knots get multiplicity 3 (the corners stay corners).
-Centerline linear_as_cubic(const Centerline& c) {
-  const auto& k = c.knots();
-  const auto& p = c.control_points();
-  std::vector<double> knots;
-  std::vector<Vec3> cps{p.front()};
-  knots.insert(knots.end(), 4, k[1]);
-  for (std::size_t i = 0; i + 1 < p.size(); ++i) {
-    const Vec3 d = p[i + 1] - p[i];
-    cps.push_back(p[i] + d / 3.0);
-    cps.push_back(p[i] + 2.0 * d / 3.0);
-    cps.push_back(p[i + 1]);
-    const double t = k[i + 2];
-    knots.insert(knots.end(), i + 2 < p.size() ? 3 : 4, t);
-  }
-  return Centerline(3, std::move(knots), std::move(cps));
-}
-
-/// Inserts u once into the knots U of a degree-p curve with control points P, in knot
-/// interval k (U[k] ≤ u ≤ U[k+1], U[k] < U[k+1]); the curve is unchanged (Boehm; Piegl &
-/// Tiller A5.1).
-void insert_knot(int p, std::size_t k, double u, std::vector<double>& U, std::vector<Vec3>& P) {
-  const std::size_t q = static_cast<std::size_t>(p);
-  std::vector<Vec3> Q(P.size() + 1);
-  for (std::size_t i = 0; i + q <= k; ++i) Q[i] = P[i];
-  for (std::size_t i = k - q + 1; i <= k; ++i) {
-    const double a = (u - U[i]) / (U[i + q] - U[i]);
-    Q[i] = a * P[i] + (1.0 - a) * P[i - 1];
-  }
-  for (std::size_t i = k + 1; i < Q.size(); ++i) Q[i] = P[i - 1];
-  U.insert(U.begin() + static_cast<std::ptrdiff_t>(k) + 1, u);
-  P = std::move(Q);
-}
-
-/// The same curve with a clamped knot vector (end knots of multiplicity degree + 1, so that
-/// it starts at its first control point and ends at its last, as join() needs). An exact
-/// <bspline> may have any non-decreasing knots: its domain ends are raised to multiplicity
-/// degree by knot insertion, and the control points and knots outside the domain dropped
-/// (the curve split at its ends, Piegl & Tiller §5.6).
-Centerline clamped(const Centerline& c) {
-  const int p = c.degree();
-  const std::size_t q = static_cast<std::size_t>(p);
-  std::vector<double> U = c.knots();
-  std::vector<Vec3> P = c.control_points();
-  auto run = [&U](double u) { return std::equal_range(U.begin(), U.end(), u); };
-  // Start: after insertion u_min fills U[j, j + m) with m ≥ p, and the curve starts at
-  // control point j + m − p − 1.
-  const double a = U[q];
-  for (auto r = run(a); r.second - r.first < p; r = run(a))
-    insert_knot(p, static_cast<std::size_t>(r.second - U.begin()) - 1, a, U, P);
-  {
-    const auto r = run(a);
-    const std::size_t j = static_cast<std::size_t>(r.first - U.begin()), m = static_cast<std::size_t>(r.second - r.first);
-    std::vector<double> V(q + 1, a);
-    V.insert(V.end(), U.begin() + static_cast<std::ptrdiff_t>(j + m), U.end());
-    P.erase(P.begin(), P.begin() + static_cast<std::ptrdiff_t>(j + m - q - 1));
-    U = std::move(V);
-  }
-  // End: u_max fills U[f, f + m) with m ≥ p, and the curve ends at control point f − 1.
-  const double b = U[P.size()];
-  for (auto r = run(b); r.second - r.first < p; r = run(b))
-    insert_knot(p, static_cast<std::size_t>(r.first - U.begin()) - 1, b, U, P);
-  const std::size_t f = static_cast<std::size_t>(run(b).first - U.begin());
-  U.resize(f);
-  U.insert(U.end(), q + 1, b);
-  P.resize(f);
-  return Centerline(p, std::move(U), std::move(P));
-}
-
-Centerline as_cubic(const Centerline& c) {
-  if (c.degree() == 3) return clamped(c);
-  if (c.degree() == 1) return linear_as_cubic(c);
-  throw std::invalid_argument("cable_centerline: only degree 1 and 3 segment curves can be joined, got degree " +
-                              std::to_string(c.degree()));
-}
-
-/// Largest gap between the end of one piece and the start of the next that join() closes,
-/// relative to the pieces' extent (control-point bounding box): rounding of coordinates
-/// written out and read back. Pieces built here meet exactly (both ends are the node's
-/// position); an exact <bspline> that stops short of its node does not make a curve.
-constexpr double kJoinGapRel = 1e-9;
-
-/// How far apart two points that should coincide may lie, given the box of the control
-/// points they come from: kJoinGapRel of the box's extent and of its distance from the
-/// origin (coordinates 10⁶ from it round by ~10⁻¹⁰ each when written and read).
-double meeting_tolerance(const AABB& box) {
-  return kJoinGapRel * (box.diagonal() + std::max(box.min.cwiseAbs().maxCoeff(), box.max.cwiseAbs().maxCoeff()));
-}
-
-/// Joins two clamped cubics end to start (C0 at the joint, knot multiplicity 3 there).
-/// Throws std::invalid_argument if they do not meet (within meeting_tolerance).
-Centerline join(const Centerline& a, const Centerline& b) {
-  const Vec3 end = a.control_points().back(), start = b.control_points().front();
-  AABB box;
-  for (const Centerline* c : {&a, &b})
-    for (const Vec3& q : c->control_points()) box.extend(q);
-  if ((end - start).norm() > meeting_tolerance(box))
-    throw std::invalid_argument("consecutive segments do not meet: one ends at " + full_precision(end) +
-                                ", the next starts at " + full_precision(start) + " (gap " +
-                                full_precision((end - start).norm()) + ")");
-  const auto& ka = a.knots();
-  const auto& kb = b.knots();
-  const double shift = ka.back() - kb.front();
-  std::vector<double> knots(ka.begin(), ka.end() - 1);  // a's knots with its end knot thrice
-  for (std::size_t i = 4; i < kb.size(); ++i) knots.push_back(kb[i] + shift);
-  std::vector<Vec3> cps = a.control_points();
-  cps.insert(cps.end(), b.control_points().begin() + 1, b.control_points().end());
-  return Centerline(3, std::move(knots), std::move(cps));
-}
 
 /// A cable whose segments do not make a curve (coincident key points, an empty knot
 /// domain, a degree that cannot be joined, ...) is a fault of the harness file: every user
@@ -235,9 +115,13 @@ std::optional<Centerline> SegmentCurves::cable(int cable) {
   const auto pieces = this->pieces(cable);
   if (pieces.empty()) return std::nullopt;
   try {
+    // Joined at the highest degree of the chain (routed pieces are cubic, pieces read from a
+    // file may be of any degree the readers accept, polylines are degree 1).
+    int degree = 3;
+    for (const CablePiece& p : pieces) degree = std::max(degree, p.curve.degree());
     for (const CablePiece& p : pieces) {
-      Centerline cubic = as_cubic(p.curve);
-      out = out ? join(*out, cubic) : cubic;
+      Centerline piece = elevated(clamped(p.curve), degree);
+      out = out ? join(*out, piece) : piece;
     }
   } catch (const std::invalid_argument& e) {
     not_a_curve(topo_.harness(), cable, e);

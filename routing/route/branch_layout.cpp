@@ -252,7 +252,9 @@ std::map<std::pair<int, bool>, Vec3> branch_exit_directions(const Harness& h, co
         if (m >= 0 && shares(k, m)) open_up(e[k], e[m]);
     }
     // Without a main line, pairs are opened in turn; opening one pair can close another, so
-    // repeat (three unit vectors can always be pairwise ≥ 90° apart).
+    // repeat. At most six directions can be pairwise ≥ 90° apart (±x, ±y, ±z): at a node of
+    // higher degree whose legs all share cables the rounds end with some pairs closer, and
+    // the audit judges a cable's turn there as a bend within the breakout (NodeTurn).
     for (int round = 0; main.first < 0 && round < kOpenRounds; ++round) {
       bool changed = false;
       for (std::size_t i = 0; i < inc.size(); ++i)

@@ -1,6 +1,6 @@
 #pragma once
 /// Where the router puts the branch points a harness file leaves open, and in which
-/// direction each harness segment leaves a branch point. Both are decided before
+/// direction each harness segment leaves a branch point (at any node degree). Both are decided before
 /// planning, from the harness tree, the ports' connector axes and the obstacles.
 
 #include "core/harness.hpp"
@@ -61,7 +61,9 @@ constexpr double kMaxMainLineTurn = 1.0471975511965976;  // 60°
 /// end counts at the end of its stub); the pair of segments that most cables pass between,
 /// among pairs within kMaxMainLineTurn of a straight line, forms the main line and leaves
 /// in exactly opposite directions so that cables along it run smooth through the node.
-/// Segments that share cables leave at least 90° apart (no cable folds back at the node).
+/// Segments that share cables leave at least 90° apart (no cable folds back at the node)
+/// wherever the node's degree allows it: at any degree along a main line, and among free
+/// legs up to six of them.
 std::map<std::pair<int, bool>, Vec3> branch_exit_directions(const Harness& h, const HarnessTopology& topo,
                                                             const std::vector<SegmentEnds>& ends);
 

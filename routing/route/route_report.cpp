@@ -3,6 +3,7 @@
 #include "core/harness_topology.hpp"
 #include "core/io/atomic_file.hpp"
 #include "core/io/harness_xml.hpp"
+#include "core/io/kbl_write.hpp"
 #include "core/io/mesh_write.hpp"
 #include "routing/curve/cable_geometry.hpp"
 #include "core/io/json_text.hpp"
@@ -111,7 +112,7 @@ json route_report_json(const RouteReport& rep) {
 }
 
 std::vector<std::filesystem::path> route_output_files(const std::filesystem::path& dir) {
-  return {dir / "routed.xml", dir / "report.json", dir / "cables.ply"};
+  return {dir / "routed.xml", dir / "report.json", dir / "cables.ply", dir / kRoutedKblName};
 }
 
 void write_route_outputs(const RouteReport& rep, const std::filesystem::path& dir, double chord_tolerance) {
@@ -134,6 +135,7 @@ void write_route_outputs(const RouteReport& rep, const std::filesystem::path& di
     colors.insert(colors.end(), tube.mesh.vertices.size(), cable_color(c));
   }
   write_harness_xml(rep.routed, dir / "routed.xml");
+  if (rep.routed.kbl) write_harness_kbl(rep.routed, dir / kRoutedKblName);
   write_file_atomic(dir / "report.json", json_text(route_report_json(rep), 2) + "\n");
   write_mesh(dir / "cables.ply", all, colors);
 }

@@ -14,12 +14,14 @@ namespace loom {
 nlohmann::json route_report_json(const RouteReport& report);
 
 /// Writes DIR/routed.xml, DIR/report.json and DIR/cables.ply (one swept tube per routed
-/// cable, coloured per cable), each atomically. `chord_tolerance` sets the tube resolution.
+/// cable, coloured per cable), each atomically, and DIR/routed.kbl when the harness was read
+/// from KBL (kbl_write.hpp). `chord_tolerance` sets the tube resolution.
 /// The tubes are swept first, within kHarnessTubeTriangleBudget triangles together; past
 /// it throws std::invalid_argument naming the cable, and writes nothing.
 void write_route_outputs(const RouteReport& report, const std::filesystem::path& dir, double chord_tolerance);
 
-/// The files write_route_outputs() writes into `dir` (routed.xml, report.json, cables.ply).
+/// The files write_route_outputs() may write into `dir` (routed.xml, report.json, cables.ply,
+/// routed.kbl).
 std::vector<std::filesystem::path> route_output_files(const std::filesystem::path& dir);
 
 }  // namespace loom

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 
 namespace loom {
 namespace {
@@ -102,12 +103,79 @@ void expect_error(const Harness& h, const std::string& needle) {
   }
 }
 
-TEST(HarnessTopology, BranchWithTwoConnections) {
+TEST(HarnessTopology, BranchWithTwoConnectionsIsAPassThroughPoint) {
   Harness h = sample();
   h.segments.pop_back();  // B2 now joins only B1 and P3
   h.cables.pop_back();
   h.cables.erase(h.cables.begin() + 2);  // drop C3, which used P4
-  expect_error(h, "exactly 3 nodes, this one connects 2");
+  HarnessTopology t(h);
+  // C1 P1 -> B1 -> B2 -> P3 runs through the pass-through point B2.
+  ASSERT_EQ(t.cable_chain(0).size(), 3u);
+  EXPECT_EQ(t.incident_segments("B2"), (std::vector<int>{2, 3}));
+  const auto notes = t.notes();
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("branch 'B2' joins 2 nodes: a pass-through point"), std::string::npos) << notes[0];
+}
+
+/// Tree path between two nodes by brute force: depth-first search over the segments.
+bool dfs_path(const Harness& h, const std::string& at, const std::string& goal, std::vector<int>& used,
+              std::vector<int>& path) {
+  if (at == goal) return true;
+  for (std::size_t s = 0; s < h.segments.size(); ++s) {
+    if (used[s]) continue;
+    const Segment& sg = h.segments[s];
+    if (sg.from != at && sg.to != at) continue;
+    used[s] = 1;
+    path.push_back(static_cast<int>(s));
+    if (dfs_path(h, sg.from == at ? sg.to : sg.from, goal, used, path)) return true;
+    path.pop_back();
+  }
+  return false;
+}
+
+// Nodes of 4, 8 and 16 segments: two hubs joined by a trunk, N − 1 ports on each; every
+// cable's chain is the tree path found by brute force, in order and direction.
+TEST(HarnessTopology, NodesOfAnyDegree) {
+  for (int n : {4, 8, 16}) {
+    Harness h;
+    h.source_file = "hubs.xml";
+    h.branches = {{"A", Vec3::Zero(), 3}, {"B", Vec3(100, 0, 0), 4}};
+    h.segments.push_back(seg("A", "B"));
+    for (int i = 0; i < n - 1; ++i) {
+      for (const char* hubid : {"A", "B"}) {
+        const std::string id = std::string("P") + hubid + std::to_string(i);
+        h.ports.push_back(port(id, i));
+        h.segments.push_back(i % 2 ? seg(id, hubid) : seg(hubid, id));
+      }
+    }
+    for (int i = 0; i < n - 1; ++i)
+      for (int j = 0; j < n - 1; j += 3) {
+        h.cables.push_back(cable("CA" + std::to_string(i) + "_" + std::to_string(j), "PA" + std::to_string(i),
+                                 "PB" + std::to_string(j), 1));
+        if (i != j)
+          h.cables.push_back(cable("CS" + std::to_string(i) + "_" + std::to_string(j), "PA" + std::to_string(i),
+                                   "PA" + std::to_string(j), 1));
+      }
+    HarnessTopology t(h);
+    EXPECT_EQ(static_cast<int>(t.incident_segments("A").size()), n);
+    EXPECT_EQ(t.nodes_by_degree(), (std::map<int, int>{{1, 2 * (n - 1)}, {n, 2}}));
+    const auto notes = t.notes();
+    ASSERT_EQ(notes.size(), n == 3 ? 0u : 2u);
+    EXPECT_NE(notes[0].find("hubs.xml:3 branch 'A' joins " + std::to_string(n) + " nodes"), std::string::npos);
+    for (std::size_t c = 0; c < h.cables.size(); ++c) {
+      std::vector<int> used(h.segments.size(), 0), path;
+      ASSERT_TRUE(dfs_path(h, h.cables[c].ports[0], h.cables[c].ports[1], used, path));
+      const auto& chain = t.cable_chain(static_cast<int>(c));
+      ASSERT_EQ(chain.size(), path.size()) << h.cables[c].id;
+      std::string at = h.cables[c].ports[0];
+      for (std::size_t k = 0; k < path.size(); ++k) {
+        EXPECT_EQ(chain[k].segment, path[k]);
+        const Segment& sg = h.segments[path[k]];
+        EXPECT_EQ(chain[k].reversed, sg.to == at) << h.cables[c].id << " step " << k;
+        at = sg.from == at ? sg.to : sg.from;
+      }
+    }
+  }
 }
 
 TEST(HarnessTopology, Cycle) {

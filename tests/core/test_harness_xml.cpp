@@ -181,13 +181,32 @@ TEST(HarnessXml, UnknownPortId) {
       <physical type="AWG20")", {"bad.xml:4:", "cable 'C1'", "unknown port id 'J9.9'"});
 }
 
-TEST(HarnessXml, BranchWithFourConnections) {
-  expect_bad(R"(<segment to="J2.1"/>)", R"(<segment to="J2.1"/><segment to="J4.1"/>)",
-             {"branch 'B1'", "exactly 3 nodes, this one connects 4"});
+// The patent's branch points join exactly 3 nodes; loom reads any degree and notes it.
+TEST(HarnessXml, BranchWithFourConnectionsIsReadWithANote) {
+  std::string text = kSample;
+  const std::string from = R"(<segment to="J2.1"/>)";
+  text.replace(text.find(from), from.size(), R"(<segment to="J2.1"/><segment to="J4.1"/>)");
+  const Harness h = parse_harness_xml(text, "four.xml");
+  const HarnessTopology t(h);
+  EXPECT_EQ(t.incident_segments("B1").size(), 4u);
+  ASSERT_EQ(t.notes().size(), 1u);
+  EXPECT_NE(t.notes()[0].find("branch 'B1' joins 4 nodes"), std::string::npos) << t.notes()[0];
 }
 
-TEST(HarnessXml, BranchWithTwoConnections) {
-  expect_bad(R"(<segment to="J2.1"/>)", "", {"branch 'B1'", "connects 2"});
+TEST(HarnessXml, BranchWithTwoConnectionsIsAPassThroughPoint) {
+  // B1 keeps J1.1 and J3.4 only: C1 runs through it; C2 and J2.1 go.
+  std::string text = kSample;
+  for (const std::string cut : {R"(<segment to="J2.1"/>)", R"(<port id="J2.1" x="0" y="100" z="0" dx="1" dy="0" dz="0"/>)"})
+    text.erase(text.find(cut), cut.size());
+  const auto c2 = text.find(R"(<cable id="C2">)");
+  text.erase(c2, text.find("</cable>", c2) + 8 - c2);
+  const Harness h = parse_harness_xml(text, "two.xml");
+  const HarnessTopology t(h);
+  EXPECT_EQ(t.incident_segments("B1").size(), 2u);
+  EXPECT_EQ(t.cable_chain(h.find_cable("C1")).size(), 2u);
+  ASSERT_EQ(t.notes().size(), 1u);
+  EXPECT_NE(t.notes()[0].find("two.xml:"), std::string::npos) << t.notes()[0];
+  EXPECT_NE(t.notes()[0].find("branch 'B1' joins 2 nodes: a pass-through point"), std::string::npos) << t.notes()[0];
 }
 
 TEST(HarnessXml, Cycle) {
