@@ -221,8 +221,8 @@ TEST(Regression, AlphaSimCorefinementOrderDoesNotFollowTheHeap) {
 // holds (~12k of 400k random points inside the implicit solid and outside the mesh);
 // CGAL's is 580.5 mm³ and holds it. The lost piece holds no surface of the boxes, so the
 // containment check passed: the error was silent. With the outlines not grown
-// (polygon_growth_factor 0) both give 580.48. The default path is CGAL's; this checks
-// that its mesh holds the implicit solid on this input (it fails with occt_booleans).
+// (polygon_growth_factor 0) both give 580.48. CGAL runs the Booleans unless STEP output is
+// asked for; this checks that its mesh holds the implicit solid on this input.
 TEST(Regression, AlphaSimMeshHoldsTheImplicitSolidOfTwoTurnedBoxes) {
   loom::Part boxes;
   boxes.name = "boxes";
@@ -262,9 +262,8 @@ TEST(Regression, AlphaSimMeshHoldsTheImplicitSolidOfTwoTurnedBoxes) {
 // silhouette triangles (seen nearly edge-on) project to between the lattice nodes; each
 // repair closed the points found, the next round found others, and after three rounds
 // the plane became its hull. The slivers' edges are checked exactly (segment_gaps)
-// and closed in the first repair of a plane's sample misses
-// (AlphaSimOptions::thin_edge_factor), and a plane becomes its hull only after three
-// repairs of its own (the rounds were counted for all planes together).
+// and every triangle is tested whole against every shape (AlphaShape2D::triangle_gaps), so
+// no plane depends on random samples to be repaired.
 TEST(Regression, AlphaSimBunnyIsNotThreeConvexHulls) {
   LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   const loom::Part bunny = shared_part("bunny", "trimesh/bunny.ply");
@@ -312,37 +311,32 @@ TEST(Regression, AlphaSimFacesTouchingThemselvesAreMerged) {
 
 }  // namespace
 
-// The random-sample verification (4 samples per L_max², fresh ones
-// each round) passed shapes that did not hold every triangle of the part. On the bunny at
-// dim_pre = 4% of its diagonal the implicit solid left 4 of 209,916 points of a lattice
-// on the triangles (L_max/4 apart, corners and edges included) outside by more than the
-// tolerance: slivers the random samples, a few per L_max², never fell in. Exact
-// containment (AlphaSimOptions::exact_containment, the default) tests every triangle
-// whole against every shape (AlphaShape2D::triangle_gaps) and repairs what it finds.
+// A random-sample verification (4 samples per L_max², fresh ones each round) passed shapes
+// that did not hold every triangle of the part: on the bunny at dim_pre = 4% of its
+// diagonal the implicit solid left 4 of 209,916 points of a lattice on the triangles
+// (L_max/4 apart, corners and edges included) outside by more than the tolerance: slivers
+// the random samples, a few per L_max², never fell in. Every triangle is now tested whole
+// against every shape (AlphaShape2D::triangle_gaps) and what is found is repaired.
 TEST(Regression, AlphaSimRandomSamplesMissedSliversOfTheSurface) {
   LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   const loom::Part bunny = shared_part("bunny", "trimesh/bunny.ply");
-  auto outside = [&](bool exact) {
-    loom::AlphaSimOptions o;
-    o.dim_pre = 0.04 * bunny.mesh.bounds().diagonal();
-    o.exact_containment = exact;
-    o.coarse_interior = exact;  // sampled containment, or exact (the default)
-    const loom::AlphaSimPart sp = loom::simplify_part(bunny, o);
-    EXPECT_EQ(sp.result.status, loom::AlphaSimStatus::Ok) << sp.result.reason;
-    EXPECT_DOUBLE_EQ(sp.result.containment, 1.0);  // the mesh's own samples pass either way
-    std::size_t out = 0;
-    for (const auto& f : bunny.mesh.triangles) {
-      const loom::Vec3 a = bunny.mesh.vertices[f[0]], b = bunny.mesh.vertices[f[1]], c = bunny.mesh.vertices[f[2]];
-      const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
-      const int n = std::max(1, static_cast<int>(std::ceil(longest / (sp.result.l_max / 4.0))));
-      for (int i = 0; i <= n; ++i)
-        for (int j = 0; i + j <= n; ++j)
-          out += sp.solid->contains(a + (b - a) * (double(i) / n) + (c - a) * (double(j) / n), sp.result.tolerance) ? 0 : 1;
-    }
-    return out;
-  };
-  EXPECT_GT(outside(false), 0u);
-  EXPECT_EQ(outside(true), 0u);
+  loom::AlphaSimOptions o;
+  o.dim_pre = 0.04 * bunny.mesh.bounds().diagonal();
+  const loom::AlphaSimPart sp = loom::simplify_part(bunny, o);
+  EXPECT_EQ(sp.result.status, loom::AlphaSimStatus::Ok) << sp.result.reason;
+  EXPECT_DOUBLE_EQ(sp.result.containment, 1.0);
+  ASSERT_TRUE(sp.solid);
+  std::size_t out = 0, points = 0;
+  for (const auto& f : bunny.mesh.triangles) {
+    const loom::Vec3 a = bunny.mesh.vertices[f[0]], b = bunny.mesh.vertices[f[1]], c = bunny.mesh.vertices[f[2]];
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const int n = std::max(1, static_cast<int>(std::ceil(longest / (sp.result.l_max / 4.0))));
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; i + j <= n; ++j, ++points)
+        out += sp.solid->contains(a + (b - a) * (double(i) / n) + (c - a) * (double(j) / n), sp.result.tolerance) ? 0 : 1;
+  }
+  EXPECT_GT(points, 200000u);
+  EXPECT_EQ(out, 0u);
 }
 
 // fill_pinches visited the pinched vertices in the order of their
