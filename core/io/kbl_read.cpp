@@ -7,7 +7,7 @@
 #include "core/io/input_file.hpp"
 #include "core/io/kbl_curve.hpp"
 #include "core/io/kbl_dom.hpp"
-#include "core/io/xml_lines.hpp"
+#include "core/io/line_map.hpp"
 
 #include <pugixml.hpp>
 
@@ -188,7 +188,7 @@ class KblReader {
   void read_fixings(Harness& h);
   void count_ignored(const pugi::xml_node& root, const pugi::xml_node& harness);
 
-  XmlLines lines_;
+  LineMap lines_;
   std::string file_;
   std::unordered_map<std::string, pugi::xml_node> by_id_;
   std::vector<NodeRec> nodes_;
@@ -866,7 +866,7 @@ Harness parse_harness_kbl(std::string text, const std::string& name_for_errors) 
   auto owned = std::make_shared<const std::string>(std::move(text));
   pugi::xml_document doc;
   const auto res = doc.load_buffer(owned->data(), owned->size(), pugi::parse_default | pugi::parse_doctype);
-  const XmlLines lines(*owned);
+  const LineMap lines(*owned);
   if (!res) throw InputError({name_for_errors, lines.line(res.offset), ""}, std::string("malformed XML: ") + res.description());
   for (auto n : doc.children())
     if (n.type() == pugi::node_doctype)

@@ -4,7 +4,7 @@
 #include "core/error.hpp"
 #include "core/io/input_file.hpp"
 #include "core/io/kbl_dom.hpp"
-#include "core/io/xml_lines.hpp"
+#include "core/io/line_map.hpp"
 
 #include <pugixml.hpp>
 
@@ -16,7 +16,7 @@
 namespace loom {
 
 Harness parse_harness_vec(const std::string& text, const std::string& name_for_errors) {
-  const XmlLines lines(text);
+  const LineMap lines(text);
   pugi::xml_document doc;
   const auto res = doc.load_buffer(text.data(), text.size());
   if (!res) throw InputError({name_for_errors, lines.line(res.offset), ""}, std::string("malformed XML: ") + res.description());

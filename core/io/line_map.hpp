@@ -17,6 +17,8 @@ class LineMap {
     for (std::size_t i = 0; i < text.size(); ++i)
       if (text[i] == '\n') newlines_.push_back(static_cast<std::ptrdiff_t>(i));
   }
+  /// Number of lines of the text.
+  std::size_t count() const { return newlines_.size() + 1; }
   /// The line holding byte `offset`; 0 for a negative offset (unknown).
   int line(std::ptrdiff_t offset) const {
     if (offset < 0) return 0;
