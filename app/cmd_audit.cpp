@@ -10,6 +10,7 @@
 #include "core/io/output_set.hpp"
 #include "core/progress.hpp"
 #include "routing/audit/audit.hpp"
+#include "routing/curve/cable_limit.hpp"
 #include "routing/view/render.hpp"
 #include "routing/audit/report_json.hpp"
 #include "routing/view/view_html.hpp"
@@ -128,7 +129,9 @@ int run_audit_command(const AuditFlags& f) {
   const AuditReport rep = audit_scene_file(f.scene, opt, &scene);
   const std::filesystem::path report_path = std::filesystem::path(f.out) / "report.json";
   const nlohmann::json report = audit_report_json(rep);
-  write_view_outputs(outputs.staging(), scene, scene.harness, report, render);  // view.html, render.png (issue 9)
+  naming_cable_errors(scene.harness, [&] {  // a tube refused names its cable's element
+    return write_view_outputs(outputs.staging(), scene, scene.harness, report, render);  // view.html, render.png
+  });
   write_audit_report(rep, outputs.staging() / "report.json");
   outputs.commit();
   if (f.json)

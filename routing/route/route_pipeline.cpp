@@ -5,6 +5,7 @@
 #include "index/simplify/alpha_sim.hpp"
 #include "index/box_tree.hpp"
 #include "index/embree_index.hpp"
+#include "routing/audit/clash_check.hpp"
 #include "routing/curve/bend_repair.hpp"
 #include "routing/route/branch_layout.hpp"
 #include "routing/curve/cable_geometry.hpp"
@@ -173,6 +174,26 @@ BSplineData to_bspline(const Centerline& c) {
   return BSplineData{c.degree(), c.knots(), c.control_points()};
 }
 
+/// Refuses, before any planning, a cable that the certified audit of every route between
+/// its ports would refuse: its chords are at most 2r long, so ports farther apart than
+/// kMaxCertifiedChords of them (a diameter in the wrong units) need more than it takes.
+/// InputError at the cable's element of the harness file.
+void refuse_unauditable_cables(const Harness& h) {
+  for (const Cable& c : h.cables) {
+    const int a = h.find_port(c.ports[0]), b = h.find_port(c.ports[1]);
+    if (a < 0 || b < 0 || !(c.radius() > 0.0)) continue;  // the topology refuses these with their own messages
+    const double apart = (h.ports[static_cast<std::size_t>(b)].position - h.ports[static_cast<std::size_t>(a)].position).norm();
+    const double chords = fewest_certified_chords(apart, c.radius());
+    if (!(chords > kMaxCertifiedChords)) continue;
+    throw InputError({h.source_file, c.line, ""},
+                     "cable '" + c.id + "': its ports " + c.ports[0] + " and " + c.ports[1] + " are " +
+                         full_precision(apart) + " apart, so the audit of any route between them needs at least " +
+                         full_precision(std::ceil(chords)) + " chords of at most its diameter " +
+                         full_precision(c.physical.diameter) + ", more than the " + full_precision(kMaxCertifiedChords) +
+                         " it takes: check the diameter and the harness units");
+  }
+}
+
 }  // namespace
 
 RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
@@ -187,6 +208,7 @@ RouteReport route_scene(const Scene& scene, const RouteOptions& opt) {
   rep.iterations = opt.iterations >= 0 ? static_cast<std::uint64_t>(opt.iterations)
                                        : static_cast<std::uint64_t>(scene.routing.iterations.value);
   rep.clearance = scene.routing.clearance.value;
+  refuse_unauditable_cables(h);  // before the planning work it would throw away
   double part_extra = 0.0;
   for (const auto& p : scene.parts) part_extra = std::max(part_extra, p.clearance);
 
