@@ -11,6 +11,7 @@
 #include "core/io/output_set.hpp"
 #include "app/progress_bar.hpp"
 #include "routing/audit/audit.hpp"
+#include "routing/curve/cable_limit.hpp"
 #include "routing/view/render.hpp"
 #include "core/io/json_text.hpp"
 #include "routing/audit/report_json.hpp"
@@ -131,7 +132,9 @@ int run_audit_command(const AuditFlags& f) {
   const AuditReport rep = audit_scene_file(f.scene, opt, &scene);
   const std::filesystem::path report_path = std::filesystem::path(f.out) / "report.json";
   const nlohmann::json report = audit_report_json(rep);
-  write_view_outputs(outputs.staging(), scene, scene.harness, report, render);  // view.html, render.png
+  naming_cable_errors(scene.harness, [&] {  // a tube refused names its cable's element
+    return write_view_outputs(outputs.staging(), scene, scene.harness, report, render);  // view.html, render.png
+  });
   write_audit_report(rep, outputs.staging() / "report.json");
   if (scene.harness.kbl) write_harness_kbl(scene.harness, outputs.staging() / kRoutedKblName);
   outputs.commit();

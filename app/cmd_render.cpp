@@ -9,6 +9,7 @@
 #include "app/progress_bar.hpp"
 #include "core/units.hpp"
 #include "routing/audit/audit.hpp"
+#include "routing/curve/cable_limit.hpp"
 #include "routing/view/render.hpp"
 
 #include <CLI/CLI.hpp>
@@ -79,7 +80,8 @@ int run_render(const RenderFlags& f) {
     check_report_markers(report, f.report);
   }
   RenderStats st;
-  const Image img = render_scene(scene, scene.harness, report, opt, &st);
+  // A cable whose tube cannot be meshed is refused at its element of the harness file.
+  const Image img = naming_cable_errors(scene.harness, [&] { return render_scene(scene, scene.harness, report, opt, &st); });
   write_png(f.out, img);
   if (!f.quiet)
     std::printf("render %s: %dx%d, %zu rays, %zu tube triangles, %zu markers, %.0f ms -> %s\n", f.scene.c_str(),

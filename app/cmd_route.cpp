@@ -10,6 +10,7 @@
 #include "core/io/scene_load.hpp"
 #include "core/scene.hpp"
 #include "app/progress_bar.hpp"
+#include "routing/curve/cable_limit.hpp"
 #include "routing/view/render.hpp"
 #include "core/io/json_text.hpp"
 #include "routing/route/route_report.hpp"
@@ -103,8 +104,10 @@ int run_route(const std::string& scene_path, const RouteCommandOptions& o) {
   for (const auto& n : lr.notes) rep.notes.push_back(n);
   // Tube resolution: a tenth of the smallest cable radius is finer than any viewer needs.
   const double chord = 0.1 * 0.5 * scene.harness.smallest_diameter();
-  write_route_outputs(rep, outputs.staging(), chord > 0 ? chord : 0.01);
-  write_view_outputs(outputs.staging(), scene, rep.routed, route_report_json(rep), render);  // view.html, render.png
+  naming_cable_errors(rep.routed, [&] {  // a tube refused names its cable's element
+    write_route_outputs(rep, outputs.staging(), chord > 0 ? chord : 0.01);
+    return write_view_outputs(outputs.staging(), scene, rep.routed, route_report_json(rep), render);  // view.html, render.png
+  });
   outputs.commit();
   if (o.json) std::cout << json_text(route_report_json(rep), 2) << "\n";
   else if (!o.quiet) print_summary(rep, o.out);

@@ -189,7 +189,13 @@ int run_scan(const ScanCommandOptions& o) {
   // Tube and outputs (computed first, then written, so that a failure writes nothing).
   SweepOptions sw;
   sw.chord_tolerance = kTubeChordTolerance * d;
-  const SweepResult tube = sweep_tube(r.centerline, 0.5 * d, sw);
+  SweepResult tube;
+  try {
+    tube = sweep_tube(r.centerline, 0.5 * d, sw);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(SourceLocation{o.cloud, 0, ""},
+                     std::string("cannot mesh a tube around the recovered centerline: ") + e.what());
+  }
   const Harness h = scan_harness(r, std::filesystem::path(o.cloud).filename().string(), units);
 
   json j;

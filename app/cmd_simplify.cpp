@@ -38,6 +38,18 @@ struct SimplifyCommandOptions {
 
 double finite_or_zero(double v) { return std::isfinite(v) ? v : 0.0; }
 
+/// The targets this run did not stage (no STEP for a part whose original is kept, no STL for
+/// an empty part) that an earlier run left in the output directory. They are removed once
+/// the new set is in place: a directory must not mix this run's files with an earlier run's.
+std::vector<std::filesystem::path> stale_targets(const std::vector<std::filesystem::path>& targets,
+                                                 const std::filesystem::path& staging) {
+  std::vector<std::filesystem::path> stale;
+  std::error_code ec;
+  for (const auto& t : targets)
+    if (!std::filesystem::exists(staging / t.filename(), ec) && std::filesystem::exists(t, ec)) stale.push_back(t);
+  return stale;
+}
+
 int run_simplify(const SimplifyCommandOptions& o) {
   ProgressBar bar(stderr, o.quiet);
   SceneLoadOptions lo;
@@ -81,6 +93,7 @@ int run_simplify(const SimplifyCommandOptions& o) {
     const AlphaSimResult& r = results[i];
     const std::string& stem = stems[i];
     if (!simple[i].mesh.empty()) write_mesh(outputs.staging() / (stem + ".stl"), simple[i].mesh);
+    const bool step_written = o.step && std::filesystem::exists(outputs.staging() / (stem + ".step"));
     json projections = json::array();
     for (const auto& p : r.projections)
       projections.push_back({{"plane", p.plane},
@@ -120,6 +133,8 @@ int run_simplify(const SimplifyCommandOptions& o) {
                      {"booleans_by", r.booleans_by},
                      {"booleans_note", r.booleans_note},
                      {"projections", projections}});
+    // Only a simplified part has a STEP solid; a part kept as it was has none.
+    if (o.step) parts.back()["step_file"] = step_written ? stem + ".step" : "";
     if (!o.quiet) {
       // Below the containment tolerance a distance is rounding (a part kept as it was).
       const double hausdorff = r.hausdorff < r.tolerance ? 0.0 : r.hausdorff;
@@ -146,8 +161,17 @@ int run_simplify(const SimplifyCommandOptions& o) {
             {"triangles_before", before},
             {"triangles_after", after},
             {"parts", parts}};
+  targets.erase(targets.begin());  // simplify.json (the first target) is written below
+  const std::vector<std::filesystem::path> stale = stale_targets(targets, outputs.staging());
+  j["removed"] = json::array();  // files of an earlier run that this run has no counterpart for
+  for (const auto& t : stale) j["removed"].push_back(t.filename().string());
   write_file_atomic(outputs.staging() / "simplify.json", json_text(j, 2) + "\n");
   outputs.commit();
+  for (const auto& t : stale) {
+    std::error_code ec;
+    std::filesystem::remove(t, ec);
+    if (ec) throw std::runtime_error(t.string() + ": cannot remove the earlier run's file: " + ec.message());
+  }
   if (!o.quiet)
     std::fprintf(stderr, "loom simplify: %zu -> %zu triangles (%.1f%%) in %.2f s; wrote %s\n", before, after,
                  before > 0 ? 100.0 * after / before : 0.0,

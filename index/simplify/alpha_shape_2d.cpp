@@ -292,7 +292,7 @@ struct AlphaShape2D::Impl {
     Vec2 hi = -lo;
     removed_lo = lo;
     removed_hi = hi;
-    std::vector<std::array<Vec2, 2>> tri_boxes, seg_boxes;
+    std::vector<std::array<Vec2, 2>> seg_boxes;
     for (std::uint32_t i = 0; i < faces.size(); ++i) {
       if (!kept[i]) {
         const auto& c = coords[i];
@@ -309,7 +309,6 @@ struct AlphaShape2D::Impl {
       const auto& c = coords[i];
       area += tri_area(c);
       Vec2 bl = c[0].cwiseMin(c[1]).cwiseMin(c[2]), bh = c[0].cwiseMax(c[1]).cwiseMax(c[2]);
-      tri_boxes.push_back({bl, bh});
       lo = lo.cwiseMin(bl);
       hi = hi.cwiseMax(bh);
       for (int e = 0; e < 3; ++e) {
@@ -320,7 +319,10 @@ struct AlphaShape2D::Impl {
         seg_boxes.push_back({a.cwiseMin(b), a.cwiseMax(b)});
       }
     }
-    tri_grid.build(tri_boxes, lo, hi, kTriangleBoxesPerCell);
+    // Each kept triangle is listed along itself, not over its box: a projection fallen back
+    // to its hull keeps the long triangles across the gaps between far-apart samples, and
+    // their boxes, each over much of the grid, made billions of entries.
+    tri_grid.build_triangles(kept_coords, lo, hi, kTriangleBoxesPerCell);
     seg_grid.build(seg_boxes, lo, hi, kSegmentBoxesPerCell);
     build_flags(lo, hi);
   }

@@ -7,6 +7,10 @@
 #include "index/embree_index.hpp"
 #include "index/simplify/extrusion.hpp"
 
+// CGAL before OpenCASCADE, whose macro Handle breaks CGAL's headers.
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/convex_hull_2.h>
+
 #include <BRepAlgoAPI_Common.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakePolygon.hxx>
@@ -316,6 +320,69 @@ double plane_sample_estimate(const Mesh& mesh, const std::vector<MeshEdge>& edge
     n += area / l_max / l_max + (hi - lo).sum() / l_max + 1.0;
   }
   return n;
+}
+
+/// Lattice points of spacing l_max in the convex hull of the vertices of `mesh`'s triangles
+/// projected to `proj` (plane coordinates), by the hull's area and perimeter as
+/// plane_sample_estimate counts a triangle's. The α-shape's Delaunay triangulation spans
+/// that hull whatever the samples cover: open triangles far apart (sheets seen edge-on, a
+/// truncated file) leave it nearly empty, and the long triangles across the emptiness, all
+/// kept when the projection falls back to its hull, cost what its lattice would.
+double hull_lattice_estimate(const Mesh& mesh, const std::vector<Vec2>& proj, double l_max) {
+  using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+  std::vector<Kernel::Point_2> used, hull;
+  used.reserve(3 * mesh.triangles.size());
+  for (const auto& f : mesh.triangles)
+    for (const auto i : f) used.emplace_back(proj[i].x(), proj[i].y());
+  CGAL::convex_hull_2(used.begin(), used.end(), std::back_inserter(hull));
+  double twice_area = 0.0, perimeter = 0.0;
+  for (std::size_t i = 0; i < hull.size(); ++i) {
+    const Kernel::Point_2& a = hull[i];
+    const Kernel::Point_2& b = hull[(i + 1) % hull.size()];
+    twice_area += a.x() * b.y() - a.y() * b.x();
+    perimeter += std::hypot(b.x() - a.x(), b.y() - a.y());
+  }
+  // Divided twice, as in plane_sample_estimate (l_max² underflows for l_max < ~1e-154).
+  return 0.5 * std::abs(twice_area) / l_max / l_max + perimeter / l_max + 1.0;
+}
+
+/// Counts in too_fine_reason beyond this are said as "more than" the limit: a double
+/// prints integers exactly up to 2^53, and l_max² far below the part's area gives +inf.
+constexpr double kLargestPrintedCount = 1e15;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// What one projection plane would cost: its samples (plane_sample_estimate) and the
+/// lattice of its convex hull (hull_lattice_estimate).
+struct PlaneWork {
+  double samples = 0.0;
+  double hull = 0.0;
+};
+
+/// The reason a part is too fine for α-SIM (status TooFine), or empty if every plane's
+/// samples and hull lattice stay within `limit` points. NaN (not expected) counts as too
+/// many; a count from kLargestPrintedCount (up to +inf) is said as "more than" the limit:
+/// no output of loom holds "inf" or "nan".
+std::string too_fine_reason(const std::vector<PlaneWork>& planes, double l_max, std::size_t limit) {
+  double samples = 0.0, hull = 0.0;
+  for (const PlaneWork& w : planes) {
+    samples = std::isnan(w.samples) || std::isnan(samples) ? kNaN : std::max(samples, w.samples);
+    hull = std::isnan(w.hull) || std::isnan(hull) ? kNaN : std::max(hull, w.hull);
+  }
+  const double cap = static_cast<double>(limit);
+  const std::string most = std::to_string(limit);
+  // "about N ... > limit", or "more than limit ..." when N does not print as a count.
+  auto count = [&](double n, const std::string& what) {
+    return n < kLargestPrintedCount ? "about " + full_precision(std::round(n)) + " " + what + " > " + most
+                                    : "more than " + most + " " + what;
+  };
+  const std::string at = "sampling at L_max = " + full_precision(l_max);
+  if (!(samples <= cap))
+    return at + " needs " + count(samples, "points in a plane") + ": original kept (raise dim_pre)";
+  if (!(hull <= cap))
+    return at + ", the convex hull of a projection spans " + count(hull, "lattice points") + ", which its about " +
+           full_precision(std::round(samples)) +
+           " samples leave mostly empty (triangles far apart): original kept (raise dim_pre, or split the part)";
+  return "";
 }
 
 /// The lattice points of one offset met by the triangles of a projection, deduplicated on
@@ -1428,22 +1495,18 @@ bool PartSimplification::check_input() {
     return false;
   }
 
-  // The sample count is known before sampling: refuse what would not fit in memory.
+  // The work is known before sampling: refuse what would not fit in memory.
   projected.assign(specs.size(), {});  // the vertices in each plane
   {
-    std::vector<double> per_plane(specs.size());
+    std::vector<PlaneWork> per_plane(specs.size());
     tbb::parallel_for(std::size_t(0), specs.size(), [&](std::size_t k) {
       projected[k] = project_vertices(part.mesh, specs[k].frame);
-      per_plane[k] = plane_sample_estimate(part.mesh, edges, projected[k], r.l_max);
+      per_plane[k] = {plane_sample_estimate(part.mesh, edges, projected[k], r.l_max),
+                      hull_lattice_estimate(part.mesh, projected[k], r.l_max)};
     });
-    double estimate = 0.0;  // NaN (not expected) is taken as too many
-    for (double e : per_plane) estimate = std::isnan(e) ? e : std::max(estimate, e);
-    if (!(estimate <= static_cast<double>(opt.max_cloud_points))) {
-      // The estimate may exceed any integer type (+inf): printed as a double.
-      keep_original(out, part, AlphaSimStatus::TooFine,
-                    "sampling at L_max = " + full_precision(r.l_max) + " needs about " +
-                        full_precision(std::round(estimate)) + " points in a plane > " +
-                        std::to_string(opt.max_cloud_points) + ": original kept (raise dim_pre)");
+    const std::string why = too_fine_reason(per_plane, r.l_max, opt.max_cloud_points);
+    if (!why.empty()) {
+      keep_original(out, part, AlphaSimStatus::TooFine, why);
       return false;
     }
   }

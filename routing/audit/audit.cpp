@@ -10,6 +10,7 @@
 #include "index/brute_force_index.hpp"
 #include "index/embree_index.hpp"
 #include "routing/curve/cable_geometry.hpp"
+#include "routing/curve/cable_limit.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -299,7 +300,8 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
   if (scene.has_harness)
     for (auto& n : attach_ports(scene.harness, scene.parts, req.routing_clearance, inputs, index)) rep.notes.push_back(n);
   const Stopwatch t1;
-  rep.result = check_clashes(inputs, scene.parts, index, req);
+  // A cable whose audit would pass a limit is refused at its element of the harness file.
+  rep.result = naming_cable_errors(scene.harness, [&] { return check_clashes(inputs, scene.parts, index, req); });
   rep.check_ms = t1.ms();
   rep.notes.insert(rep.notes.end(), rep.result.notes.begin(), rep.result.notes.end());
   return rep;

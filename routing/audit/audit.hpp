@@ -99,7 +99,8 @@ void apply_matching_routes(Scene& scene, const std::filesystem::path& routes);
 
 /// Audits a loaded scene (its parts and harness). Builds the index unless the request is
 /// the brute-force baseline (use_index = false, discrete). Throws InputError for an
-/// inconsistent harness.
+/// inconsistent harness, and for a cable whose audit would pass a limit (check_clashes'
+/// CableLimitError), naming the harness file and the cable's line.
 AuditReport run_audit(const Scene& scene, const AuditOptions& opt);
 
 /// Loads the scene file (timed as timing_ms.load), applies --routes (apply_matching_routes),

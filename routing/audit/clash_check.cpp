@@ -7,6 +7,7 @@
 #include "routing/audit/clash_context.hpp"
 
 #include "core/error.hpp"
+#include "routing/curve/cable_limit.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -27,11 +28,21 @@ constexpr double kNoCableTolerance = 0.01;
 /// Share of the tolerance left to the chords' distance from the curve; the rest covers the
 /// index's own error (structure: chord + index ≤ tol; cable–cable: 2 · chord ≤ tol).
 constexpr double kChordShareOfTolerance = 0.5;
-/// Most chords the certified audit accepts for one cable's deviation bound. A routed cable
-/// (bends of at least a few radii) needs a few thousand at the default tolerance, a
-/// 100 m cable at a 1 µm tolerance ~10⁶; beyond this the route wiggles on the scale of the
-/// tolerance (e.g. 200,000 key points 1 µm apart) and flattening it would not end.
-constexpr double kMaxChordsPerCable = 1e7;
+/// Refuses a certified tolerance at or below twice the index's rounding (it cannot be
+/// certified), saying where the tolerance came from (--tolerance, or the thinnest cable,
+/// which the refusal then names) at full precision.
+[[noreturn]] void refuse_tolerance(const std::vector<CableInput>& cables, const Context& ctx, const std::string& source) {
+  const bool requested = source == "request";
+  const std::string text = "clash tolerance " + full_precision(ctx.tol) + " (" +
+                           (requested ? std::string("as requested") : source) +
+                           ") is not above twice the index's distance rounding " + full_precision(ctx.abs_err) +
+                           " (scene units): give --tolerance above " + full_precision(2.0 * ctx.abs_err) +
+                           " or check the cable diameters and the scene's units";
+  if (requested || cables.empty()) throw std::invalid_argument(text);
+  const auto thinnest = std::min_element(cables.begin(), cables.end(),
+                                         [](const CableInput& a, const CableInput& b) { return a.radius < b.radius; });
+  throw CableLimitError(thinnest->id, "cable '" + thinnest->id + "' is the thinnest: " + text);
+}
 
 /// The smallest bend radius of cable c (per bend piece where it has them, and at the nodes
 /// it passes) into `sum`, and a bend-radius violation into `out` for every stretch bending
@@ -101,6 +112,8 @@ const char* violation_kind_name(ViolationKind k) {
   return k == ViolationKind::BendRadius ? "bend-radius" : "clearance";
 }
 
+double fewest_certified_chords(double length, double radius) { return length / (kMaxChordRadii * radius); }
+
 double default_clash_tolerance(const std::vector<CableInput>& cables, std::string* source) {
   double rmin = kInf;
   for (const auto& c : cables) rmin = std::min(rmin, c.radius);
@@ -148,19 +161,13 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
   }
   if (index) ctx.abs_err = index->accuracy().abs_error;
   if (request.method == ClashMethod::Certified && !(ctx.abs_err < 0.5 * ctx.tol))
-    // A tolerance at or below the index's rounding cannot be certified: say where the
-    // tolerance came from (--tolerance, or the thinnest cable) at full precision.
-    throw std::invalid_argument("clash tolerance " + full_precision(ctx.tol) + " (" +
-                                (res.tolerance_source == "request" ? std::string("as requested") : res.tolerance_source) +
-                                ") is not above twice the index's distance rounding " + full_precision(ctx.abs_err) +
-                                " (scene units): give --tolerance above " + full_precision(2.0 * ctx.abs_err) +
-                                " or check the cable diameters and the scene's units");
+    refuse_tolerance(cables, ctx, res.tolerance_source);
   ctx.chord_error = kChordShareOfTolerance * (ctx.tol - ctx.abs_err);
   if (request.method == ClashMethod::Certified)
     for (const auto& c : cables) {
       const double hmax = kMaxChordRadii * c.radius;
       const double n = planned_chords(c.curve, ctx.chord_error, hmax, kShortSpanRadii * c.radius);
-      if (n <= kMaxChordsPerCable) continue;
+      if (n <= kMaxCertifiedChords) continue;
       // Say which bound asked for the chords: the longest chord (a route thousands of
       // kilometres long is a units or key-point mistake) or the chord error (a wiggle).
       const double by_length = c.curve.length() / hmax;
@@ -169,9 +176,9 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
               ? "it is " + full_precision(c.curve.length()) + " long, " + full_precision(std::ceil(by_length)) +
                     " chords of at most 2r = " + full_precision(hmax) + "; check its key points and units"
               : "its curvature reaches the scale of the tolerance; smooth the route or raise --tolerance";
-      throw std::invalid_argument("check_clashes: cable '" + c.id + "' would need " + full_precision(n) +
-                                  " chords to stay within " + full_precision(ctx.chord_error) +
-                                  " of its curve (more than " + full_precision(kMaxChordsPerCable) + "): " + reason);
+      throw CableLimitError(c.id, "cable '" + c.id + "' would need " + full_precision(n) +
+                                      " chords to stay within " + full_precision(ctx.chord_error) +
+                                      " of its curve (more than " + full_precision(kMaxCertifiedChords) + "): " + reason);
     }
   res.cables.resize(cables.size());
   std::vector<std::vector<ClashEntry>> per_clash(cables.size());
@@ -203,20 +210,9 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
   } else {
     std::vector<DiscreteSamples> ds(cables.size());
     res.spacing = request.spacing > 0.0 ? request.spacing : 0.0;
-    // A spacing far below the cable's length is a request mistake: name the cable and where
-    // the spacing came from before any sampling.
-    for (const auto& c : cables) {
-      const double l = request.spacing > 0.0 ? request.spacing : 2.0 * c.radius;
-      const double n = std::ceil(c.curve.length() / l);
-      if (n > Centerline::kMaxArcSamples)
-        throw std::invalid_argument("cable '" + c.id + "': sample spacing " + full_precision(l) +
-                                    (request.spacing > 0.0 ? " (--spacing)" : " (its diameter)") + " gives " +
-                                    full_precision(n) + " samples over its length " +
-                                    full_precision(c.curve.length()) + ", more than the " +
-                                    full_precision(Centerline::kMaxArcSamples) + " the discrete method takes");
-    }
+    check_discrete_work(ctx);  // before any sampling
     parallel_indices(cables.size(), request.threads, [&](std::size_t c) {
-      const double l = request.spacing > 0.0 ? request.spacing : 2.0 * cables[c].radius;
+      const double l = discrete_spacing(request, cables[c]);
       const auto samples = cables[c].curve.sample_by_arc_length(l);
       ds[c].spacing = samples.size() > 1 ? samples[1].first - samples[0].first : l;
       for (const auto& sp : samples) {

@@ -113,7 +113,7 @@ struct CableInput {
 };
 
 /// Work the cable–cable and self passes may take on before it refuses the audit
-/// (std::invalid_argument, exit 2) instead of running for hours or out of memory. Routed
+/// (CableLimitError naming a cable, exit 2) instead of running for hours or out of memory. Routed
 /// harnesses stay far below them (the bench's 10× scene, 1,000 cables: 6·10⁴ overlapping
 /// block pairs and at most 1.6·10⁴ contacts); a route that folds back on itself or over
 /// another cable thousands of times reaches them (2,000 zigzags of a 50 mm route on the
@@ -129,7 +129,8 @@ struct ClashLimits {
   /// kept for grouping into stretches (~112 bytes each).
   std::size_t max_pair_contacts = 4'000'000;
   /// Discrete method with an index: most sample pairs its grid may hand to the distance
-  /// test (counted from the grid's occupancy before testing; a few ns each). The
+  /// test (a few ns each): bounded from below by each cable's length and spacing before any
+  /// sample is taken, then counted from the grid's occupancy before testing. The
   /// brute-force baseline (no index) compares every pair by design and is not limited.
   std::size_t max_sample_pairs = 4'000'000'000;
 };
@@ -265,9 +266,25 @@ struct ClashResult {
 
 /// Checks every cable against the parts, each other and itself. `index` indexes exactly
 /// `parts` (same order); it may be null only when use_index is false. Throws
-/// std::invalid_argument for a cable without a curve or a non-positive radius.
+/// std::invalid_argument for a cable without a curve or a non-positive radius, and
+/// CableLimitError (routing/curve/cable_limit.hpp) naming a cable whose audit would pass a
+/// limit: more than kMaxCertifiedChords chords, more samples or sample pairs than the
+/// discrete method takes, or the ClashLimits.
 ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vector<Part>& parts,
                           const ObstacleIndex* index, const ClashRequest& request);
+
+/// Most chords the certified audit flattens one cable into. A routed cable (bends of at
+/// least a few radii) needs a few thousand at the default tolerance, a 100 m cable at a 1 µm
+/// tolerance ~10⁶; beyond this the route wiggles on the scale of the tolerance (200,000 key
+/// points 1 µm apart), is thousands of kilometres long, or the cable is far thinner than the
+/// scene's scale, and flattening it would not end: check_clashes refuses it before any chord
+/// is made (CableLimitError).
+constexpr double kMaxCertifiedChords = 1e7;
+
+/// Fewest chords the certified audit needs for a centerline `length` long of radius
+/// `radius` (scene units): its chords are at most 2r long. A cable whose ports are farther
+/// apart than kMaxCertifiedChords of them cannot be audited, whatever its route.
+double fewest_certified_chords(double length, double radius);
 
 /// The derived default tolerance: smallest cable radius / 100 (and its rule as text).
 double default_clash_tolerance(const std::vector<CableInput>& cables, std::string* source = nullptr);

@@ -139,6 +139,17 @@ struct DiscreteSamples {
   double spacing = 0.0;
 };
 
+/// The discrete method's sample spacing of a cable: --spacing, else the paper's 2r.
+inline double discrete_spacing(const ClashRequest& req, const CableInput& c) {
+  return req.spacing > 0.0 ? req.spacing : 2.0 * c.radius;
+}
+
+/// Refuses, before any sample is taken, a discrete audit whose samples or sample pairs
+/// would pass its limits (Centerline::kMaxArcSamples per cable; with an index, a lower
+/// bound on the pairs its grid hands to the distance test against max_sample_pairs):
+/// CableLimitError naming the cable and the figure.
+void check_discrete_work(const Context& ctx);
+
 /// The discrete method's cable–structure checks of one cable's samples, into `tr`.
 void discrete_structure(Context& ctx, int cable, const DiscreteSamples& ds, StretchTracker& tr);
 

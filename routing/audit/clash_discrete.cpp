@@ -6,6 +6,7 @@
 #include "core/error.hpp"
 #include "index/brute_force_index.hpp"
 #include "index/triangle_distance.hpp"
+#include "routing/curve/cable_limit.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -50,7 +51,62 @@ BruteHit brute_point(const Context& ctx, const Vec3& p) {
   return best;
 }
 
+/// Side of the discrete method's grid cells: the largest contact distance over all cables.
+double sample_cell(const std::vector<CableInput>& cables) {
+  double rmax = 0.0;
+  for (const auto& c : cables) rmax = std::max(rmax, c.radius);
+  return std::max(2.0 * rmax, 1e-12);
+}
+
+/// "sample spacing L (--spacing)" or "(its diameter)", for refusals.
+std::string spacing_words(const ClashRequest& req, double l) {
+  return "sample spacing " + full_precision(l) + (req.spacing > 0.0 ? " (--spacing)" : " (its diameter)");
+}
+
 }  // namespace
+
+void check_discrete_work(const Context& ctx) {
+  const ClashRequest& req = ctx.req;
+  // A spacing far below the cable's length is a request mistake: name the cable and where
+  // the spacing came from.
+  for (const auto& c : ctx.cables) {
+    const double l = discrete_spacing(req, c);
+    const double n = std::ceil(c.curve.length() / l);
+    if (n > Centerline::kMaxArcSamples)
+      throw CableLimitError(c.id, "cable '" + c.id + "': " + spacing_words(req, l) + " gives " + full_precision(n) +
+                                      " samples over its length " + full_precision(c.curve.length()) +
+                                      ", more than the " + full_precision(Centerline::kMaxArcSamples) +
+                                      " the discrete method takes");
+  }
+  if (!req.use_index || (!req.check_cable_cable && !req.check_self)) return;
+  // The grid of discrete_cable_pairs hands every sample (and midpoint) the samples of the 27
+  // cells around its own, which hold at least the samples of its own cable within half a
+  // cell of arc length (chords are no longer than their arcs): a lower bound on the pairs
+  // that its own count, made once the samples exist, can only exceed.
+  const double reach = 0.5 * sample_cell(ctx.cables);
+  double total = 0.0, most = -1.0;
+  std::size_t worst = 0;
+  for (std::size_t c = 0; c < ctx.cables.size(); ++c) {
+    const double L = ctx.cables[c].curve.length();
+    const double intervals = std::max(1.0, std::ceil(L / discrete_spacing(req, ctx.cables[c])));
+    const double samples = intervals + 1.0;
+    const double near = std::min(samples, std::floor(reach / (L / intervals)) + 1.0);
+    const double pairs = 2.0 * samples * near;
+    total += pairs;
+    if (pairs > most) {
+      most = pairs;
+      worst = c;
+    }
+  }
+  if (!(total > static_cast<double>(req.limits.max_sample_pairs))) return;
+  const CableInput& c = ctx.cables[worst];
+  throw CableLimitError(c.id, "cable '" + c.id + "': " + spacing_words(req, discrete_spacing(req, c)) +
+                                  " puts samples so close that the discrete method would compare at least " +
+                                  full_precision(total) + " pairs of samples, more than the " +
+                                  full_precision(static_cast<double>(req.limits.max_sample_pairs)) +
+                                  " it takes (each sample meets those within " + full_precision(reach) +
+                                  " of it along the cable)");
+}
 
 void discrete_structure(Context& ctx, int cable, const DiscreteSamples& ds, StretchTracker& tr) {
   const double r = ctx.cables[cable].radius;
@@ -157,9 +213,7 @@ void discrete_cable_pairs(Context& ctx, const std::vector<DiscreteSamples>& ds, 
     });
   } else {
     // Uniform grid of samples, cell = the largest contact distance.
-    double rmax = 0.0;
-    for (const auto& c : cables) rmax = std::max(rmax, c.radius);
-    const double cell = std::max(2.0 * rmax, 1e-12);
+    const double cell = sample_cell(cables);
     auto key = [&](const Vec3& p) {
       const std::int64_t x = static_cast<std::int64_t>(std::floor(p.x() / cell));
       const std::int64_t y = static_cast<std::int64_t>(std::floor(p.y() / cell));
@@ -194,10 +248,11 @@ void discrete_cable_pairs(Context& ctx, const std::vector<DiscreteSamples>& ds, 
       }
     }
     if (candidates > static_cast<double>(ctx.req.limits.max_sample_pairs))
-      throw std::invalid_argument("check_clashes: the discrete method would compare about " +
-                                  full_precision(std::round(candidates)) + " pairs of samples (limit " +
-                                  full_precision(static_cast<double>(ctx.req.limits.max_sample_pairs)) + "; cable '" +
-                                  cables[worst_cable].id + "' among them): " + kFoldBack);
+      throw CableLimitError(cables[worst_cable].id,
+                            "the discrete method would compare about " + full_precision(std::round(candidates)) +
+                                " pairs of samples (limit " +
+                                full_precision(static_cast<double>(ctx.req.limits.max_sample_pairs)) + "; cable '" +
+                                cables[worst_cable].id + "' among them): " + kFoldBack);
     parallel_indices(cables.size(), ctx.req.threads, [&](std::size_t ai) {
       const int a = static_cast<int>(ai);
       std::vector<PairContact> local;

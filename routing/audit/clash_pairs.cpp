@@ -9,6 +9,7 @@
 #include "index/box_pairs.hpp"
 #include "index/triangle_distance.hpp"
 #include "routing/audit/chord_plan.hpp"
+#include "routing/curve/cable_limit.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -168,15 +169,17 @@ void certified_cable_pairs(Context& ctx, std::vector<ClashEntry>& out) {
   BoxPairResult found = overlapping_box_pairs(boxes, bp);
   ctx.counters.block_overlaps_estimate =
       static_cast<std::int64_t>(std::llround(std::min(found.estimated_overlaps, 9e18)));
+  // A cable with the most overlapping blocks, named by the refusals (which need blocks).
+  const std::string busiest = found.status == BoxPairStatus::Done ? "" : ctx.cables[blocks[found.busiest].cable].id;
   if (found.status == BoxPairStatus::TooManyOverlaps)
-    throw std::invalid_argument("check_clashes: about " + full_precision(std::round(found.estimated_overlaps)) +
-                                " pairs of chord blocks come within reach of each other (limit " +
-                                full_precision(static_cast<double>(lim.max_block_overlaps)) + "; cable '" +
-                                ctx.cables[blocks[found.busiest].cable].id + "' among them): " + kFoldBack);
+    throw CableLimitError(busiest, "about " + full_precision(std::round(found.estimated_overlaps)) +
+                                       " pairs of chord blocks come within reach of each other (limit " +
+                                       full_precision(static_cast<double>(lim.max_block_overlaps)) + "; cable '" +
+                                       busiest + "' among them): " + kFoldBack);
   if (found.status == BoxPairStatus::TooManyKept)
-    throw std::invalid_argument("check_clashes: more than " + full_precision(static_cast<double>(lim.max_block_pairs)) +
-                                " pairs of chord blocks of different cables, or of one cable πr apart, come within "
-                                "reach of each other: " + kFoldBack);
+    throw CableLimitError(busiest, "more than " + full_precision(static_cast<double>(lim.max_block_pairs)) +
+                                       " pairs of chord blocks of different cables, or of one cable πr apart, come "
+                                       "within reach of each other (cable '" + busiest + "' among them): " + kFoldBack);
   std::vector<BoxPair>& pairs = found.pairs;
   ctx.counters.block_pairs = as_i64(pairs.size());
   if (ctx.req.check_self)

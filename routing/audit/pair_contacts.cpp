@@ -2,6 +2,8 @@
 // (pair_contacts.hpp).
 #include "routing/audit/pair_contacts.hpp"
 
+#include "routing/curve/cable_limit.hpp"
+
 #include <algorithm>
 #include <map>
 #include <numeric>
@@ -112,9 +114,9 @@ void refuse_contacts(const Context& ctx, const std::vector<PairContact>& found, 
   const std::string among = top.first == top.second
                                 ? "cable '" + ctx.cables[top.first].id + "' with itself"
                                 : "cables '" + ctx.cables[top.first].id + "' and '" + ctx.cables[top.second].id + "'";
-  throw std::invalid_argument("check_clashes: more than " +
-                              full_precision(static_cast<double>(ctx.req.limits.max_pair_contacts)) + " pairs of " +
-                              what + " are in contact (" + among + " the most of them): " + kFoldBack);
+  throw CableLimitError(ctx.cables[top.first].id,
+                        "more than " + full_precision(static_cast<double>(ctx.req.limits.max_pair_contacts)) +
+                            " pairs of " + what + " are in contact (" + among + " the most of them): " + kFoldBack);
 }
 
 }  // namespace loom::audit

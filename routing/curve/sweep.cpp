@@ -6,6 +6,9 @@
 // inflections).
 #include "routing/curve/sweep.hpp"
 
+#include "core/error.hpp"
+#include "routing/curve/cable_limit.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -173,11 +176,11 @@ double sections(const Centerline& c, const RadiusFn& radius_at, bool variable_ra
 
   auto check_radius = [&](double s, double r, double rs) {
     if (!(r > 0.0) || !std::isfinite(r))
-      throw std::invalid_argument(std::string(who) + ": radius " + std::to_string(r) + " at s = " +
-                                  std::to_string(s) + " is not positive and finite");
+      throw std::invalid_argument(std::string(who) + ": radius " + full_precision(r) + " at s = " +
+                                  full_precision(s) + " is not positive and finite");
     if (!(std::abs(rs) < 1.0))
-      throw std::invalid_argument(std::string(who) + ": |dr/ds| = " + std::to_string(std::abs(rs)) +
-                                  " ≥ 1 at s = " + std::to_string(s) +
+      throw std::invalid_argument(std::string(who) + ": |dr/ds| = " + full_precision(std::abs(rs)) +
+                                  " ≥ 1 at s = " + full_precision(s) +
                                   ": the moving sphere swallows its neighbours, no envelope surface");
   };
 
@@ -266,8 +269,9 @@ double sections(const Centerline& c, const RadiusFn& radius_at, bool variable_ra
     rings.push_back(make_ring(u, std::min(s, L), d, rings.back().tangent));
     frame_next();
     if (rings.size() > kMaxRings)
-      throw std::invalid_argument(std::string(who) + ": chord tolerance " + std::to_string(opt.chord_tolerance) +
-                                  " needs more than " + std::to_string(kMaxRings) + " rings");
+      throw std::invalid_argument("the tube at chord tolerance " + full_precision(opt.chord_tolerance) +
+                                  " needs more than " + std::to_string(kMaxRings) + " rings along its " +
+                                  full_precision(L) + " of centerline");
   };
   while (u < u1) {
     while (bpi + 2 < bp.size() && u >= bp[bpi + 1]) ++bpi;
@@ -348,8 +352,8 @@ int circumferential_resolution(double radius, double tolerance) {
   const double half_angle = std::acos(1.0 - tolerance / radius);  // sagitta R(1 − cos(π/n)) ≤ tol
   const double need = std::ceil(M_PI / half_angle);
   if (need > kMaxCircumferential)
-    throw std::invalid_argument("chord tolerance " + std::to_string(tolerance) + " is too small for radius " +
-                                std::to_string(radius));
+    throw std::invalid_argument("chord tolerance " + full_precision(tolerance) + " is too small for radius " +
+                                full_precision(radius));
   return std::max(kMinCircumferential, static_cast<int>(need));
 }
 
@@ -392,12 +396,12 @@ void mesh_sections(const SweepOptions& opt, double max_turn, SweepResult& out) {
   const std::size_t un = static_cast<std::size_t>(n);
   const std::size_t ring_vertices = nr * un;
   if (ring_vertices + 2 > std::numeric_limits<std::uint32_t>::max())
-    throw std::invalid_argument("sweep: " + std::to_string(ring_vertices) + " vertices exceed 32-bit indices");
+    throw std::invalid_argument("the tube's " + std::to_string(ring_vertices) + " vertices exceed 32-bit indices");
   // The mesh's size is known before any of it is allocated: refuse it here if it is over
   // the caller's budget (e.g. a route folding back on itself thousands of times).
   const std::size_t planned_triangles = (nr > 0 ? nr - 1 : 0) * 2 * un + (opt.end_caps ? 2 * un : 0);
   if (planned_triangles > opt.max_triangles)
-    throw std::invalid_argument("sweep: the tube would have " + std::to_string(planned_triangles) + " triangles (" +
+    throw std::invalid_argument("the tube would have " + std::to_string(planned_triangles) + " triangles (" +
                                 std::to_string(nr) + " rings of " + std::to_string(n) + " vertices), more than the " +
                                 std::to_string(opt.max_triangles) + " allowed");
   // Unit circle (cos, sin) at the even rings' angles 2πj/n, then at the odd rings' 2π(j + ½)/n.
@@ -512,7 +516,7 @@ bool zero_length(const Centerline& c) { return !c.empty() && c.length() == 0.0; 
 void sweep_ball(const Centerline& c, double radius, const SweepOptions& opt, SweepResult& out) {
   out = sweep_junction(c.position(c.u_min()), radius, opt);
   if (out.mesh.triangles.size() > opt.max_triangles)
-    throw std::invalid_argument("sweep: the ball of a zero-length centerline would have " +
+    throw std::invalid_argument("the ball of a zero-length centerline would have " +
                                 std::to_string(out.mesh.triangles.size()) + " triangles, more than the " +
                                 std::to_string(opt.max_triangles) + " allowed");
 }
@@ -559,9 +563,12 @@ SweepResult TubeBudget::sweep(const Centerline& c, double radius, SweepOptions o
   try {
     tube = sweep_tube(c, radius, opt);
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(owner_ + ": cable '" + cable + "': " + e.what() + " (the tubes of " +
-                                std::to_string(cables_) + " cables before it have " + std::to_string(used_) + " of " +
-                                std::to_string(total_) + "; a route folding back on itself thousands of times?)");
+    // What the cables before it took of the budget matters only when they took some.
+    const std::string taken = used_ == 0 ? std::string()
+                                         : " (the tubes of " + std::to_string(cables_) + " cables before it have " +
+                                               std::to_string(used_) + " of " + std::to_string(total_) +
+                                               " triangles; a route folding back on itself thousands of times?)";
+    throw CableLimitError(cable, owner_ + ": cable '" + cable + "': " + e.what() + taken);
   }
   used_ += tube.mesh.triangles.size();
   ++cables_;

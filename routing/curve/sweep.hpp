@@ -82,8 +82,9 @@ class TubeBudget {
  public:
   /// `owner` prefixes refusals (e.g. "render", "cables.ply").
   explicit TubeBudget(std::string owner, std::size_t total = kHarnessTubeTriangleBudget);
-  /// sweep_tube(c, radius, opt) within what is left. Past it throws std::invalid_argument
-  /// naming the owner, `cable`, the triangles the cables before it took and the budget.
+  /// sweep_tube(c, radius, opt) within what is left. Past it, or for any refusal of the
+  /// sweep, throws CableLimitError (cable_limit.hpp) for `cable`, naming the owner, the
+  /// cable and, when the cables before it took some, their share of the budget.
   SweepResult sweep(const Centerline& c, double radius, SweepOptions opt, const std::string& cable);
   /// Triangles of the tubes swept so far.
   std::size_t used() const { return used_; }

@@ -5,6 +5,7 @@
 #include "core/harness_topology.hpp"
 #include "index/simplify/alpha_sim.hpp"
 #include "index/embree_index.hpp"
+#include "routing/audit/clash_check.hpp"
 #include "routing/curve/bend_repair.hpp"
 #include "routing/route/branch_layout.hpp"
 #include "routing/route/port_check.hpp"
@@ -96,6 +97,26 @@ BSplineData to_bspline(const Centerline& c) {
   return BSplineData{c.degree(), c.knots(), c.control_points()};
 }
 
+/// Refuses, before any planning, a cable that the certified audit of every route between
+/// its ports would refuse: its chords are at most 2r long, so ports farther apart than
+/// kMaxCertifiedChords of them (a diameter in the wrong units) need more than it takes.
+/// InputError at the cable's element of the harness file.
+void refuse_unauditable_cables(const Harness& h) {
+  for (const Cable& c : h.cables) {
+    const int a = h.find_port(c.ports[0]), b = h.find_port(c.ports[1]);
+    if (a < 0 || b < 0 || !(c.radius() > 0.0)) continue;  // the topology refuses these with their own messages
+    const double apart = (h.ports[static_cast<std::size_t>(b)].position - h.ports[static_cast<std::size_t>(a)].position).norm();
+    const double chords = fewest_certified_chords(apart, c.radius());
+    if (!(chords > kMaxCertifiedChords)) continue;
+    throw InputError({h.source_file, c.line, ""},
+                     "cable '" + c.id + "': its ports " + c.ports[0] + " and " + c.ports[1] + " are " +
+                         full_precision(apart) + " apart, so the audit of any route between them needs at least " +
+                         full_precision(std::ceil(chords)) + " chords of at most its diameter " +
+                         full_precision(c.physical.diameter) + ", more than the " + full_precision(kMaxCertifiedChords) +
+                         " it takes: check the diameter and the harness units");
+  }
+}
+
 /// The stub ends of one segment and what its port ends may touch near the port.
 struct SegmentExits {
   EndFrame ea, eb;                   ///< the from- and to-end
@@ -170,6 +191,7 @@ RouteRun::RouteRun(const Scene& scene, const RouteOptions& opt)
                                         : static_cast<std::uint64_t>(scene.routing.iterations.value);
   rep_.clearance = scene.routing.clearance.value;
   for (const auto& p : scene.parts) part_extra_ = std::max(part_extra_, p.clearance);
+  refuse_unauditable_cables(h_);  // before the planning work it would throw away
 }
 
 RouteReport RouteRun::run() {

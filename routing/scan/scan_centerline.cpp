@@ -1,6 +1,8 @@
 #include "routing/scan/scan_centerline.hpp"
 #include "core/stopwatch.hpp"
 
+#include "core/error.hpp"
+
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <nanoflann.hpp>
@@ -830,6 +832,14 @@ void project_on_chain(const std::vector<Vec3>& pts, const Chain& chain, double d
   });
 }
 
+/// True if a pass-1 block fit (free radius) measures the cable's diameter, nominally d: a
+/// radius beyond d is a failed fit, and so is one whose points lie farther from the fitted
+/// surface, on average, than the radius itself. Why the second: a start radius far below
+/// the cloud's (a diameter of 1e-300 given for a 2 mm cable) keeps the least-squares steps,
+/// scaled by it, too small to move; the fit then ends where it began, its radius "agreeing"
+/// with the given one while every point is millimetres off.
+bool measures_diameter(const FitOut& f, double d) { return f.ok && f.r < d && f.rms <= f.r; }
+
 }  // namespace
 
 std::optional<double> estimate_tube_diameter(const std::vector<Vec3>& cloud, std::uint64_t seed) {
@@ -1114,7 +1124,7 @@ bool CenterlineExtraction::fit_blocks() {
   run_pass(true, 0.5 * d, no_prior, nullptr);
   std::vector<double> diam;
   for (const auto& f : fits)
-    if (f.ok && f.r < d) diam.push_back(2.0 * f.r);  // a radius beyond d is a failed fit
+    if (measures_diameter(f, d)) diam.push_back(2.0 * f.r);
   if (diam.size() < 2) {
     std::string why = "the block fits do not agree on a diameter";
     const std::size_t thin = static_cast<std::size_t>(
@@ -1124,7 +1134,7 @@ bool CenterlineExtraction::fit_blocks() {
              " blocks the points cover less than " + std::to_string(kMinArcSectors * 360 / kArcSectors) +
              " degrees around the fitted axis (a line or a surface, not a tube)";
     else if (opt.diameter)
-      why += " (is the given diameter " + std::to_string(*opt.diameter) + " right?)";
+      why += " (is the given diameter " + full_precision(*opt.diameter) + " right?)";
     return fail(ScanStatus::NotATube, why);
   }
   const double fitted_d = median(diam);
@@ -1135,9 +1145,9 @@ bool CenterlineExtraction::fit_blocks() {
     res.diameter_spread = 1.4826 * median(dev);
     res.diameter = d;
   } else if (std::abs(fitted_d - d) > kGivenDiameterTolerance * d) {
-    return fail(ScanStatus::NotATube, "the given diameter " + std::to_string(d) +
+    return fail(ScanStatus::NotATube, "the given diameter " + full_precision(d) +
                                             " does not match the cloud: its cross-sections fit a diameter of " +
-                                            std::to_string(fitted_d));
+                                            full_precision(fitted_d));
   }
   std::vector<std::optional<Vec3>> priors(m);
   if (!graph && opt.smoothness > 0.0) {  // the paper's E_ext; the graph method's curved blocks need none
