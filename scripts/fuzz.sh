@@ -37,7 +37,7 @@ targets=()
 for a in "$@"; do
   case "$a" in
     --unit-tests) unit_tests=1 ;;
-    -h|--help) sed -n '2,20p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "${BASH_SOURCE[0]}"; exit 0 ;;
     ''|*[!0-9]*) targets+=("$a") ;;
     *) seconds="$a" ;;
   esac
