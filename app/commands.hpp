@@ -17,7 +17,7 @@ namespace loom::app {
 constexpr int kMaxThreads = 1024;
 
 void add_info_command(CLI::App& app, int& exit_code);
-/// `loom simplify`: α-SIM per part → DIR/<part>.stl + DIR/simplify.json (issue 4).
+/// `loom simplify`: α-SIM per part → DIR/<part>.stl + DIR/simplify.json.
 void add_simplify_command(CLI::App& app, int& exit_code);
 /// `loom scan`: centerline, tube and deviation report of a scanned cable (DESIGN §4).
 void add_scan_command(CLI::App& app, int& exit_code);
@@ -47,7 +47,7 @@ void add_iterations_option(CLI::App& cmd, long long& iterations);
 int run_route(const std::string& scene, const RouteCommandOptions& options);
 
 void add_demo_command(CLI::App& app, int& exit_code);
-/// `loom render`: a ray-cast PNG of a scene, its cables and a report's clashes (issue 9).
+/// `loom render`: a ray-cast PNG of a scene, its cables and a report's clashes.
 void add_render_command(CLI::App& app, int& exit_code);
 /// The size of render.png when --render-size is not given, as "WxH" (RenderOptions' default).
 std::string default_render_size();

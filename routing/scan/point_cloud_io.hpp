@@ -1,5 +1,5 @@
 #pragma once
-/// Reading scanned point clouds (issue 8): PLY (ascii, binary little/big endian), XYZ text
+/// Reading scanned point clouds: PLY (ascii, binary little/big endian), XYZ text
 /// and PCD (ascii, binary, binary_compressed/LZF). Only x, y, z are kept; every other
 /// property is skipped. Points with a non-finite coordinate (organised PCD clouds mark
 /// missing pixels with NaN) are dropped and counted. Coordinates are as stored in the file

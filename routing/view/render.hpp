@@ -1,5 +1,5 @@
 #pragma once
-/// render.png: a picture of a scene ray-cast on the CPU with Embree (issue 9): parts and
+/// render.png: a picture of a scene ray-cast on the CPU with Embree: parts and
 /// cable tubes (swept from the cable centerlines) Lambert-shaded, clashes and violations of a
 /// report.json drawn as discs at their projected points, from a camera framing the harness.
 

@@ -2,7 +2,7 @@
 /// view.html: one self-contained page (three.js r111 inlined, no network) showing a scene's
 /// parts, the harness cables coloured per cable, clashes (red) and violations (bend radius
 /// orange, clearance yellow) from a report.json, with a side list that flies the camera to
-/// an item, orbit/pan/zoom and part visibility toggles (issue 9).
+/// an item, orbit/pan/zoom and part visibility toggles.
 
 #include "core/harness.hpp"
 #include "core/mesh.hpp"
