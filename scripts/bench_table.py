@@ -182,9 +182,7 @@ def alpha_sim_rows():
     before = sum(num(r, "triangles_before", "alpha_sim_parts.csv") for r in parts)
     after = sum(num(r, "triangles_after", "alpha_sim_parts.csv") for r in parts)
     contained = min(num(r, "containment", "alpha_sim_parts.csv") for r in rows("alpha_sim_parts.csv"))
-    tp = pick(rows("alpha_sim_throughput.csv"), "alpha_sim_throughput.csv", threads="2", measure="0",
-              absorb_box_prisms="1", occt_booleans="0", edge_on_segments="1", exact_containment="1",
-              coarse_interior="1")
+    tp = pick(rows("alpha_sim_throughput.csv"), "alpha_sim_throughput.csv", threads="2", measure="0")
     rate = num(tp, "triangles_per_second", "alpha_sim_throughput.csv")
     every = rows("alpha_sim_parts.csv")
     speedups = [num(r, k, "alpha_sim_parts.csv") for r in every

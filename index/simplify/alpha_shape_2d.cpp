@@ -119,14 +119,27 @@ struct BucketGrid {
     for (std::uint32_t k = 0; k < tris.size(); ++k)
       for_triangle_cells(tris[k], [&](int x, int y) { items[count[static_cast<std::size_t>(y) * nx + x]++] = k; });
   }
-  /// Calls f(i, j) for each cell (i, j) that the closed triangle c meets, and the cells
-  /// beside those in its row (row by row: the x-range of the triangle's part in the row's
-  /// slab, which its edges' parts there span; one more cell each side for the rounding).
+  /// Calls f(i, j) for each cell (i, j) that the closed triangle c meets, and perhaps a
+  /// cell it only comes within rounding of (row by row: the x-range of the triangle's part
+  /// in the row's slab, which its edges' parts there span, widened by the rounding).
   template <class F>
   void for_triangle_cells(const std::array<Vec2, 3>& c, F&& f) const {
     if (empty()) return;
     const double ymin = std::min({c[0].y(), c[1].y(), c[2].y()}), ymax = std::max({c[0].y(), c[1].y(), c[2].y()});
-    for (int j = cy(ymin), j1 = cy(ymax); j <= j1; ++j) {
+    const double xmin = std::min({c[0].x(), c[1].x(), c[2].x()}), xmax = std::max({c[0].x(), c[1].x(), c[2].x()});
+    // A triangle whose box spans at most two cells each way is listed over its box (as
+    // build() lists boxes): exact, and without the rounding margin below, which would
+    // list most of the many small triangles in three cells instead of one.
+    const int bx0 = cx(xmin), bx1 = cx(xmax), by0 = cy(ymin), by1 = cy(ymax);
+    if (bx1 - bx0 <= 1 && by1 - by0 <= 1) {
+      for (int j = by0; j <= by1; ++j)
+        for (int i = bx0; i <= bx1; ++i) f(i, j);
+      return;
+    }
+    // Widens each row's x-range beyond the rounding of its interpolation and of cx(), far
+    // below a cell: a whole cell each side would list a long triangle three cells wide.
+    const double pad = 1e-12 * (std::abs(xmin) + std::abs(xmax) + std::abs(origin.x())) + 1e-9 * cell;
+    for (int j = by0; j <= by1; ++j) {
       const double s0 = std::max(origin.y() + j * cell, ymin), s1 = std::min(origin.y() + (j + 1) * cell, ymax);
       double xl = std::numeric_limits<double>::infinity(), xr = -xl;
       for (int e = 0; e < 3; ++e) {
@@ -139,10 +152,10 @@ struct BucketGrid {
         xr = std::max(xr, r[1]);
       }
       if (!(xl <= xr)) {  // the row's slab meets the triangle only within rounding
-        xl = std::min({c[0].x(), c[1].x(), c[2].x()});
-        xr = std::max({c[0].x(), c[1].x(), c[2].x()});
+        xl = xmin;
+        xr = xmax;
       }
-      for (int i = std::max(0, cx(xl) - 1), i1 = std::min(nx - 1, cx(xr) + 1); i <= i1; ++i) f(i, j);
+      for (int i = cx(xl - pad), i1 = cx(xr + pad); i <= i1; ++i) f(i, j);
     }
   }
   /// The items listed in every cell within `pad` of the segment ab (row by row: the

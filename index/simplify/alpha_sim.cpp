@@ -330,10 +330,15 @@ double plane_sample_estimate(const Mesh& mesh, const std::vector<MeshEdge>& edge
 /// kept when the projection falls back to its hull, cost what its lattice would.
 double hull_lattice_estimate(const Mesh& mesh, const std::vector<Vec2>& proj, double l_max) {
   using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-  std::vector<Kernel::Point_2> used, hull;
-  used.reserve(3 * mesh.triangles.size());
+  // Each vertex once (a closed mesh names each about six times): the hull's sort is most
+  // of the cost.
+  std::vector<char> is_used(proj.size(), 0);
   for (const auto& f : mesh.triangles)
-    for (const auto i : f) used.emplace_back(proj[i].x(), proj[i].y());
+    for (const auto i : f) is_used[i] = 1;
+  std::vector<Kernel::Point_2> used, hull;
+  used.reserve(proj.size());
+  for (std::size_t i = 0; i < proj.size(); ++i)
+    if (is_used[i]) used.emplace_back(proj[i].x(), proj[i].y());
   CGAL::convex_hull_2(used.begin(), used.end(), std::back_inserter(hull));
   double twice_area = 0.0, perimeter = 0.0;
   for (std::size_t i = 0; i < hull.size(); ++i) {
