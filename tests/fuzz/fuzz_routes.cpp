@@ -6,6 +6,7 @@
 // scratch directory. One worker thread: the fuzzer runs beside other work.
 #include "fuzz_support.hpp"
 
+#include "core/io/json_text.hpp"
 #include "core/io/mesh_read.hpp"
 #include "core/io/mesh_write.hpp"
 #include "routing/audit/audit.hpp"
