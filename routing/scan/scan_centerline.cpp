@@ -521,10 +521,19 @@ struct Chain {
   }
 };
 
+/// floor(v / cell) as an integer, clamped to ±2^62: a cell far below the scan's scale (a
+/// diameter given in the wrong units) gives quotients beyond any integer type, and
+/// converting those is undefined.
+std::int64_t grid_index(double v, double cell) {
+  return static_cast<std::int64_t>(std::clamp(std::floor(v / cell), -0x1p62, 0x1p62));
+}
+
+/// Hash key of the grid cell of p: its indices wrapped to 21 bits each (far cells may
+/// share a key; callers compare the points themselves).
 std::int64_t cell_key(const Vec3& p, double cell) {
-  const auto ix = static_cast<std::int64_t>(std::floor(p.x() / cell)) & 0x1FFFFF;
-  const auto iy = static_cast<std::int64_t>(std::floor(p.y() / cell)) & 0x1FFFFF;
-  const auto iz = static_cast<std::int64_t>(std::floor(p.z() / cell)) & 0x1FFFFF;
+  const std::int64_t ix = grid_index(p.x(), cell) & 0x1FFFFF;
+  const std::int64_t iy = grid_index(p.y(), cell) & 0x1FFFFF;
+  const std::int64_t iz = grid_index(p.z(), cell) & 0x1FFFFF;
   return (ix << 42) | (iy << 21) | iz;
 }
 
@@ -629,9 +638,7 @@ bool build_chain(const std::vector<Vec3>& pts, const std::vector<Vec3>& sub, con
   for (std::size_t k = 0; k < node.size(); ++k) {
     if (static_cast<double>(support[k]) < 0.2 * sup_med || support[k] < 3) continue;
     const Vec3& x = node[k];
-    const auto ix = static_cast<std::int64_t>(std::floor(x.x() / mr));
-    const auto iy = static_cast<std::int64_t>(std::floor(x.y() / mr));
-    const auto iz = static_cast<std::int64_t>(std::floor(x.z() / mr));
+    const std::int64_t ix = grid_index(x.x(), mr), iy = grid_index(x.y(), mr), iz = grid_index(x.z(), mr);
     int hit = -1;
     for (int dx = -1; dx <= 1 && hit < 0; ++dx)
       for (int dy = -1; dy <= 1 && hit < 0; ++dy)
