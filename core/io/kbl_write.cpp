@@ -164,7 +164,13 @@ void KblWriter::write_nodes() {
     const auto it = o_.node_ids.find(loom_id);
     pugi::xml_node node = it == o_.node_ids.end() ? pugi::xml_node() : element(it->second);
     if (!node) throw std::invalid_argument("harness_to_kbl: node '" + loom_id + "' is not a Node of " + h_.source_file);
-    if (const pugi::xml_node cp = element(text_of(child(node, "Cartesian_point")))) return set_point(cp, p);
+    const pugi::xml_node ref_el = child(node, "Cartesian_point");
+    const pugi::xml_node cp = element(text_of(ref_el));
+    if (cp && children(cp, "Coordinates").size() == 3) return set_point(cp, p);
+    if (cp) {  // a formboard (2D) point: the node takes a new 3D one, the drawing's goes if unused
+      dropped_points_.insert(cp.attribute("id").value());
+      return set_text(ref_el, new_point(p).attribute("id").value());
+    }
     // A node the router placed: a new point, referenced after the node's Id and Alias_ids.
     pugi::xml_node after;
     for (auto c : node.children())
@@ -172,7 +178,8 @@ void KblWriter::write_nodes() {
     pugi::xml_node ref = after ? node.insert_child_after("Cartesian_point", after) : node.prepend_child("Cartesian_point");
     set_text(ref, new_point(p).attribute("id").value());
   };
-  for (const auto& p : h_.ports) place(p.id, p.position);
+  for (const auto& p : h_.ports)
+    if (p.placed) place(p.id, p.position);  // an unplaced port keeps the drawing's point
   for (const auto& b : h_.branches)
     if (b.position) place(b.id, *b.position);
 }
@@ -216,6 +223,9 @@ void KblWriter::write_segment(std::size_t k, const Centerline& c) {
     vl = new_object(seg, "Virtual_length", !ev.empty() ? ev.back() : !sv.empty() ? sv.back() : head);
   }
   set_measure(vl, c.length());
+  // A drawing's Virtual_length was its formboard length: kept as the length to manufacture.
+  if (const auto& nominal = h_.segments[k].nominal_length; nominal && !child(seg, "Physical_length"))
+    set_measure(new_object(seg, "Physical_length", vl), *nominal);
 }
 
 void KblWriter::write_lengths(const HarnessTopology& topo) {
