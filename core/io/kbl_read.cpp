@@ -33,6 +33,7 @@ namespace loom {
 namespace {
 
 using kbl_dom::child;
+using kbl_dom::describe;
 using kbl_dom::children;
 using kbl_dom::local_name;
 
@@ -102,12 +103,6 @@ class KblReader {
 
  private:
   int line(const pugi::xml_node& n) const { return lines_.line(n.offset_debug()); }
-
-  static std::string describe(const pugi::xml_node& n) {
-    std::string s = "<" + std::string(n.name());
-    if (auto a = n.attribute("id")) s += " id=\"" + std::string(a.value()) + "\"";
-    return s + ">";
-  }
 
   [[noreturn]] void fail(const pugi::xml_node& n, const std::string& reason) const {
     throw InputError({file_, line(n), describe(n)}, reason);

@@ -29,21 +29,11 @@ namespace {
 
 using kbl_dom::child;
 using kbl_dom::children;
+using kbl_dom::describe;
+using kbl_dom::words;
 using kbl_dom::local_name;
 
-std::string text_of(const pugi::xml_node& n) {
-  std::istringstream in(n.child_value());
-  std::string t, out;
-  while (in >> t) out += (out.empty() ? "" : " ") + t;
-  return out;
-}
-
-std::vector<std::string> tokens(const pugi::xml_node& n) {
-  std::istringstream in(n.child_value());
-  std::vector<std::string> out;
-  for (std::string t; in >> t;) out.push_back(t);
-  return out;
-}
+std::string text_of(const pugi::xml_node& n) { return kbl_dom::words_text(n); }
 
 std::string lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -77,11 +67,6 @@ class VecReader {
 
  private:
   int line(const pugi::xml_node& n) const { return lines_.line(n.offset_debug()); }
-  static std::string describe(const pugi::xml_node& n) {
-    std::string s = "<" + std::string(n.name());
-    if (auto a = n.attribute("id")) s += " id=\"" + std::string(a.value()) + "\"";
-    return s + ">";
-  }
   [[noreturn]] void fail(const pugi::xml_node& n, const std::string& reason) const {
     throw InputError({file_, line(n), describe(n)}, reason);
   }
@@ -109,13 +94,21 @@ class VecReader {
     return it == by_name_.end() ? std::vector<pugi::xml_node>() : it->second;
   }
   std::string kbl_text(const pugi::xml_node& root);
+  std::map<std::string, std::vector<std::string>> placements() const;
+  std::map<std::string, std::vector<pugi::xml_node>> write_contacts(pugi::xml_node harness);
+  void write_wires(pugi::xml_node kbl_root, pugi::xml_node harness);
   void add_wire_part(pugi::xml_node kbl_root, const pugi::xml_node& wer, const pugi::xml_node& spec);
+  std::map<std::string, std::string> write_nodes(pugi::xml_node kbl_root,
+                                                 const std::map<std::string, std::vector<pugi::xml_node>>& contacts);
+  void write_routings(pugi::xml_node kbl_root);
+  void write_segments(pugi::xml_node kbl_root, const std::map<std::string, std::string>& node_id);
 
   LineMap lines_;
   std::string file_;
   std::unordered_map<std::string, pugi::xml_node> by_id_;
   std::map<std::string, std::vector<pugi::xml_node>> by_name_;  ///< elements by local name, in order
   std::map<std::string, pugi::xml_node> kbl_source_;  ///< KBL id → the VEC element it stands for
+  std::map<std::string, std::string> contact_of_end_;  ///< WireEnd id → ContactPoint id
   std::set<std::string> parts_written_;
   std::vector<std::string> notes_;  ///< what the translation left out, for KblOrigin::notes
 };
@@ -159,17 +152,9 @@ void VecReader::add_wire_part(pugi::xml_node kbl_root, const pugi::xml_node& wer
   kbl_source_[sid] = spec;
 }
 
-std::string VecReader::kbl_text(const pugi::xml_node& root) {
-  pugi::xml_document kdoc;
-  pugi::xml_node k = kdoc.append_child("kbl:KBL_container");
-  k.append_attribute("xmlns:kbl") = "http://www.prostep.org/Car_electric_container/KBL2.3/KBLSchema";
-  k.append_attribute("xmlns:xsi") = "http://www.w3.org/2001/XMLSchema-instance";
-  k.append_attribute("id") = root.attribute("id").value();
-  k.append_attribute("version_id") = "2.4";
-  pugi::xml_node harness = k.append_child("Harness");
-  harness.append_attribute("id") = "loom.harness";
-  // Components placed at nodes (OnPointPlacement → NodeLocation).
-  std::map<std::string, std::vector<std::string>> at_node;  // VEC node id → component ids
+/// Components placed at nodes (OnPointPlacement → NodeLocation): VEC node id → component ids.
+std::map<std::string, std::vector<std::string>> VecReader::placements() const {
+  std::map<std::string, std::vector<std::string>> at_node;
   for (const auto& pl : all("Placement")) {
     const pugi::xml_node placed = child(pl, "PlacedElement");
     if (!placed) continue;
@@ -180,45 +165,23 @@ std::string VecReader::kbl_text(const pugi::xml_node& root) {
         if (const pugi::xml_node node = lookup(rn, text_of(rn)); comp && local_name(node) == "TopologyNode")
           at_node[node.attribute("id").value()].push_back(comp.attribute("id").value());
   }
-  // Contact points in the component whose cavity they equip; wire ends to contact points.
-  std::map<std::string, std::vector<pugi::xml_node>> contacts;  // component id → contact points
-  std::map<std::string, std::string> contact_of_end;             // WireEnd id → ContactPoint id
+  return at_node;
+}
+
+/// Contact points as the Contact_points of the connector occurrence whose cavity they equip;
+/// returns component id → its contact points (and notes which contact mounts each wire end).
+std::map<std::string, std::vector<pugi::xml_node>> VecReader::write_contacts(pugi::xml_node harness) {
+  std::map<std::string, std::vector<pugi::xml_node>> contacts;
   for (const auto& cp : all("ContactPoint")) {
     pugi::xml_node comp;
     for (auto cm : children(cp, "CavityMounting"))
       for (auto ref : children(cm, "EquippedCavityRef"))
-        for (const auto& t : tokens(ref))
+        for (const auto& t : words(ref))
           if (!comp) comp = ancestor(lookup(ref, t), "Component");
     if (comp) contacts[comp.attribute("id").value()].push_back(cp);
     for (auto wm : children(cp, "WireMounting"))
       for (auto ref : children(wm, "ReferencedWireEnd"))
-        for (const auto& t : tokens(ref)) contact_of_end.emplace(lookup(ref, t).attribute("id").value(), cp.attribute("id").value());
-  }
-  // Wires: each WireElementReference with its ends is a connection of a wire occurrence.
-  for (const auto& wer : all("WireElementReference")) {
-    const std::string wid = wer.attribute("id").value();
-    const pugi::xml_node rwe = child(wer, "ReferencedWireElement");
-    if (!rwe) fail(wer, "has no <ReferencedWireElement>");
-    const pugi::xml_node we = lookup(rwe, text_of(rwe));
-    const pugi::xml_node wes = child(we, "WireElementSpecification");
-    if (!wes) fail(we, "has no <WireElementSpecification>");
-    const pugi::xml_node spec = lookup(wes, text_of(wes));
-    add_wire_part(k, wer, spec);
-    pugi::xml_node conn = harness.append_child("Connection");
-    conn.append_attribute("id") = ("loom.conn." + wid).c_str();
-    kbl_source_["loom.conn." + wid] = wer;
-    conn.append_child("Id").text().set(text_of(child(wer, "Identification")).c_str());
-    conn.append_child("Wire").text().set(wid.c_str());
-    for (auto end : children(wer, "WireEnd")) {
-      pugi::xml_node ex = conn.append_child("Extremities");
-      ex.append_attribute("id") = end.attribute("id").value();
-      kbl_source_[end.attribute("id").value()] = end;
-      if (const pugi::xml_node pos = child(end, "PositionOnWire"))
-        ex.append_child("Position_on_wire").text().set(full_precision(number(pos)).c_str());
-      const auto cp = contact_of_end.find(end.attribute("id").value());
-      if (cp == contact_of_end.end()) fail(end, "no <ContactPoint> mounts this wire end: loom cannot tell where the wire ends");
-      ex.append_child("Contact_point").text().set(cp->second.c_str());
-    }
+        for (const auto& t : words(ref)) contact_of_end_.emplace(lookup(ref, t).attribute("id").value(), cp.attribute("id").value());
   }
   for (const auto& [comp_id, cps] : contacts) {
     const pugi::xml_node comp = by_id_.at(comp_id);
@@ -233,32 +196,72 @@ std::string VecReader::kbl_text(const pugi::xml_node& root) {
       c.append_child("Id").text().set(text_of(child(cp, "Identification")).c_str());
     }
   }
+  return contacts;
+}
+
+/// Each WireElementReference with its ends: a wire occurrence of its specification's
+/// General_wire and the Connection between the contact points that mount its ends.
+void VecReader::write_wires(pugi::xml_node kbl_root, pugi::xml_node harness) {
   for (const auto& wer : all("WireElementReference")) {
+    const std::string wid = wer.attribute("id").value();
+    const pugi::xml_node rwe = child(wer, "ReferencedWireElement");
+    if (!rwe) fail(wer, "has no <ReferencedWireElement>");
+    const pugi::xml_node we = lookup(rwe, text_of(rwe));
+    const pugi::xml_node wes = child(we, "WireElementSpecification");
+    if (!wes) fail(we, "has no <WireElementSpecification>");
+    add_wire_part(kbl_root, wer, lookup(wes, text_of(wes)));
+    pugi::xml_node conn = harness.append_child("Connection");
+    conn.append_attribute("id") = ("loom.conn." + wid).c_str();
+    kbl_source_["loom.conn." + wid] = wer;
+    conn.append_child("Id").text().set(text_of(child(wer, "Identification")).c_str());
+    conn.append_child("Wire").text().set(wid.c_str());
+    for (auto end : children(wer, "WireEnd")) {
+      pugi::xml_node ex = conn.append_child("Extremities");
+      ex.append_attribute("id") = end.attribute("id").value();
+      kbl_source_[end.attribute("id").value()] = end;
+      if (const pugi::xml_node pos = child(end, "PositionOnWire"))
+        ex.append_child("Position_on_wire").text().set(full_precision(number(pos)).c_str());
+      const auto cp = contact_of_end_.find(end.attribute("id").value());
+      if (cp == contact_of_end_.end()) fail(end, "no <ContactPoint> mounts this wire end: loom cannot tell where the wire ends");
+      ex.append_child("Contact_point").text().set(cp->second.c_str());
+    }
     pugi::xml_node occ = harness.append_child("General_wire_occurrence");
     occ.append_attribute("xsi:type") = "kbl:Wire_occurrence";
-    occ.append_attribute("id") = wer.attribute("id").value();
-    kbl_source_[wer.attribute("id").value()] = wer;
-    const pugi::xml_node we = by_id_.at(text_of(child(wer, "ReferencedWireElement")));
-    occ.append_child("Part").text().set(text_of(child(we, "WireElementSpecification")).c_str());
+    occ.append_attribute("id") = wid.c_str();
+    kbl_source_[wid] = wer;
+    occ.append_child("Part").text().set(text_of(wes).c_str());
     occ.append_child("Wire_number").text().set(text_of(child(wer, "Identification")).c_str());
   }
-  // Nodes: named by their Identification where it is unique (the name the drawing shows).
+}
+
+/// Nodes, named by their Identification where it is unique (the name the drawing shows),
+/// referencing the connectors placed on them; returns VEC node id → KBL node id.
+std::map<std::string, std::string> VecReader::write_nodes(pugi::xml_node kbl_root,
+                                                          const std::map<std::string, std::vector<pugi::xml_node>>& contacts) {
+  const auto at_node = placements();
   std::map<std::string, int> names;
   for (const auto& n : all("TopologyNode")) ++names[text_of(child(n, "Identification"))];
-  std::map<std::string, std::string> node_id;  // VEC id → KBL id
+  std::map<std::string, std::string> node_id;
   for (const auto& n : all("TopologyNode")) {
     const std::string name = text_of(child(n, "Identification")), vid = n.attribute("id").value();
     const std::string kid = !name.empty() && names[name] == 1 && !by_id_.count(name) ? name : vid;
     node_id[vid] = kid;
     kbl_source_[kid] = n;
-    pugi::xml_node kn = k.append_child("Node");
+    pugi::xml_node kn = kbl_root.append_child("Node");
     kn.append_attribute("id") = kid.c_str();
     kn.append_child("Id").text().set(name.c_str());
     std::string refs;
-    for (const auto& c : at_node[vid])
-      if (contacts.count(c)) refs += (refs.empty() ? "" : " ") + c;
+    if (const auto it = at_node.find(vid); it != at_node.end())
+      for (const auto& c : it->second)
+        if (contacts.count(c)) refs += (refs.empty() ? "" : " ") + c;
     if (!refs.empty()) kn.append_child("Referenced_components").text().set(refs.c_str());
   }
+  return node_id;
+}
+
+/// Routings of single wires, their segments once each; a path that passes a segment twice
+/// (out along a branch and back) is noted and left out: a tree route cannot hold the loop.
+void VecReader::write_routings(pugi::xml_node kbl_root) {
   for (const auto& r : all("Routing")) {
     const pugi::xml_node re = child(r, "RoutedElement");
     if (!re) fail(r, "has no <RoutedElement>");
@@ -268,30 +271,33 @@ std::string VecReader::kbl_text(const pugi::xml_node& root) {
     std::string segs, twice;
     for (auto path : children(r, "Path"))
       for (auto s : children(path, "Segment"))
-        for (const auto& t : tokens(s)) {
+        for (const auto& t : words(s)) {
           lookup(s, t);
           if (seen.insert(t).second) segs += (segs.empty() ? "" : " ") + t;
           else twice += (twice.empty() ? "" : " ") + text_of(child(by_id_.at(t), "Identification"));
         }
     if (!twice.empty()) {
-      // Out along a branch and back (a special routing): a tree route cannot hold the loop.
       notes_.push_back("routing '" + text_of(child(r, "Identification")) + "' (line " + std::to_string(line(r)) +
                        ") passes " + twice + " twice, out and back: loom routes its wire along the tree path "
                        "between its ends (the loop is not modelled)");
       continue;
     }
-    pugi::xml_node kr = k.append_child("Routing");
+    pugi::xml_node kr = kbl_root.append_child("Routing");
     kr.append_attribute("id") = r.attribute("id").value();
     kbl_source_[r.attribute("id").value()] = r;
     kr.append_child("Routed_wire").text().set(("loom.conn." + std::string(wer.attribute("id").value())).c_str());
     kr.append_child("Segments").text().set(segs.c_str());
   }
+}
+
+/// Segments between their nodes, with the adapted length (rounded for manufacture), else
+/// the designed one, as their Physical_length.
+void VecReader::write_segments(pugi::xml_node kbl_root, const std::map<std::string, std::string>& node_id) {
   for (const auto& s : all("TopologySegment")) {
-    pugi::xml_node ks = k.append_child("Segment");
+    pugi::xml_node ks = kbl_root.append_child("Segment");
     ks.append_attribute("id") = s.attribute("id").value();
     kbl_source_[s.attribute("id").value()] = s;
     ks.append_child("Id").text().set(text_of(child(s, "Identification")).c_str());
-    // The adapted length (rounded for manufacture) before the designed one.
     pugi::xml_node length;
     for (auto li : children(s, "LengthInformation"))
       if (const pugi::xml_node l = child(li, "Length"); l && (!length || lower(text_of(child(li, "Classification"))) == "adapted"))
@@ -311,6 +317,22 @@ std::string VecReader::kbl_text(const pugi::xml_node& root) {
           .set(node_id.at(n.attribute("id").value()).c_str());
     }
   }
+}
+
+std::string VecReader::kbl_text(const pugi::xml_node& root) {
+  pugi::xml_document kdoc;
+  pugi::xml_node k = kdoc.append_child("kbl:KBL_container");
+  k.append_attribute("xmlns:kbl") = "http://www.prostep.org/Car_electric_container/KBL2.3/KBLSchema";
+  k.append_attribute("xmlns:xsi") = "http://www.w3.org/2001/XMLSchema-instance";
+  k.append_attribute("id") = root.attribute("id").value();
+  k.append_attribute("version_id") = "2.4";
+  pugi::xml_node harness = k.append_child("Harness");
+  harness.append_attribute("id") = "loom.harness";
+  const auto contacts = write_contacts(harness);
+  write_wires(k, harness);
+  const auto node_id = write_nodes(k, contacts);
+  write_routings(k);
+  write_segments(k, node_id);
   std::ostringstream os;
   kdoc.save(os, "  ");
   return os.str();

@@ -28,6 +28,7 @@ namespace {
 using kbl_dom::child;
 using kbl_dom::children;
 using kbl_dom::local_name;
+std::string text_of(const pugi::xml_node& n) { return kbl_dom::words_text(n); }
 
 /// The shortest decimal text that reads back as exactly v.
 std::string number_text(double v) {
@@ -39,12 +40,6 @@ std::string number_text(double v) {
   return buf;
 }
 
-std::string text_of(const pugi::xml_node& n) {
-  std::istringstream in(n.child_value());
-  std::string t, out;
-  while (in >> t) out += (out.empty() ? "" : " ") + t;
-  return out;
-}
 
 class KblWriter {
  public:
