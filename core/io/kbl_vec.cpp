@@ -40,18 +40,20 @@ std::string lower(std::string s) {
   return s;
 }
 
-/// The id of the element of `kbl` that starts on `line`, or of the nearest one around it
-/// with an id (empty if none): where the KBL reader found a fault.
-std::string kbl_id_at(const std::string& kbl, int line) {
+/// Per line of `kbl` where an element starts: the id of that element, or of the nearest
+/// one around it with an id (where the KBL reader found a fault, or read a node or segment).
+std::map<int, std::string> kbl_ids_by_line(const std::string& kbl) {
+  std::map<int, std::string> out;
   pugi::xml_document doc;
-  if (line <= 0 || !doc.load_buffer(kbl.data(), kbl.size())) return {};
+  if (!doc.load_buffer(kbl.data(), kbl.size())) return out;
   const LineMap lines(kbl);
-  pugi::xml_node found;
   kbl_dom::for_each_node(doc.document_element(), [&](const pugi::xml_node& n) {
-    if (!found && n.type() == pugi::node_element && lines.line(n.offset_debug()) == line) found = n;
+    if (n.type() != pugi::node_element) return;
+    pugi::xml_node with_id = n;
+    for (; with_id && !with_id.attribute("id"); with_id = with_id.parent()) {}
+    if (with_id) out.emplace(lines.line(n.offset_debug()), with_id.attribute("id").value());
   });
-  for (; found && !found.attribute("id"); found = found.parent()) {}
-  return found ? found.attribute("id").value() : std::string();
+  return out;
 }
 
 /// A VEC topology (TopologyNode, TopologySegment, placements, contact points, wires,
@@ -66,6 +68,8 @@ class VecReader {
   Harness read(const pugi::xml_document& doc);
 
  private:
+  int vec_line(const std::map<int, std::string>& ids, int kbl_line) const;
+  void to_vec_lines(const std::string& kbl, Harness& h, KblOrigin& origin) const;
   int line(const pugi::xml_node& n) const { return lines_.line(n.offset_debug()); }
   [[noreturn]] void fail(const pugi::xml_node& n, const std::string& reason) const {
     throw InputError({file_, line(n), describe(n)}, reason);
@@ -338,6 +342,32 @@ std::string VecReader::kbl_text(const pugi::xml_node& root) {
   return os.str();
 }
 
+/// The VEC line of the element a line of the KBL text stands for (0 if none).
+int VecReader::vec_line(const std::map<int, std::string>& ids, int kbl_line) const {
+  const auto id = ids.find(kbl_line);
+  const auto src = id == ids.end() ? kbl_source_.end() : kbl_source_.find(id->second);
+  return src == kbl_source_.end() ? 0 : line(src->second);
+}
+
+/// The lines the KBL reader recorded (of the KBL text) made the VEC file's: those of ports,
+/// branch points, segments, cables, clamps, and the "(line N)" of its notes.
+void VecReader::to_vec_lines(const std::string& kbl, Harness& h, KblOrigin& origin) const {
+  const auto ids = kbl_ids_by_line(kbl);
+  for (auto& p : h.ports) p.line = vec_line(ids, p.line);
+  for (auto& b : h.branches) b.line = vec_line(ids, b.line);
+  for (auto& s : h.segments) s.line = vec_line(ids, s.line);
+  for (auto& c : h.cables) c.line = vec_line(ids, c.line);
+  for (auto& c : h.clamps) c.line = vec_line(ids, c.line);
+  const std::string tag = "(line ";
+  for (auto& note : origin.notes)
+    for (auto at = note.find(tag); at != std::string::npos; at = note.find(tag, at + 1)) {
+      const auto digits = note.find_first_not_of("0123456789", at + tag.size());
+      if (digits == at + tag.size()) continue;
+      const int l = std::atoi(note.c_str() + at + tag.size());
+      note.replace(at + tag.size(), digits - at - tag.size(), std::to_string(vec_line(ids, l)));
+    }
+}
+
 Harness VecReader::read(const pugi::xml_document& doc) {
   const pugi::xml_node root = doc.document_element();
   const SourceLocation where{file_, line(root), "<" + std::string(root.name()) + ">"};
@@ -377,11 +407,14 @@ Harness VecReader::read(const pugi::xml_document& doc) {
     if (reason.find("cycle") != std::string::npos && !all("VariantConfiguration").empty())
       reason += " (the file holds " + std::to_string(all("VariantConfiguration").size()) +
                 " variant configurations; loom routes one harness tree: give one variant's topology)";
-    const auto src = kbl_source_.find(kbl_id_at(kbl, e.where().line));
+    const auto ids = kbl_ids_by_line(kbl);
+    const auto id = ids.find(e.where().line);
+    const auto src = id == ids.end() ? kbl_source_.end() : kbl_source_.find(id->second);
     if (src == kbl_source_.end()) throw InputError(where, reason + " (in the file's topology read as KBL)");
     throw InputError({file_, line(src->second), describe(src->second)}, reason);
   }
   auto origin = std::make_shared<KblOrigin>(*h.kbl);
+  to_vec_lines(kbl, h, *origin);
   origin->version = "2.4 (read from VEC " + version + ")";
   origin->notes.insert(origin->notes.begin(), holds + " and no 3D geometry, read as its KBL 2.4 equivalent; routed "
                                                      "output in KBL (routed.kbl) is that KBL with the routed geometry");

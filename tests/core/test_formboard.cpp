@@ -166,6 +166,12 @@ TEST(VecTopology, OneVariantReadsAsTopologyWithItsLengths) {
     EXPECT_EQ(c.ports[0], "A1");
   }
   EXPECT_EQ(h.cables[h.find_cable("W2")].ports[1], "A3");
+  // Lines are the VEC file's, where each element is (not those of its KBL reading).
+  const std::string text = slurp(kData + "routing-examples-rl.vec");
+  EXPECT_EQ(h.ports[static_cast<std::size_t>(h.find_port("A1"))].line, line_of(text, "<TopologyNode id=\"TopologyNode_00024\""));
+  EXPECT_EQ(h.branches[static_cast<std::size_t>(h.find_branch("ND-4"))].line, line_of(text, "<TopologyNode id=\"TopologyNode_00027\""));
+  EXPECT_EQ(h.segments[3].line, line_of(text, "<TopologySegment id=\"TopologySegment_00035\""));
+  EXPECT_EQ(h.cables[h.find_cable("W2")].line, line_of(text, "<WireElementReference id=\"WireElementReference_00098\""));
   bool loop = false;
   for (const auto& n : h.kbl->notes) loop = loop || n.find("routing 'W3'") != std::string::npos;
   EXPECT_TRUE(loop);
