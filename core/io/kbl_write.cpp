@@ -173,10 +173,23 @@ void KblWriter::write_nodes() {
     pugi::xml_node ref = after ? node.insert_child_after("Cartesian_point", after) : node.prepend_child("Cartesian_point");
     set_text(ref, new_point(p).attribute("id").value());
   };
+  bool placed_any = false;
   for (const auto& p : h_.ports)
-    if (p.placed) place(p.id, p.position);  // an unplaced port keeps the drawing's point
+    if (p.placed) place(p.id, p.position), placed_any = true;  // an unplaced port keeps the drawing's point
   for (const auto& b : h_.branches)
-    if (b.position) place(b.id, *b.position);
+    if (b.position) place(b.id, *b.position), placed_any = true;
+  if (!placed_any) return;
+  // A branch point still open in a drawing now partly 3D loses its 2D point: left beside
+  // 3D ones it would make the file neither a drawing nor 3D; without one it stays open.
+  for (const auto& b : h_.branches) {
+    const auto it = o_.node_ids.find(b.id);
+    pugi::xml_node node = b.position || it == o_.node_ids.end() ? pugi::xml_node() : element(it->second);
+    const pugi::xml_node ref_el = node ? child(node, "Cartesian_point") : pugi::xml_node();
+    if (const pugi::xml_node cp = element(text_of(ref_el)); cp && children(cp, "Coordinates").size() == 2) {
+      dropped_points_.insert(cp.attribute("id").value());
+      node.remove_child(ref_el);
+    }
+  }
 }
 
 void KblWriter::write_segment(std::size_t k, const Centerline& c) {

@@ -4,6 +4,7 @@
 #include "core/error.hpp"
 #include "core/io/kbl_read.hpp"
 #include "core/io/kbl_vec.hpp"
+#include "core/io/kbl_write.hpp"
 #include "core/io/scene_load.hpp"
 
 #include <gtest/gtest.h>
@@ -91,6 +92,31 @@ TEST(FormboardKbl, ReadsAsTopologyWithTheDrawingsLengths) {
   bool said = false;
   for (const auto& n : h.kbl->notes) said = said || n.find("fixing 'K1'") != std::string::npos;
   EXPECT_TRUE(said);
+}
+
+// Written back with its ports placed but its branch point still open (what `loom audit`
+// of an unrouted scene writes): the file reads as 3D, the branch point open, the drawing's
+// lengths kept.
+TEST(FormboardKbl, PlacedPortsWriteBackAs3DWithTheBranchPointOpen) {
+  Harness h = read_harness_kbl(kMini);
+  for (std::size_t i = 0; i < h.ports.size(); ++i) {
+    h.ports[i].position = Vec3(100.0 * static_cast<double>(i), 5.0, 50.0);
+    h.ports[i].placed = true;
+  }
+  const Harness back = parse_harness_kbl(harness_to_kbl(h), "written.kbl");
+  for (std::size_t i = 0; i < h.ports.size(); ++i) {
+    EXPECT_TRUE(back.ports[i].placed);
+    EXPECT_EQ(back.ports[i].position, h.ports[i].position);
+  }
+  EXPECT_FALSE(back.branches[0].position);
+  for (const auto& s : back.segments) EXPECT_FALSE(s.bspline);
+  // Unrouted segments keep their Virtual_length; in a 3D file that is no nominal length.
+  const std::string text = harness_to_kbl(h);
+  EXPECT_NE(text.find("<Value_component>260</Value_component>"), std::string::npos);
+  // Nothing placed: the drawing is written back as it was read.
+  const Harness again = parse_harness_kbl(harness_to_kbl(read_harness_kbl(kMini)), "again.kbl");
+  for (const auto& p : again.ports) EXPECT_FALSE(p.placed);
+  EXPECT_DOUBLE_EQ(*again.segments[1].nominal_length, 260.0);
 }
 
 TEST(FormboardKbl, A2DPointAmong3DOnesIsRefusedAtThatPoint) {
