@@ -213,6 +213,20 @@ void require_placed_ports(const Harness& h, const std::string& scene_file) {
                        ", e.g. " + first + " = { at = [x, y, z], dir = [dx, dy, dz] } (scene units)");
 }
 
+/// The scene's part of a harness without 3D geometry: what it must place said in the notes,
+/// [harness.place] applied, and every port required placed.
+void place_harness(const TomlReader& r, const toml::table& ht, Harness& h, SceneLoadReport* report) {
+  const auto unplaced = std::count_if(h.ports.begin(), h.ports.end(), [](const Port& p) { return !p.placed; });
+  const auto open = std::count_if(h.branches.begin(), h.branches.end(), [](const BranchPoint& b) { return !b.position; });
+  std::vector<std::string> notes;
+  if (unplaced)
+    notes.push_back("harness file " + h.source_file + " has no 3D geometry: topology only, " + std::to_string(unplaced) +
+                    " nodes to be placed by the scene, " + std::to_string(open) + " by the router");
+  if (const toml::node* pn = ht.get("place")) place_ports(r, *pn, h, notes);
+  require_placed_ports(h, r.file());
+  if (report) report->notes.insert(report->notes.end(), notes.begin(), notes.end());
+}
+
 }  // namespace
 
 void apply_routes(Scene& scene, const std::filesystem::path& routes) {
@@ -279,18 +293,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
       r.fail(ht->get("file"), "harness.file",
              std::string("unit mismatch: the harness is in ") + unit_name(scene.harness.units) +
                  " but the scene is in " + unit_name(scene.units) + " (all lengths must share the scene unit)");
-    const auto unplaced = std::count_if(scene.harness.ports.begin(), scene.harness.ports.end(),
-                                        [](const Port& p) { return !p.placed; });
-    const auto open = std::count_if(scene.harness.branches.begin(), scene.harness.branches.end(),
-                                    [](const BranchPoint& b) { return !b.position; });
-    std::vector<std::string> place_notes;
-    if (unplaced)
-      place_notes.push_back("harness file " + scene.harness.source_file + " has no 3D geometry: topology only, " +
-                            std::to_string(unplaced) + " nodes to be placed by the scene, " + std::to_string(open) +
-                            " by the router");
-    if (const toml::node* pn = ht->get("place")) place_ports(r, *pn, scene.harness, place_notes);
-    require_placed_ports(scene.harness, file);
-    if (report) report->notes.insert(report->notes.end(), place_notes.begin(), place_notes.end());
+    place_harness(r, *ht, scene.harness, report);
     scene.has_harness = true;
   }
   const double dmin = scene.harness.smallest_diameter();
