@@ -47,6 +47,9 @@ struct Port {
   Vec3 position = Vec3::Zero();
   Vec3 direction = Vec3::UnitX();  ///< unit exit direction
   int line = 0;
+  /// False for a port of a file without 3D geometry (KBL formboard, VEC topology) until the
+  /// scene's [harness.place] gives its position and direction.
+  bool placed = true;
 };
 
 /// A branch point of the harness tree, joined to any number of nodes (3 in the patent, 2
@@ -77,6 +80,9 @@ struct Segment {
   Interp interp = Interp::BSpline;
   std::optional<BSplineData> bspline;  ///< exact routed curve from → to, if any
   std::optional<double> diameter;      ///< bundle diameter given in the file, if any
+  /// Length the file gives for the segment (KBL Physical_length, a formboard Virtual_length,
+  /// VEC segment length): what the harness maker cuts, harness units.
+  std::optional<double> nominal_length;
   /// Id of the branch element this segment was written under (empty: top level), kept
   /// so that writing the file back reproduces its structure.
   std::string parent_branch;

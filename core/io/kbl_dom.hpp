@@ -6,6 +6,8 @@
 #include <pugixml.hpp>
 
 #include <cstring>
+#include <sstream>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -30,6 +32,28 @@ inline std::vector<pugi::xml_node> children(const pugi::xml_node& n, std::string
   std::vector<pugi::xml_node> out;
   for (auto c : n.children())
     if (c.type() == pugi::node_element && local_name(c) == name) out.push_back(c);
+  return out;
+}
+
+/// An element as messages name it: `<kbl:Node id="N1">` (the id when it has one).
+inline std::string describe(const pugi::xml_node& n) {
+  std::string s = "<" + std::string(n.name());
+  if (auto a = n.attribute("id")) s += " id=\"" + std::string(a.value()) + "\"";
+  return s + ">";
+}
+
+/// The whitespace-separated words of an element's text (IDREFS, a list of ids).
+inline std::vector<std::string> words(const pugi::xml_node& n) {
+  std::istringstream in(n.child_value());
+  std::vector<std::string> out;
+  for (std::string t; in >> t;) out.push_back(t);
+  return out;
+}
+
+/// An element's text with its whitespace runs made single spaces and its ends trimmed.
+inline std::string words_text(const pugi::xml_node& n) {
+  std::string out;
+  for (const auto& w : words(n)) out += (out.empty() ? "" : " ") + w;
   return out;
 }
 

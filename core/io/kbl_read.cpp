@@ -33,6 +33,7 @@ namespace loom {
 namespace {
 
 using kbl_dom::child;
+using kbl_dom::describe;
 using kbl_dom::children;
 using kbl_dom::local_name;
 
@@ -74,6 +75,7 @@ double angle_deg(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).no
 struct NodeRec {
   pugi::xml_node el;
   std::optional<Vec3> position;
+  pugi::xml_node flat_point;  ///< its Cartesian_point when that has 2 coordinates (formboard)
   std::vector<std::string> components;  ///< Referenced_components
   std::string loom_id;
   bool port = false;
@@ -101,12 +103,6 @@ class KblReader {
 
  private:
   int line(const pugi::xml_node& n) const { return lines_.line(n.offset_debug()); }
-
-  static std::string describe(const pugi::xml_node& n) {
-    std::string s = "<" + std::string(n.name());
-    if (auto a = n.attribute("id")) s += " id=\"" + std::string(a.value()) + "\"";
-    return s + ">";
-  }
 
   [[noreturn]] void fail(const pugi::xml_node& n, const std::string& reason) const {
     throw InputError({file_, line(n), describe(n)}, reason);
@@ -186,6 +182,7 @@ class KblReader {
   void segment_diameters(const HarnessTopology& topo, Harness& h);
   void check_routings(const pugi::xml_node& root, const HarnessTopology& topo, const Harness& h);
   void read_fixings(Harness& h);
+  std::optional<double> nominal_length(const pugi::xml_node& segment) const;
   void count_ignored(const pugi::xml_node& root, const pugi::xml_node& harness);
 
   LineMap lines_;
@@ -199,6 +196,9 @@ class KblReader {
   std::map<std::string, std::vector<pugi::xml_node>> cable_connections_;  ///< loom cable id → its connections
   std::vector<std::optional<double>> file_diameter_;  ///< per segment, from its cross-section
   KblOrigin origin_;
+  /// No node has a 3D position (a formboard drawing or bare topology): ports wait for the
+  /// scene's placement, branch points for the router, and 2D centre curves are not read.
+  bool topology_only_ = false;
   int wires_ = 0, cores_ = 0, multicores_ = 0;
 };
 
@@ -243,7 +243,10 @@ void KblReader::read_nodes(const pugi::xml_node& root) {
     r.el = el;
     const std::string id = el.attribute("id").value();
     if (id.empty()) fail(el, "a <Node> needs an id");
-    if (const pugi::xml_node cp = ref(el, "Cartesian_point")) r.position = point(cp);
+    if (const pugi::xml_node cp = ref(el, "Cartesian_point")) {
+      if (children(cp, "Coordinates").size() == 2) r.flat_point = cp;
+      else r.position = point(cp);
+    }
     for (auto c : children(el, "Referenced_components"))
       for (const auto& t : tokens(c.child_value())) {
         lookup(c, t, "<Referenced_components>");
@@ -254,6 +257,16 @@ void KblReader::read_nodes(const pugi::xml_node& root) {
   }
   for (std::size_t i = 0; i < nodes_.size(); ++i)
     for (const auto& c : nodes_[i].components) occurrence_node_.emplace(c, static_cast<int>(i));
+  // A file is either 3D (DMU) or a drawing: a 2D point among 3D ones has no 3D position to
+  // take, and guessing one would route the harness somewhere the file does not say.
+  const auto in_3d = std::count_if(nodes_.begin(), nodes_.end(), [](const NodeRec& n) { return n.position.has_value(); });
+  topology_only_ = in_3d == 0;
+  if (!topology_only_)
+    for (const auto& n : nodes_)
+      if (n.flat_point)
+        fail(n.flat_point, "has 2 coordinates: a 2D (formboard) point of node '" + std::string(n.el.attribute("id").value()) +
+                               "' while " + std::to_string(in_3d) + " other nodes have 3D (DMU) positions; loom needs "
+                               "the 3D positions of all nodes, or of none (topology only, placed by the scene)");
 }
 
 void KblReader::find_ports(const pugi::xml_node& harness) {
@@ -374,6 +387,10 @@ Centerline KblReader::trim_to_nodes(const SegmentRec& s, Centerline c, const pug
 std::optional<BSplineData> KblReader::segment_curve(const SegmentRec& s) {
   const auto curves = children(s.el, "Center_curve");
   if (curves.empty()) return std::nullopt;  // not routed yet: the router plans it
+  if (topology_only_) {
+    ++origin_.ignored["Center_curve (2D, of a topology-only file)"];
+    return std::nullopt;  // a formboard curve: the router plans the 3D one
+  }
   std::optional<Centerline> joined;
   const NodeRec& a = nodes_[static_cast<std::size_t>(s.from)];
   for (const auto& cel : curves) {
@@ -439,13 +456,16 @@ void KblReader::read_segments(const pugi::xml_node& root, Harness& h) {
       if (local_name(n) != "Node") fail(child(el, name), std::string("<") + name + "> refers to a <" + n.name() + ">, not a <Node>");
       *end = node_index_.at(n.attribute("id").value());
     }
-    r.start_vector = vector3(el, "Start_vector");
-    r.end_vector = vector3(el, "End_vector");
+    if (!topology_only_) {  // a drawing's tangents are 2D
+      r.start_vector = vector3(el, "Start_vector");
+      r.end_vector = vector3(el, "End_vector");
+    }
     Segment seg;
     seg.from = nodes_[static_cast<std::size_t>(r.from)].loom_id;
     seg.to = nodes_[static_cast<std::size_t>(r.to)].loom_id;
     seg.line = line(el);
     seg.bspline = segment_curve(r);
+    seg.nominal_length = nominal_length(el);
     origin_.segment_curves.push_back(seg.bspline);
     // The bundle's nominal diameter from its cross-section (the largest one given).
     std::optional<double> area;
@@ -744,8 +764,17 @@ void KblReader::read_fixings(Harness& h) {
       c.segment = static_cast<int>(s);
       c.line = line(fa);
       std::optional<Vec3> at;
-      if (const pugi::xml_node pl = child(fix, "Placement"))
-        if (const pugi::xml_node cp = ref(pl, "Cartesian_point")) at = point(cp);
+      // A topology-only file places fixings on its drawing (2D), not in the vehicle.
+      if (const pugi::xml_node pl = topology_only_ ? pugi::xml_node() : child(fix, "Placement"))
+        if (const pugi::xml_node cp = ref(pl, "Cartesian_point")) {
+          // A drawing's placement (2D) kept in a file that loom gave 3D geometry: the fixing
+          // sits at its location on the segment instead.
+          if (children(cp, "Coordinates").size() == 2)
+            origin_.notes.push_back("fixing '" + c.id + "' (line " + std::to_string(c.line) +
+                                    "): its placement is a 2D (formboard) point; placed by its location on the segment");
+          else
+            at = point(cp);
+        }
       if (!at && h.segments[s].bspline) {
         const pugi::xml_node loc = child(fa, "Location");
         const double share = loc ? number(loc) : 0.5;
@@ -775,6 +804,17 @@ void KblReader::read_fixings(Harness& h) {
                             std::to_string(protected_segments.size()) +
                             " segments: not modelled as material; each segment's cross-section (else the bundle "
                             "rule) gives its diameter");
+}
+
+std::optional<double> KblReader::nominal_length(const pugi::xml_node& segment) const {
+  // Physical_length is the length to manufacture; a drawing's Virtual_length is the length
+  // on the formboard (in a 3D file it is the centre curve's, checked in segment_curve).
+  pugi::xml_node len = child(segment, "Physical_length");
+  if (!len && topology_only_) len = child(segment, "Virtual_length");
+  if (!len) return std::nullopt;
+  const double mm = measure(len, 1);
+  if (!(mm > 0.0)) fail(len, "a segment length must be positive, got " + full_precision(mm));
+  return mm;
 }
 
 void KblReader::count_ignored(const pugi::xml_node& root, const pugi::xml_node& harness) {
@@ -830,9 +870,9 @@ Harness KblReader::read(const pugi::xml_document& doc, std::shared_ptr<const std
   for (auto& n : nodes_) {
     origin_.node_ids[n.loom_id] = n.el.attribute("id").value();
     if (n.port) {
-      if (!n.position)
+      if (!n.position && !topology_only_)
         fail(n.el, "holds connector '" + n.loom_id + "' but has no <Cartesian_point>: a port needs its position");
-      h.ports.push_back({n.loom_id, *n.position, Vec3::UnitX(), line(n.el)});
+      h.ports.push_back({n.loom_id, n.position.value_or(Vec3::Zero()), Vec3::UnitX(), line(n.el), n.position.has_value()});
     } else {
       h.branches.push_back({n.loom_id, n.position, line(n.el)});
     }

@@ -6,6 +6,10 @@
 /// node trimmed there) and their cross-section as a nominal bundle diameter; wires and
 /// multicores (a jacket with its cores) become cables between the ports of their
 /// connections' contact points, each checked against its Routing; fixings become clamps.
+/// A file whose nodes have no 3D position (a formboard drawing: 2D points, or none) is read
+/// as topology only: ports unplaced (Port::placed false, the scene's [harness.place] places
+/// them), branch points left to the router, 2D curves not read, each segment's
+/// Physical_length or drawing Virtual_length kept as its nominal length.
 /// Lengths in millimetres (the file's units converted), world frame of the file.
 /// What loom does not use is named and counted in KblOrigin, never dropped silently.
 
@@ -47,8 +51,8 @@ struct KblOrigin {
 constexpr double kKblNodeGap = 0.01;
 
 /// Reads a KBL file (.kbl). Throws InputError naming the file, line and element for every
-/// fault: malformed XML, a reference to a missing id, a 2D-only (formboard) or missing
-/// geometry, a curve far from its nodes, a number that is not finite, a wire without an
+/// fault: malformed XML, a reference to a missing id, a 2D point among 3D nodes, a port
+/// without a position in a 3D file, a curve far from its nodes, a number that is not finite, a wire without an
 /// outside diameter, a Routing that differs from the tree path between its wire's ends, a
 /// cycle.
 Harness read_harness_kbl(const std::filesystem::path& path);

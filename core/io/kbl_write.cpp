@@ -28,6 +28,7 @@ namespace {
 using kbl_dom::child;
 using kbl_dom::children;
 using kbl_dom::local_name;
+std::string text_of(const pugi::xml_node& n) { return kbl_dom::words_text(n); }
 
 /// The shortest decimal text that reads back as exactly v.
 std::string number_text(double v) {
@@ -39,12 +40,6 @@ std::string number_text(double v) {
   return buf;
 }
 
-std::string text_of(const pugi::xml_node& n) {
-  std::istringstream in(n.child_value());
-  std::string t, out;
-  while (in >> t) out += (out.empty() ? "" : " ") + t;
-  return out;
-}
 
 class KblWriter {
  public:
@@ -164,7 +159,13 @@ void KblWriter::write_nodes() {
     const auto it = o_.node_ids.find(loom_id);
     pugi::xml_node node = it == o_.node_ids.end() ? pugi::xml_node() : element(it->second);
     if (!node) throw std::invalid_argument("harness_to_kbl: node '" + loom_id + "' is not a Node of " + h_.source_file);
-    if (const pugi::xml_node cp = element(text_of(child(node, "Cartesian_point")))) return set_point(cp, p);
+    const pugi::xml_node ref_el = child(node, "Cartesian_point");
+    const pugi::xml_node cp = element(text_of(ref_el));
+    if (cp && children(cp, "Coordinates").size() == 3) return set_point(cp, p);
+    if (cp) {  // a formboard (2D) point: the node takes a new 3D one, the drawing's goes if unused
+      dropped_points_.insert(cp.attribute("id").value());
+      return set_text(ref_el, new_point(p).attribute("id").value());
+    }
     // A node the router placed: a new point, referenced after the node's Id and Alias_ids.
     pugi::xml_node after;
     for (auto c : node.children())
@@ -172,9 +173,23 @@ void KblWriter::write_nodes() {
     pugi::xml_node ref = after ? node.insert_child_after("Cartesian_point", after) : node.prepend_child("Cartesian_point");
     set_text(ref, new_point(p).attribute("id").value());
   };
-  for (const auto& p : h_.ports) place(p.id, p.position);
+  bool placed_any = false;
+  for (const auto& p : h_.ports)
+    if (p.placed) place(p.id, p.position), placed_any = true;  // an unplaced port keeps the drawing's point
   for (const auto& b : h_.branches)
-    if (b.position) place(b.id, *b.position);
+    if (b.position) place(b.id, *b.position), placed_any = true;
+  if (!placed_any) return;
+  // A branch point still open in a drawing now partly 3D loses its 2D point: left beside
+  // 3D ones it would make the file neither a drawing nor 3D; without one it stays open.
+  for (const auto& b : h_.branches) {
+    const auto it = o_.node_ids.find(b.id);
+    pugi::xml_node node = b.position || it == o_.node_ids.end() ? pugi::xml_node() : element(it->second);
+    const pugi::xml_node ref_el = node ? child(node, "Cartesian_point") : pugi::xml_node();
+    if (const pugi::xml_node cp = element(text_of(ref_el)); cp && children(cp, "Coordinates").size() == 2) {
+      dropped_points_.insert(cp.attribute("id").value());
+      node.remove_child(ref_el);
+    }
+  }
 }
 
 void KblWriter::write_segment(std::size_t k, const Centerline& c) {
@@ -216,6 +231,9 @@ void KblWriter::write_segment(std::size_t k, const Centerline& c) {
     vl = new_object(seg, "Virtual_length", !ev.empty() ? ev.back() : !sv.empty() ? sv.back() : head);
   }
   set_measure(vl, c.length());
+  // A drawing's Virtual_length was its formboard length: kept as the length to manufacture.
+  if (const auto& nominal = h_.segments[k].nominal_length; nominal && !child(seg, "Physical_length"))
+    set_measure(new_object(seg, "Physical_length", vl), *nominal);
 }
 
 void KblWriter::write_lengths(const HarnessTopology& topo) {

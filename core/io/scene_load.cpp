@@ -144,6 +144,89 @@ Harness read_harness_file(const std::filesystem::path& p) {
   return read_harness_xml(p);
 }
 
+/// The loom port id a [harness.place] key names: the port's own id, or the id of its node
+/// in the file (a KBL Node id); empty if neither.
+std::string placed_port_id(const Harness& h, const std::string& key) {
+  if (h.find_port(key) >= 0) return key;
+  if (h.kbl)
+    for (const auto& [loom_id, file_id] : h.kbl->node_ids)
+      if (file_id == key && h.find_port(loom_id) >= 0) return loom_id;
+  return {};
+}
+
+/// [harness.place]: per port, `ID = { at = [x, y, z], dir = [dx, dy, dz] }` in scene units.
+/// A port of a topology-only harness gets its position here; a 3D one is moved (said in the
+/// notes) and its segments' curves, which no longer reach it, are dropped for the router.
+void place_ports(const TomlReader& r, const toml::node& pn, Harness& h, std::vector<std::string>& notes) {
+  const toml::table* place = pn.as_table();
+  if (!place) r.fail(&pn, "harness.place", "expected a table [harness.place] of ID = { at = [x, y, z], dir = [dx, dy, dz] }");
+  for (const auto& [k, v] : *place) {
+    const std::string key(k.str()), where = "harness.place." + key;
+    const toml::table* t = v.as_table();
+    if (!t) r.fail(&v, where, "expected an inline table { at = [x, y, z], dir = [dx, dy, dz] }");
+    r.only_keys(*t, where, {"at", "dir"});
+    if (!t->get("at") || !t->get("dir")) r.fail(&v, where, "needs both 'at' (position) and 'dir' (exit direction)");
+    const std::string id = placed_port_id(h, key);
+    if (id.empty()) {
+      const bool branch = h.find_branch(key) >= 0 || (h.kbl && std::any_of(h.kbl->node_ids.begin(), h.kbl->node_ids.end(),
+                                                                               [&](const auto& e) { return e.second == key; }));
+      r.fail(&v, where, "'" + key + "' is " + (branch ? "a branch point" : "no port") + " of harness file " + h.source_file +
+                            (branch ? ": the router places branch points; [harness.place] places ports"
+                                    : " (a key is a port id or its node's id in the file)"));
+    }
+    const Vec3 at = r.vec3(t->get("at"), where + ".at"), dir = r.vec3(t->get("dir"), where + ".dir");
+    if (!(dir.norm() > 0.0)) r.fail(t->get("dir"), where + ".dir", "the exit direction must not be zero");
+    Port& p = h.ports[static_cast<std::size_t>(h.find_port(id))];
+    if (p.placed) {
+      notes.push_back("port '" + id + "': the scene's [harness.place] moves it from " + full_precision(p.position) +
+                      " to " + full_precision(at) + " (the file's position is replaced)");
+      for (auto& s : h.segments)
+        if ((s.from == id || s.to == id) && (s.bspline || !s.path.empty())) {
+          s.bspline.reset();
+          s.path.clear();
+          notes.push_back("segment " + s.from + " -> " + s.to + ": its curve no longer reaches the moved port '" + id +
+                          "': the router plans it");
+        }
+    }
+    p.position = at;
+    p.direction = dir.normalized();
+    p.placed = true;
+  }
+}
+
+/// Refuses a harness with ports still unplaced, naming them all, the harness file and the
+/// scene table that places them.
+void require_placed_ports(const Harness& h, const std::string& scene_file) {
+  std::string missing;
+  int first_line = 0, count = 0;
+  for (const auto& p : h.ports)
+    if (!p.placed) {
+      missing += (missing.empty() ? "" : ", ") + p.id + (p.line ? " (line " + std::to_string(p.line) + ")" : "");
+      if (!count++) first_line = p.line;
+    }
+  if (!count) return;
+  const std::string first = h.ports[static_cast<std::size_t>(
+      std::find_if(h.ports.begin(), h.ports.end(), [](const Port& p) { return !p.placed; }) - h.ports.begin())].id;
+  throw InputError({h.source_file, first_line, ""},
+                   "no 3D geometry: " + std::to_string(count) + " port" + (count == 1 ? " has" : "s have") +
+                       " no position: " + missing + "; give each in the [harness.place] table of " + scene_file +
+                       ", e.g. " + first + " = { at = [x, y, z], dir = [dx, dy, dz] } (scene units)");
+}
+
+/// The scene's part of a harness without 3D geometry: what it must place said in the notes,
+/// [harness.place] applied, and every port required placed.
+void place_harness(const TomlReader& r, const toml::table& ht, Harness& h, SceneLoadReport* report) {
+  const auto unplaced = std::count_if(h.ports.begin(), h.ports.end(), [](const Port& p) { return !p.placed; });
+  const auto open = std::count_if(h.branches.begin(), h.branches.end(), [](const BranchPoint& b) { return !b.position; });
+  std::vector<std::string> notes;
+  if (unplaced)
+    notes.push_back("harness file " + h.source_file + " has no 3D geometry: topology only, " + std::to_string(unplaced) +
+                    " nodes to be placed by the scene, " + std::to_string(open) + " by the router");
+  if (const toml::node* pn = ht.get("place")) place_ports(r, *pn, h, notes);
+  require_placed_ports(h, r.file());
+  if (report) report->notes.insert(report->notes.end(), notes.begin(), notes.end());
+}
+
 }  // namespace
 
 void apply_routes(Scene& scene, const std::filesystem::path& routes) {
@@ -192,7 +275,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
 
   // Harness first: cable sizes drive the derived tessellation deflection.
   if (const toml::table* ht = r.section(doc, "harness")) {
-    r.only_keys(*ht, "harness", {"file"});
+    r.only_keys(*ht, "harness", {"file", "place"});
     auto hf = r.string(*ht, "harness", "file");
     if (!hf) r.fail(ht, "harness.file", "missing harness file name");
     if (hf->empty()) r.fail(ht->get("file"), "harness.file", "empty file name");
@@ -210,6 +293,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
       r.fail(ht->get("file"), "harness.file",
              std::string("unit mismatch: the harness is in ") + unit_name(scene.harness.units) +
                  " but the scene is in " + unit_name(scene.units) + " (all lengths must share the scene unit)");
+    place_harness(r, *ht, scene.harness, report);
     scene.has_harness = true;
   }
   const double dmin = scene.harness.smallest_diameter();

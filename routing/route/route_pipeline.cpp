@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <memory>
@@ -38,6 +39,11 @@ constexpr int kBendReplans = 2;
 /// this. A port on a face leaving along the normal is exactly `required` from the face at
 /// `required`: rounding must not make that face a wall.
 constexpr double kAttachSlackPerRadius = 0.01;
+
+/// Share by which a routed segment may be longer than the nominal (formboard or physical)
+/// length its file gives before the report says so: the harness maker cuts that length, and
+/// a bundle's breakouts and sag take up a few percent.
+constexpr double kNominalLengthTolerance = 0.05;
 
 /// A segment's key-point polyline and the curve through it.
 struct SegmentGeometry {
@@ -157,6 +163,7 @@ class RouteRun {
   AuditReport audit_now();
   std::set<int> segments_to_repair() const;
   void note_reproducibility();
+  void note_nominal_lengths();
 
   const Scene& scene_;
   const RouteOptions& opt_;
@@ -192,6 +199,12 @@ RouteRun::RouteRun(const Scene& scene, const RouteOptions& opt)
   rep_.clearance = scene.routing.clearance.value;
   for (const auto& p : scene.parts) part_extra_ = std::max(part_extra_, p.clearance);
   refuse_unauditable_cables(h_);  // before the planning work it would throw away
+  // A topology-only port has no position until the scene places it (load_scene refuses the
+  // scene otherwise); a harness built in code must not route it from the origin.
+  for (const Port& p : h_.ports)
+    if (!p.placed)
+      throw InputError({h_.source_file, p.line, "port " + p.id},
+                       "has no 3D position (topology only): place it in the scene's [harness.place] table");
 }
 
 RouteReport RouteRun::run() {
@@ -201,6 +214,7 @@ RouteReport RouteRun::run() {
   build_splines();
   replan_bend_failures();
   audit_and_repair();
+  note_nominal_lengths();
   note_reproducibility();
   rep_.timing.total = total_.ms();
   return std::move(rep_);
@@ -683,6 +697,37 @@ void RouteRun::note_reproducibility() {
                                       "the iterations)");
       }
   for (const auto& n : rep_.unreproducible) rep_.notes.push_back(n);
+}
+
+/// Compares each routed segment with the nominal length its file gives: a note for every
+/// one longer by more than kNominalLengthTolerance, and one for the totals.
+void RouteRun::note_nominal_lengths() {
+  const char* u = unit_name(scene_.units);
+  auto fixed1 = [](double v) {  // lengths and percentages to 0.1: what a cut length needs
+    char buf[48];
+    std::snprintf(buf, sizeof buf, "%.1f", v);
+    return std::string(buf);
+  };
+  auto over = [&](double len, double nom) { return (len >= nom ? "+" : "") + fixed1(100.0 * (len - nom) / nom) + "%"; };
+  const std::string tol = fixed1(100.0 * kNominalLengthTolerance) + "%";
+  double routed = 0.0, nominal = 0.0;
+  int compared = 0, longer = 0;
+  for (const Segment& sg : h_.segments) {
+    if (!sg.nominal_length || !sg.bspline) continue;
+    const double len = Centerline(sg.bspline->degree, sg.bspline->knots, sg.bspline->control_points).length();
+    routed += len;
+    nominal += *sg.nominal_length;
+    ++compared;
+    if (len <= (1.0 + kNominalLengthTolerance) * *sg.nominal_length) continue;
+    ++longer;
+    rep_.notes.push_back("segment " + sg.from + " -> " + sg.to + ": routed " + fixed1(len) + " " + u + ", nominal " +
+                         fixed1(*sg.nominal_length) + " " + u + " (" + over(len, *sg.nominal_length) +
+                         ", beyond the " + tol + " tolerance)");
+  }
+  if (compared)
+    rep_.notes.push_back("nominal lengths: " + std::to_string(compared) + " segments routed " + fixed1(routed) + " " + u +
+                         " in total against " + fixed1(nominal) + " " + u + " nominal (" + over(routed, nominal) + "); " +
+                         std::to_string(longer) + " longer than nominal by more than " + tol);
 }
 
 }  // namespace

@@ -10,7 +10,6 @@
 #include "core/harness_topology.hpp"
 #include "core/io/kbl_curve.hpp"
 #include "core/io/kbl_read.hpp"
-#include "core/io/kbl_vec.hpp"
 #include "core/io/kbl_write.hpp"
 #include "routing/audit/audit.hpp"
 
@@ -261,18 +260,6 @@ TEST(KblFiles, ModelSampleHasNoGeometryAndIsRefusedNamingTheContainer) {
                  {"kbl-model-sample.kbl:2", "<kbl:KBL_container id=\"ID000\">", "no <Node> and no <Segment>"});
 }
 
-// The VEC guideline example holds topology only: refused, saying what it holds and lacks.
-TEST(KblFiles, VecRoutingExamplesIsRefusedSayingWhatIsMissing) {
-  try {
-    read_harness_vec(kDir + "routing-examples.vec");
-    FAIL() << "expected a refusal";
-  } catch (const InputError& e) {
-    for (const char* n : {"routing-examples.vec:1", "<vec:VecContent>", "VEC 2.1.0 with 8 TopologyNode, 8 TopologySegment, 4 Routing",
-                          "no 3D geometry", "KBL 2.3/2.4 files (.kbl)"})
-      EXPECT_NE(std::string(e.what()).find(n), std::string::npos) << n << "\n" << e.what();
-  }
-}
-
 TEST(KblFiles, BatteriePlusIsOneRingTerminalCable) {
   const Harness h = read_harness_kbl(kDir + kBatteriePlus);
   ASSERT_EQ(h.cables.size(), 1u);
@@ -501,12 +488,18 @@ TEST(KblHostile, ACurveFarFromItsNodeIsNamed) {
   expect_bad(t, "<Center_curve id=\"CC3\"", {"segment 'S3'", "from its start node 'N2'", "passes it"});
 }
 
-TEST(KblHostile, AFormboardOnlyFileIsSaidToBe2D) {
+// A drawing (every point 2D) is topology only: no port placed, its 2D curves not read.
+TEST(KblMini, AFormboardOnlyFileReadsAsTopology) {
   std::string t = MiniKbl().text();
   for (auto at = t.find("<Coordinates>0</Coordinates></Cartesian_point>"); at != std::string::npos;
        at = t.find("<Coordinates>0</Coordinates></Cartesian_point>", at))
     t.replace(at, 46, "</Cartesian_point>");
-  expect_bad(t, "<Cartesian_point id=\"P1\"", {"2D (formboard) geometry only"});
+  const Harness h = parse_harness_kbl(t, "mini.kbl");
+  ASSERT_EQ(h.ports.size(), 3u);
+  for (const auto& p : h.ports) EXPECT_FALSE(p.placed) << p.id;
+  EXPECT_FALSE(h.branches[0].position);
+  for (const auto& s : h.segments) EXPECT_FALSE(s.bspline);
+  EXPECT_EQ(h.kbl->ignored.at("Center_curve (2D, of a topology-only file)"), 3);
 }
 
 TEST(KblHostile, AWireWithoutItsDiameterOrWithAWrongUnitIsNamed) {
