@@ -256,6 +256,11 @@ class Reader {
     for (auto n = root.next_sibling(); n; n = n.next_sibling())
       if (n.type() == pugi::node_element) fail(n, "a second root element: a harness file holds one <harness> root");
     h.name = root.attribute("name") ? root.attribute("name").value() : root.name();
+    // A name taken from the element travels into report.json and routed.xml like an
+    // attribute value, so it must be UTF-8 as they are (pugixml reads any bytes in names).
+    if (const std::size_t bad = first_invalid_utf8(h.name); bad != std::string::npos)
+      fail(root, "the root element's name, the harness name without a 'name' attribute, is not valid UTF-8 (byte " +
+                     std::to_string(bad) + ")");
     if (auto u = root.attribute("units")) {
       auto unit = parse_unit(u.value());
       if (!unit) fail(root, std::string("unknown units '") + u.value() + "' (use mm, cm, m or in)");

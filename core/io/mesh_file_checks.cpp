@@ -134,7 +134,13 @@ bool read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
       const std::string& type = p.list ? w[3] : (w.size() >= 2 ? w[1] : w[0]);
       p.bytes = ply_scalar_bytes(type);
       p.floating = type.rfind("float", 0) == 0 || type == "double";
-      if (p.bytes == 0 || (p.list && p.count_bytes == 0)) return false;
+      // Assimp reads an unknown type as a property of no bytes and goes on with the data
+      // misaligned, into faces that abort its triangulation (ai_assert).
+      const std::string& bad = p.list && p.count_bytes == 0 ? w[2] : type;
+      if (p.bytes == 0 || (p.list && p.count_bytes == 0))
+        throw InputError({path.string(), line_no, "property"},
+                         "'" + bad + "' is not a PLY type (char uchar short ushort int uint float double, "
+                         "or int8 ... float64)");
       out.extents.back().min_bytes += p.list ? p.count_bytes : p.bytes;
       out.properties.back().push_back(p);
     }
@@ -213,6 +219,15 @@ std::string list_length_text(const std::array<unsigned char, 8>& b, std::size_t 
                        " bytes left in the file can hold (a truncated or corrupt file?)");
 }
 
+/// Refuses a face of no vertices. Why: every count then agrees with the data, yet Assimp's
+/// triangulation aborts on it (ai_assert numOut != mNumFaces, SIGABRT).
+void check_face_length(const std::filesystem::path& path, const PlyElementExtent& e, int line, std::uint64_t instance,
+                       std::uint64_t n) {
+  if (n == 0 && e.name == "face")
+    throw InputError({path.string(), line, "element face instance " + std::to_string(instance)},
+                     "a face of no vertices");
+}
+
 /// Every binary list length against the bytes left after it. Why: Assimp allocates a list
 /// by its length field before reading it, so a 100-byte file with a face of 10⁸ indices
 /// took 830 MB and one of 4·10⁹ ended in std::bad_alloc. Elements without lists are
@@ -242,6 +257,7 @@ void check_ply_binary_lists(const std::filesystem::path& path, const PlyLayout& 
         const std::string text =
             list_length_text(raw, static_cast<std::size_t>(p.count_bytes), big, p.count_signed, n);
         if (n > cur.left() / p.bytes) bad_list(path, e, k, text, cur.left());
+        check_face_length(path, e, e.line, k, n);
         cur.skip(n * p.bytes);
       }
   }
@@ -320,6 +336,7 @@ void check_ply_ascii_body(const std::filesystem::path& path, const PlyLayout& la
             throw InputError({path.string(), line_no, where}, "list length '" + t + "' is not a count");
           }
           if (n > left / 2) bad_list(path, e, k, t, left);  // " v" per value at least
+          check_face_length(path, e, line_no, k, n);
         }
         if (n > w.size() - at) {
           short_line = true;
@@ -361,8 +378,25 @@ void check_ply(const std::filesystem::path& path) {
 
 // --- OFF ---------------------------------------------------------------------------------
 
-/// The OFF header's vertex and face counts against the file size: each vertex and face takes
-/// at least one line. A header this check cannot parse is left to Assimp.
+/// `t` with every byte outside printable ASCII written as \xNN, for a message that names a
+/// corrupt token (a NUL would end the message where it is printed).
+std::string printable(const std::string& t) {
+  static const char* kHex = "0123456789abcdef";
+  std::string out;
+  for (const unsigned char c : t) {
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+    } else {
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    }
+  }
+  return out;
+}
+
+/// The OFF header's vertex and face counts, whole numbers, against the file size: each vertex
+/// and face takes at least one line.
 void check_off(const std::filesystem::path& path) {
   const std::string head = file_bytes(path, 1 << 16);
   std::istringstream is(head);
@@ -383,7 +417,13 @@ void check_off(const std::filesystem::path& path) {
   const std::string& magic = tokens[0];
   if (magic.size() >= 3 && magic.compare(magic.size() - 3, 3, "OFF") == 0) at = 1;
   std::uint64_t nv = 0, nf = 0;
-  if (at + 1 >= tokens.size() || !parse_count(tokens[at], nv) || !parse_count(tokens[at + 1], nf)) return;
+  if (at + 1 >= tokens.size()) return;
+  // A count that is not all digits is refused, not left to Assimp: its reader takes the
+  // leading digits ("1000000000x" as 10⁹ faces) and allocates by them before reading any.
+  for (const std::size_t k : {at, at + 1})
+    if (!parse_count(tokens[k], k == at ? nv : nf))
+      throw InputError({path.string(), lines[k], "OFF header"},
+                       std::string(k == at ? "vertex" : "face") + " count '" + printable(tokens[k]) + "' is not a count");
   std::error_code ec;
   const auto size = static_cast<std::uint64_t>(std::filesystem::file_size(path, ec));
   if (ec) return;

@@ -8,10 +8,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <array>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <utility>
 
 #include <sys/wait.h>
 
@@ -292,6 +295,95 @@ TEST(FuzzRegression, PlyAsciiShortFaceListAborted) {
   EXPECT_EQ(loom::read_mesh_file(d / "ok.ply").triangle_count(), 3u);
 }
 
+// A binary PLY whose vertex property z has the type "floa`" (libFuzzer, from the tetrahedron
+// seed): Assimp took the unknown type as zero bytes, read the faces misaligned and aborted
+// in its triangulation (ai_assert, SIGABRT in `loom info`). The header check names it.
+TEST(FuzzRegression, PlyUnknownPropertyTypeAborted) {
+  const fs::path d = scratch();
+  std::string body;
+  for (const float v : {0.f, 0.f, 0.f, 10.f, 0.f, 0.f, 0.f, 10.f, 0.f, 0.f, 0.f, 10.f})
+    body.append(reinterpret_cast<const char*>(&v), sizeof v);
+  for (const std::array<std::int32_t, 3>& f : {std::array<std::int32_t, 3>{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}) {
+    body += '\3';
+    body.append(reinterpret_cast<const char*>(f.data()), sizeof f);
+  }
+  const std::string header_before = "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\n"
+                                    "property float y\nproperty ";
+  const std::string header_after = " z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n";
+  write(d / "good.ply", header_before + "float" + header_after + body);
+  EXPECT_EQ(loom::read_mesh_file(d / "good.ply").triangle_count(), 4u);
+  write(d / "typo.ply", header_before + "floa`" + header_after + body);
+  const auto r = bounded_info_of_part(d, "typo.ply");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("typo.ply:6: property: 'floa`' is not a PLY type"), std::string::npos) << r.out;
+  write(d / "list.ply", header_before + "float" + " z\nelement face 4\nproperty list uchr int vertex_indices\nend_header\n" + body);
+  const std::string e = input_error([&] { loom::read_mesh_file(d / "list.ply"); });
+  EXPECT_NE(e.find("list.ply:8: property: 'uchr' is not a PLY type"), std::string::npos) << e;
+}
+
+// A face whose vertex list is empty, ASCII or binary (libFuzzer): every count agrees with the
+// data, yet Assimp's triangulation aborted on it (SIGABRT in `loom info`).
+TEST(FuzzRegression, PlyEmptyFaceAborted) {
+  const fs::path d = scratch();
+  const std::string head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                           "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n";
+  write(d / "ascii.ply", head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n0\n");
+  auto r = bounded_info_of_part(d, "ascii.ply");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("ascii.ply:14: element face instance 1: a face of no vertices"), std::string::npos) << r.out;
+  std::string bin = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                    "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n";
+  for (const float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) bin.append(reinterpret_cast<const char*>(&v), sizeof v);
+  bin += '\0';  // the empty face first
+  bin += '\3';
+  for (const std::int32_t i : {0, 1, 2}) bin.append(reinterpret_cast<const char*>(&i), sizeof i);
+  write(d / "binary.ply", bin);
+  r = bounded_info_of_part(d, "binary.ply");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("binary.ply:7: element face instance 0: a face of no vertices"), std::string::npos) << r.out;
+}
+
+// OFF counts with a letter, a comma or a NUL after the digits (libFuzzer): the pre-check
+// could not parse them and left the file to Assimp, which read the leading digits and
+// allocated 10⁹ faces (16 GB) before reading one.
+TEST(FuzzRegression, OffCountWithTrailingBytesAllocatedByItsDigits) {
+  const fs::path d = scratch();
+  const std::pair<std::string, std::string> cases[] = {
+      {"1000000000x", "1000000000x"}, {"1000000000,", "1000000000,"}, {std::string("10\0", 3), "10\\x00"}};
+  for (const auto& [bad, shown] : cases) {
+    write(d / "bad.off", "OFF\n4 " + bad + " 0\n");
+    const std::string e = input_error([&] { loom::read_mesh_file(d / "bad.off"); });
+    EXPECT_NE(e.find("bad.off:2: OFF header: face count '" + shown + "' is not a count"), std::string::npos) << e;
+  }
+  write(d / "v.off", "OFF 4x 1 0\n");
+  const std::string e = input_error([&] { loom::read_mesh_file(d / "v.off"); });
+  EXPECT_NE(e.find("v.off:1: OFF header: vertex count '4x' is not a count"), std::string::npos) << e;
+}
+
+// Every minimised input of tests/fuzz/findings: a mesh as the one part of a scene, a harness
+// XML as its harness; `loom info` refuses each, exit 2, naming the file.
+TEST(FuzzRegression, EveryKeptFindingIsRefusedNamingTheFile) {
+  const fs::path findings = fs::path(LOOM_SOURCE_DIR) / "tests/fuzz/findings";
+  int seen = 0;
+  for (const auto& folder : fs::directory_iterator(findings)) {
+    if (!folder.is_directory()) continue;
+    for (const auto& entry : fs::directory_iterator(folder.path())) {
+      const fs::path d = scratch() / folder.path().filename();
+      fs::create_directories(d);
+      const std::string name = entry.path().filename().string();
+      fs::copy_file(entry.path(), d / name);
+      const bool harness = entry.path().extension() == ".xml";
+      write(d / "scene.toml", harness ? "[scene]\n[harness]\nfile = '" + name + "'\n"
+                                      : "[scene]\n[[part]]\nfile = '" + name + "'\n");
+      const auto r = run_bounded("info " + (d / "scene.toml").string() + " --quiet");
+      EXPECT_EQ(r.status, 2) << name << ": " << r.out;
+      EXPECT_NE(r.out.find(name), std::string::npos) << r.out;
+      ++seen;
+    }
+  }
+  EXPECT_GE(seen, 8);
+}
+
 // A mesh PLY whose header never reaches end_header: Assimp's line reader spun forever (and
 // read out of bounds, SIGSEGV, with a NUL after the header's last line).
 TEST(FuzzRegression, PlyMeshUnterminatedHeaderHung) {
@@ -414,6 +506,19 @@ std::string with(const std::string& text, const std::string& from, const std::st
   const auto at = s.find(from);
   EXPECT_NE(at, std::string::npos) << from;
   return at == std::string::npos ? s : s.replace(at, from.size(), to);
+}
+
+// A root element named with a byte that is not UTF-8 (<h\x8f/>, libFuzzer) and no 'name'
+// attribute: the harness took the element's name unchecked and wrote it into a routed.xml
+// that the reader then refused.
+TEST(FuzzRegression, XmlRootNameNotUtf8WasWrittenUnreadable) {
+  const std::string e =
+      input_error([] { loom::parse_harness_xml("<?xml version=\"1.0\"?>\n<h\x8f/>\n", "h.xml"); });
+  EXPECT_NE(e.find("h.xml:2: <h\x8f>: the root element's name, the harness name without a 'name' attribute, is not valid UTF-8"),
+            std::string::npos)
+      << e;
+  // Named by its attribute, the element's name does not matter.
+  EXPECT_NO_THROW(loom::parse_harness_xml("<?xml version=\"1.0\"?>\n<h\x8f name=\"W\"/>\n", "h.xml"));
 }
 
 // x=" " (or a tab, two blanks) read as 0: strtod converted nothing and the trailing blanks
