@@ -155,6 +155,8 @@ int probe(int wires, int threads) {
   bench::HarnessShape shape;
   shape.wires = wires;
   const HarnessScene sc = make_harness_scene("probe", shape, 0);
+  std::printf("%zu wires, %zu segments, %zu branch points, fullest segment %d\n", sc.cables.size(),
+              sc.harness.segments.size(), sc.harness.branches.size(), sc.most_per_segment);
   const char* names[] = {"all", "bend", "cable-cable", "self"};
   for (int part = 0; part < 4; ++part) {
     ClashRequest req = request(false, threads);

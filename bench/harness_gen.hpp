@@ -22,10 +22,14 @@ namespace loom::bench {
 /// What to generate.
 struct HarnessShape {
   int spine_branches = 40;  ///< branch points on the trunk
-  int side_branches = 50;   ///< further branch points in the side trees
+  int side_branches = 20;   ///< further branch points in the side trees
   int wires = 250;
-  /// Most segments meeting at a branch point (≥ 3).
+  /// Segments meeting at a dense trunk branch point (≥ 3): the trunk's two and
+  /// max_degree − 2 side trees rolled around it.
   int max_degree = 16;
+  /// Every dense_every-th trunk branch point (from the fifth, or the middle of a shorter
+  /// trunk) is dense; the others carry one side tree.
+  int dense_every = 10;
   double spacing = 60.0;    ///< trunk length between branch points, mm
   double min_wire = 1000.0, max_wire = 5000.0;  ///< wire length along the tree, mm
   unsigned seed = 1;
@@ -103,12 +107,15 @@ inline Vec3 spine_tangent(double x) {
   return Vec3(1.0, 40.0 / 300.0 * std::cos(x / 300.0), 30.0 / 430.0 * std::cos(x / 430.0 + 1.0)).normalized();
 }
 
+/// Levels of branch points in a side tree.
+constexpr int kMaxSideDepth = 3;
+
 /// Grows a side tree from node `from` along `dir` (angle `ang` from the side's first
 /// direction `u0` in the plane of u0 and w, w ⊥ the trunk): a branch point while `pool`
 /// lasts (its children ±45° off, so that every turn through it is at most 90°, and no
 /// further than 80° from u0: the side tree stays in its slab across the trunk), else a port.
 inline void grow(Tree& t, std::mt19937& rng, int from, const Vec3& u0, const Vec3& w, double ang, int depth,
-                 int& pool, int max_degree) {
+                 int& pool) {
   std::uniform_real_distribution<double> U(0, 1);
   const Vec3 dir = std::cos(ang) * u0 + std::sin(ang) * w;
   const double len = 120.0 + 280.0 * U(rng);
@@ -117,24 +124,24 @@ inline void grow(Tree& t, std::mt19937& rng, int from, const Vec3& u0, const Vec
   // Leaves along dir for 15 mm (the breakout), then bows gently sideways.
   const Vec3 side = dir.cross(u0.cross(w)).normalized();
   const std::vector<Vec3> path{a + 15.0 * dir, a + 0.55 * len * dir + 0.06 * len * (U(rng) - 0.5) * side};
-  const bool branch = pool > 0 && depth < 3 && U(rng) < 0.7;
+  const bool branch = pool > 0 && depth < kMaxSideDepth && U(rng) < 0.7;
   const int n = t.add_node(end, !branch, -dir);
   t.add_segment(from, n, path);
   if (!branch) return;
   --pool;
-  const int children = 2 + static_cast<int>(U(rng) * (max_degree - 2));
+  const int children = U(rng) < 0.3 ? 3 : 2;
   for (int c = 0; c < children; ++c) {
     const double off = children == 1 ? 0.0 : -M_PI / 4 + (M_PI / 2) * c / (children - 1);
-    grow(t, rng, n, u0, w, std::clamp(ang + off, -80.0 * M_PI / 180, 80.0 * M_PI / 180), depth + 1, pool, max_degree);
+    grow(t, rng, n, u0, w, std::clamp(ang + off, -80.0 * M_PI / 180, 80.0 * M_PI / 180), depth + 1, pool);
   }
 }
 
 }  // namespace detail
 
 /// A harness of `shape`: the trunk of shape.spine_branches branch points from a port at
-/// x = 0 to one at its far end, each branch point with max_degree − 2 side trees at most
-/// (square to the trunk, rolled by the golden angle from one to the next), side trees
-/// splitting while shape.side_branches lasts, wires between random port pairs whose tree
+/// x = 0 to one at its far end, each branch point with one side tree, or max_degree − 2 at
+/// a dense one (square to the trunk, rolled by the golden angle from one to the next and
+/// evenly around it), side trees splitting in two or three while shape.side_branches lasts, wires between random port pairs whose tree
 /// path is within [min_wire, max_wire] (any pair when too few are).
 inline GeneratedHarness generate_harness(const HarnessShape& shape) {
   std::mt19937 rng(shape.seed);
@@ -158,11 +165,15 @@ inline GeneratedHarness generate_harness(const HarnessShape& shape) {
   for (int k = 1; k <= K; ++k) {
     const Vec3 tan = detail::spine_tangent(xs[k]);
     const auto [e1, e2] = detail::frame_of(tan);
-    const int sides = 1 + static_cast<int>(U(rng) * (max_deg - 2));
+    const int first_dense = std::min(5, (K + 1) / 2);
+    const bool dense = shape.dense_every > 0 && k >= first_dense && (k - first_dense) % shape.dense_every == 0;
+    const int sides = dense ? max_deg - 2 : 1;
     for (int j = 0; j < sides; ++j) {
       const double roll = 2.399963 * k + 2.0 * M_PI * j / sides;
       const Vec3 u0 = std::cos(roll) * e1 + std::sin(roll) * e2;
-      detail::grow(t, rng, spine[k], u0, tan.cross(u0).normalized(), 0.0, 0, pool, max_deg);
+      // A dense point's side trees end at once (a connector cluster): split, their legs
+      // would fan into each other's wedges.
+      detail::grow(t, rng, spine[k], u0, tan.cross(u0).normalized(), 0.0, dense ? detail::kMaxSideDepth : 0, pool);
     }
   }
   // Tree paths between ports: distances from every port (a BFS per port over the tree).

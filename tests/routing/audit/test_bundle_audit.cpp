@@ -92,7 +92,8 @@ RandomCase random_case(std::uint32_t seed) {
   shape.min_wire = 100.0;
   shape.max_wire = 3000.0;
   shape.seed = seed;
-  shape.max_degree = 3 + static_cast<int>(U(rng) * 14);  // nodes of 3 to 16 segments
+  shape.max_degree = 3 + static_cast<int>(U(rng) * 14);  // dense nodes of 3 to 16 segments
+  shape.dense_every = 1 + static_cast<int>(U(rng) * 4);
   RandomCase rc;
   rc.harness = bench::generate_harness(shape).harness;
   const int n_parts = static_cast<int>(U(rng) * 31);
