@@ -1,5 +1,5 @@
 // `loom audit SCENE [--routes FILE] [--method certified|discrete] [--no-index] [--spacing L]
-// [--tolerance T] [--threads N] [--out DIR] [--render-size WxH] [--json] [--quiet]`: clash,
+// [--tolerance T] [--per-cable] [--threads N] [--out DIR] [--render-size WxH] [--json] [--quiet]`: clash,
 // bend and clearance audit of a harness in its scene; writes DIR/report.json (DESIGN §4),
 // DIR/view.html and DIR/render.png. Progress bars on stderr when it is a terminal.
 #include "app/commands.hpp"
@@ -37,6 +37,7 @@ struct AuditFlags {
   std::string method = "certified";
   bool method_given = false;
   bool no_index = false;
+  bool per_cable = false;  ///< certified: every cable on its own, not at the bundle level
   double spacing = 0.0;    ///< 0: the default (a given value is > 0, checked on the option)
   double tolerance = 0.0;  ///< 0: the default (a given value is > 0, checked on the option)
   int threads = 0;
@@ -115,6 +116,11 @@ int run_audit_command(const AuditFlags& f) {
   if (f.spacing > 0.0 && opt.check.method == ClashMethod::Certified)
     throw InputError({"", 0, "--spacing"}, "applies to the discrete method only (--method discrete or --no-index); "
                                            "the certified method places its samples to meet --tolerance");
+  if (f.per_cable && opt.check.method == ClashMethod::Discrete)
+    throw InputError({"", 0, "--per-cable"}, "applies to the certified method only; the discrete method" +
+                                                 std::string(f.no_index ? " (--no-index)" : "") +
+                                                 " always checks every cable on its own");
+  opt.check.per_cable = f.per_cable;
   opt.check.spacing = f.spacing;
   opt.check.tolerance = f.tolerance;
   opt.check.threads = f.threads;
@@ -160,6 +166,8 @@ void add_audit_command(CLI::App& app, int& exit_code) {
       ->check(finite_number(0.0, false));
   cmd->add_option("--tolerance", f->tolerance, "Certified accuracy (default: smallest cable radius / 100)")
       ->check(finite_number(0.0, false));
+  cmd->add_flag("--per-cable", f->per_cable,
+                "Certified: check every cable on its own (the reference) instead of each shared segment once");
   cmd->add_option("--threads", f->threads, "Worker threads (default: all cores)")
       ->check(whole_number(1, kMaxThreads));
   cmd->add_option("--out", f->out, "Output directory for report.json")->check(non_empty_path())->capture_default_str();

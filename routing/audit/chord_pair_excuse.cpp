@@ -86,6 +86,13 @@ std::optional<SegmentSegmentResult> closest_apart(const Vec3& pa, const Vec3& pb
   return best;
 }
 
+std::optional<ParamBox> ball_box(const Vec3& pa, const Vec3& pb, const Vec3& qa, const Vec3& qb, const Vec3& center,
+                                 double radius) {
+  ParamBox x{};
+  if (ball_interval(pa, pb, center, radius, x.l0, x.l1) && ball_interval(qa, qb, center, radius, x.m0, x.m1)) return x;
+  return std::nullopt;
+}
+
 std::vector<ParamBox> excused_boxes(const CableInput& ca, const Vec3& pa, const Vec3& pb, double sa0, double sa1,
                                     const CableInput& cb, const Vec3& qa, const Vec3& qb, double tb0, double tb1) {
   std::vector<ParamBox> out;
@@ -97,11 +104,8 @@ std::vector<ParamBox> excused_boxes(const CableInput& ca, const Vec3& pa, const 
         out.push_back(x);
   for (const auto& ja : ca.junctions)
     for (const auto& jb : cb.junctions)
-      if (ja.node == jb.node) {
-        const double rad = std::max(ja.radius, jb.radius);
-        if (ball_interval(pa, pb, ja.position, rad, x.l0, x.l1) && ball_interval(qa, qb, ja.position, rad, x.m0, x.m1))
-          out.push_back(x);
-      }
+      if (ja.node == jb.node)
+        if (const auto b = ball_box(pa, pb, qa, qb, ja.position, std::max(ja.radius, jb.radius))) out.push_back(*b);
   return out;
 }
 
@@ -158,6 +162,36 @@ std::optional<SegmentSegmentResult> closest_unexcused(const std::vector<ParamBox
     }
   }
   return best;
+}
+
+std::optional<PairContact> judge_chord_pair(const std::vector<CableInput>& cables, const ChordRef& A, const ChordRef& B,
+                                            SegmentSegmentResult r) {
+  const CableInput& ca = cables[static_cast<std::size_t>(A.cable)];
+  const CableInput& cb = cables[static_cast<std::size_t>(B.cable)];
+  const bool self = A.cable == B.cable;
+  const double r_sum = ca.radius + cb.radius;
+  const double self_gap = M_PI * ca.radius;
+  if (!(std::sqrt(r.dist2) < r_sum)) return std::nullopt;
+  double s = A.s0 + r.s * (A.s1 - A.s0), t = B.s0 + r.t * (B.s1 - B.s0);
+  if (self && std::abs(s - t) < self_gap) {
+    // Excused there: the closest points of the two chords at least π r apart instead.
+    const auto apart = closest_apart(A.a, A.b, A.s0, A.s1, B.a, B.b, B.s0, B.s1, self_gap);
+    if (!apart) return std::nullopt;
+    r = *apart;
+  }
+  if (self && self_excused_at_node(ca, r.p, r.q)) return std::nullopt;  // the node's turn: a bend
+  if (!self && excused(ca, s, r.p, cb, t, r.q)) {
+    // Excused there: the closest points of the two chords outside the excused region instead.
+    const auto boxes = excused_boxes(ca, A.a, A.b, A.s0, A.s1, cb, B.a, B.b, B.s0, B.s1);
+    const auto outside = closest_unexcused(boxes, A.a, A.b, B.a, B.b);
+    if (!outside) return std::nullopt;
+    r = *outside;
+  }
+  s = A.s0 + r.s * (A.s1 - A.s0);
+  t = B.s0 + r.t * (B.s1 - B.s0);
+  const double d = std::sqrt(r.dist2);
+  if (!(d < r_sum)) return std::nullopt;
+  return PairContact::ordered(A.cable, s, A.s0, A.s1, r.p, B.cable, t, B.s0, B.s1, r.q, d);
 }
 
 }  // namespace loom::audit

@@ -8,6 +8,7 @@
 
 #include "index/triangle_distance.hpp"
 #include "routing/audit/clash_context.hpp"
+#include "routing/audit/pair_contacts.hpp"
 
 #include <optional>
 #include <vector>
@@ -32,6 +33,11 @@ struct ParamBox {
   double l0, l1, m0, m1;
 };
 
+/// The box of chord parameters where chord A (pa→pb) and chord B (qa→qb) both lie within
+/// `radius` of `center` (a junction's excuse on one chord pair), if they both reach it.
+std::optional<ParamBox> ball_box(const Vec3& pa, const Vec3& pb, const Vec3& qa, const Vec3& qb, const Vec3& center,
+                                 double radius);
+
 /// The cable–cable excuse (excused()) on one chord pair, as boxes of chord parameters:
 /// both points in one harness segment, or both within a shared junction's radius — each a
 /// product of an interval on each chord.
@@ -48,5 +54,19 @@ std::vector<ParamBox> excused_boxes(const CableInput& ca, const Vec3& pa, const 
 /// other chord's parameter runs over an interval: a point–segment distance.
 std::optional<SegmentSegmentResult> closest_unexcused(const std::vector<ParamBox>& boxes, const Vec3& pa,
                                                       const Vec3& pb, const Vec3& qa, const Vec3& qb);
+
+/// One chord of a cable in its direction of travel: from a (arc length s0) to b (s1 ≥ s0).
+struct ChordRef {
+  int cable = -1;  ///< index into the checked cables
+  Vec3 a = Vec3::Zero(), b = Vec3::Zero();
+  double s0 = 0.0, s1 = 0.0;
+};
+
+/// The pair rules on chords A and B (one cable for a self pair) whose closest points are r
+/// (parameters on A and B): a contact closer than the radii sum, at the closest points or,
+/// where those are excused, at the closest points outside the excuse (closest_apart,
+/// closest_unexcused); std::nullopt if there is none.
+std::optional<PairContact> judge_chord_pair(const std::vector<CableInput>& cables, const ChordRef& A, const ChordRef& B,
+                                            SegmentSegmentResult r);
 
 }  // namespace loom::audit

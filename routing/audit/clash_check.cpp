@@ -3,6 +3,7 @@
 // bend check.
 #include "routing/audit/clash_check.hpp"
 
+#include "routing/audit/bundle_layout.hpp"
 #include "routing/audit/chord_plan.hpp"
 #include "routing/audit/clash_context.hpp"
 
@@ -12,6 +13,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -25,6 +28,10 @@ namespace {
 constexpr double kDefaultToleranceOfRadius = 0.01;
 /// The tolerance reported when there is no cable to derive it from (nothing is checked).
 constexpr double kNoCableTolerance = 0.01;
+/// How far (as a share of the chord error) a cable's curve may pass from the ends of its
+/// bend pieces for the bundle level to take them as its pieces (rounding only: they are
+/// the curve's own pieces).
+constexpr double kMeetShareOfChordError = 0.25;
 /// Share of the tolerance left to the chords' distance from the curve; the rest covers the
 /// index's own error (structure: chord + index ≤ tol; cable–cable: 2 · chord ≤ tol).
 constexpr double kChordShareOfTolerance = 0.5;
@@ -48,13 +55,21 @@ constexpr double kChordShareOfTolerance = 0.5;
 /// it passes) into `sum`, and a bend-radius violation into `out` for every stretch bending
 /// tighter than the cable's minimum (Centerline::bend_stretches_below), at its tightest
 /// point, and for every node turn tighter than it (NodeTurn).
-void check_bend(const Context& ctx, std::size_t c, CableCheckSummary& sum, std::vector<Violation>& out) {
+/// `memo` (may be null) holds the results of curves the cable shares with others.
+void check_bend(const Context& ctx, std::size_t c, CableCheckSummary& sum, std::vector<Violation>& out,
+                const BendMemo* memo) {
   const CableInput& in = ctx.cables[c];
-  BendExtremum b = in.bend_pieces.empty() ? in.curve.min_bend_radius() : BendExtremum{};
+  // The k-th curve judged (bend piece, or the whole curve): from the memo where it has it.
+  auto min_of = [&](std::size_t k, const Centerline& curve) {
+    const BendExtremum* m = memo ? memo->min_radius(c, k) : nullptr;
+    return m ? *m : curve.min_bend_radius();
+  };
+  BendExtremum b = in.bend_pieces.empty() ? min_of(0, in.curve) : BendExtremum{};
   if (!in.bend_pieces.empty()) {
     b.radius = std::numeric_limits<double>::infinity();
-    for (const auto& [s0, piece] : in.bend_pieces) {
-      const BendExtremum pb = piece.min_bend_radius();
+    for (std::size_t k = 0; k < in.bend_pieces.size(); ++k) {
+      const auto& [s0, piece] = in.bend_pieces[k];
+      const BendExtremum pb = min_of(k, piece);
       if (pb.radius < b.radius) {
         b = pb;
         b.s += s0;
@@ -68,20 +83,22 @@ void check_bend(const Context& ctx, std::size_t c, CableCheckSummary& sum, std::
   if (!(ctx.req.check_bend && in.min_bend_radius > 0.0 && b.radius < in.min_bend_radius)) return;
   // One violation per stretch bending tighter than the minimum, at its tightest point (as
   // one clash per contact stretch): a route with two tight corners needs both mended.
-  auto add = [&](const Centerline& curve, double s0) {
-    for (const BendExtremum& e : curve.bend_stretches_below(in.min_bend_radius)) {
+  auto add = [&](const Centerline& curve, double s0, std::size_t k) {
+    const std::vector<BendExtremum>* known = memo ? memo->below(c, k) : nullptr;
+    for (const BendExtremum& e : known ? *known : curve.bend_stretches_below(in.min_bend_radius)) {
       Violation v;
       v.kind = ViolationKind::BendRadius;
       v.cable = static_cast<int>(c);
       v.value = e.radius;
       v.limit = in.min_bend_radius;
       v.s = s0 + e.s;
+      v.s_begin = v.s_end = v.s;
       v.point = curve.position(e.u);
       out.push_back(v);
     }
   };
-  if (in.bend_pieces.empty()) add(in.curve, 0.0);
-  for (const auto& [s0, piece] : in.bend_pieces) add(piece, s0);
+  if (in.bend_pieces.empty()) add(in.curve, 0.0, 0);
+  for (std::size_t k = 0; k < in.bend_pieces.size(); ++k) add(in.bend_pieces[k].second, in.bend_pieces[k].first, k);
   for (const NodeTurn& t : in.node_turns) {
     if (!(t.radius < in.min_bend_radius)) continue;
     Violation v;
@@ -184,6 +201,7 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
   std::vector<std::vector<ClashEntry>> per_clash(cables.size());
   std::vector<std::vector<Violation>> per_viol(cables.size());
   ProgressCounter checked(request.progress, "audit", cables.size(), "cables");
+  std::optional<Layout> layout;  // the bundle level's pieces (certified, when cables share some)
 
   if (request.method == ClashMethod::Certified) {
     res.tolerance = ctx.tol;
@@ -196,15 +214,28 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
       tbb::task_arena arena(request.threads > 0 ? request.threads : tbb::task_arena::automatic);
       arena.execute([&] { ctx.part_tree = std::make_unique<BoxTree>(std::move(boxes)); });
     }
+    // The bundle level where cables share pieces: each shared piece checked once for all.
+    if (!request.per_cable) {
+      layout = make_layout(cables, kMeetShareOfChordError * ctx.chord_error, request.threads);
+      if (!layout->shared) layout.reset();
+    }
+    BundleStructure bundled;
+    std::unique_ptr<BendMemo> memo;
+    if (layout) {
+      res.bundle_level = true;
+      if (request.check_structure && !parts.empty()) bundled = bundle_structure(ctx, *layout);
+      memo = std::make_unique<BendMemo>(ctx, *layout);
+    }
     parallel_indices(cables.size(), request.threads, [&](std::size_t c) {
       CableCheckSummary& sum = res.cables[c];
       sum.length = cables[c].curve.length();
       if (request.check_structure && !parts.empty()) {
-        certified_structure(ctx, static_cast<int>(c), sum, per_clash[c], per_viol[c]);
+        certified_structure(ctx, static_cast<int>(c), sum, per_clash[c], per_viol[c],
+                            bundled.cables.empty() ? nullptr : &bundled.cables[c]);
       } else {
         sum.min_clearance = kInf;
       }
-      check_bend(ctx, c, sum, per_viol[c]);
+      check_bend(ctx, c, sum, per_viol[c], memo.get());
       checked.add();
     });
   } else {
@@ -230,7 +261,7 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
         per_viol[c] = std::move(tr.violations);
         sum.min_clearance = std::max(tr.min_key, -cables[c].radius);
       }
-      check_bend(ctx, c, sum, per_viol[c]);
+      check_bend(ctx, c, sum, per_viol[c], nullptr);
       checked.add();
     });
     std::vector<ClashEntry> pair_out;
@@ -239,7 +270,10 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
   }
   if (request.method == ClashMethod::Certified) {
     std::vector<ClashEntry> pair_out;
-    certified_cable_pairs(ctx, pair_out);
+    if (layout)
+      bundle_cable_pairs(ctx, *layout, pair_out);
+    else
+      certified_cable_pairs(ctx, pair_out);
     for (const auto& e : pair_out) per_clash[e.cable].push_back(e);
   }
   for (std::size_t c = 0; c < cables.size(); ++c) {

@@ -105,6 +105,8 @@ struct CableInput {
   /// Pieces over which bends are judged: (arc length where the piece starts, its curve).
   /// Empty: the whole `curve`. Where two harness segments meet at a node the wires splay
   /// inside the breakout, so the direction change there is judged as a NodeTurn instead.
+  /// Each is `curve` over [start, start + its length]; cables whose pieces are equal (one
+  /// harness segment's curve) are checked together at the bundle level (ClashRequest).
   std::vector<std::pair<double, Centerline>> bend_pieces;
   /// The direction changes between bend pieces, one per node the cable passes (NodeTurn).
   std::vector<NodeTurn> node_turns;
@@ -169,6 +171,14 @@ struct ClashRequest {
   /// sample positions, and so the last digits of a report, depend on ε. 0 = exact queries
   /// (then cut_short_queries changes nothing in the report). Must be finite and ≥ 0.
   double distance_rel_error = 0.25;
+  /// Certified: check every cable on its own (the reference), not at the bundle level.
+  /// The bundle level (false) takes the pieces several cables share (their bend pieces:
+  /// harness segments) once for all of them — structure proofs as a tube of the largest
+  /// radius, one chord set, bends once per curve — and works per cable only where a piece
+  /// cannot decide: near a part, where cables part at a node or meet another piece. Its
+  /// findings are this reference's within the tolerance; a harness whose cables share no
+  /// piece is checked per cable either way.
+  bool per_cable = false;
   /// Work limits of the cable–cable and self passes (see ClashLimits).
   ClashLimits limits;
   /// Worker threads (≤ 0: all cores).
@@ -217,6 +227,8 @@ struct Violation {
   double limit = 0.0;      ///< bend: min_bend_radius; clearance: required
   double s = 0.0;          ///< arc length where it is worst
   Vec3 point = Vec3::Zero();  ///< centerline point there
+  double s_begin = 0.0;    ///< clearance: start of the band stretch (to one chord, ≤ 2r); bend: s
+  double s_end = 0.0;      ///< clearance: end of the band stretch (to one chord, ≤ 2r); bend: s
 };
 
 /// Per-cable summary.
@@ -261,6 +273,7 @@ struct ClashResult {
   double chord_error = 0.0;        ///< max distance between the measured chords and the curve
   double distance_rel_error = 0.0; ///< certified: ε of the free-space and first chord queries (ClashRequest)
   double spacing = 0.0;            ///< discrete: sample spacing used (0 = per cable 2r)
+  bool bundle_level = false;       ///< certified: checked at the bundle level (ClashRequest::per_cable)
   std::vector<std::string> notes;  ///< what the user should know (open parts, …)
 };
 

@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <utility>
 #include <vector>
 
 namespace loom::audit {
@@ -32,6 +33,11 @@ constexpr double kShortSpanRadii = 0.25;
 /// Arc-length slack (relative to the cable length) when deciding that two chord or sample
 /// intervals touch.
 constexpr double kTouchRel = 1e-9;
+/// Default longest sphere-tracing step of the certified structure pass, in tube radii.
+constexpr double kDefaultMaxStepRadii = 50.0;
+/// Stretches of the sphere trace shorter than this many tube radii that cannot be proven
+/// clear are handed to the exact chord measurement.
+constexpr double kLeafRadii = 2.0;
 
 inline std::int64_t as_i64(std::size_t v) { return static_cast<std::int64_t>(v); }
 
@@ -123,10 +129,51 @@ inline bool self_excused_at_node(const CableInput& c, const Vec3& p, const Vec3&
   return false;
 }
 
+/// A part within reach of a chord the bundle level measured: its exact distance from the
+/// chord and where.
+struct ChordPartDistance {
+  int part = -1;
+  double dist = 0.0;  ///< exact distance from the chord to the part's surface
+  double t = 0.0;     ///< parameter of the closest point on the chord, from its start
+  Vec3 point = Vec3::Zero();  ///< that point of the chord
+};
+
+/// A chord of a shared piece measured once for all its cables: every part within the
+/// largest radius + the part's required clearance + the measuring margin (nothing touches
+/// the centerline, which lies outside every closed part).
+struct MeasuredChord {
+  Vec3 a = Vec3::Zero(), b = Vec3::Zero();
+  double sigma0 = 0.0, sigma1 = 0.0;  ///< arc lengths along the piece at a and b
+  std::vector<ChordPartDistance> parts;
+};
+
+/// A stretch of a cable the bundle level has decided: proven clear (`chords` null: farther
+/// than the cable's radius + the band + the measuring margin from every part, outside every
+/// closed part), or measured (`chords`: the piece's chords over it, in the piece's
+/// direction, the cable running them backwards when `reversed`).
+struct HintStretch {
+  double s0 = 0.0, s1 = 0.0;  ///< on the cable, s0 < s1
+  const std::vector<MeasuredChord>* chords = nullptr;
+  double piece_s0 = 0.0;      ///< the cable's arc length at σ = 0 of the piece
+  double piece_length = 0.0;  ///< the piece's length on the cable
+  bool reversed = false;
+  /// Cable arc length at piece arc length σ.
+  double s_at(double sigma) const { return reversed ? piece_s0 + (piece_length - sigma) : piece_s0 + sigma; }
+};
+
+/// What the bundle level decided of one cable before its structure pass (bundle_layout.hpp).
+struct StructureHints {
+  std::vector<HintStretch> stretches;  ///< sorted, disjoint
+  /// Smallest clearance seen there, to parts the cable is not attached to (an upper bound
+  /// on the cable's smallest clearance).
+  double sampled_min = kInf;
+};
+
 /// Certified cable–structure pass of one cable (sphere tracing + exact chords): its clashes
-/// and clearance violations appended, its smallest clearance written into `sum`.
+/// and clearance violations appended, its smallest clearance written into `sum`. The
+/// stretches `hints` proves clear are not traced again (null: none).
 void certified_structure(Context& ctx, int cable, CableCheckSummary& sum, std::vector<ClashEntry>& clashes,
-                         std::vector<Violation>& violations);
+                         std::vector<Violation>& violations, const StructureHints* hints = nullptr);
 
 /// Certified cable–cable and self pass over all cables (chord blocks in one BVH, exact
 /// segment distances): one entry per contact stretch, appended to `out`.

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -82,32 +83,10 @@ std::int64_t narrow_phase(const Context& ctx, const CableChords& A, std::size_t 
       const double reach = r_sum + 0.5 * ((A.ch.p[ka + 1] - A.ch.p[ka]).norm() + (B.ch.p[kb + 1] - B.ch.p[kb]).norm());
       if ((ma - mb).squaredNorm() >= reach * reach) continue;
       ++tests;
-      SegmentSegmentResult r = closest_segment_segment(A.ch.p[ka], A.ch.p[ka + 1], B.ch.p[kb], B.ch.p[kb + 1]);
-      if (!(std::sqrt(r.dist2) < r_sum)) continue;
-      double s = sa0 + r.s * (sa1 - sa0), t = tb0 + r.t * (tb1 - tb0);
-      if (self && std::abs(s - t) < self_gap) {
-        // Excused there: the closest points of the two chords at least π r apart instead.
-        const auto apart = closest_apart(A.ch.p[ka], A.ch.p[ka + 1], sa0, sa1, B.ch.p[kb], B.ch.p[kb + 1], tb0, tb1,
-                                         self_gap);
-        if (!apart) continue;
-        r = *apart;
-        s = sa0 + r.s * (sa1 - sa0);
-        t = tb0 + r.t * (tb1 - tb0);
-      }
-      if (self && self_excused_at_node(ca, r.p, r.q)) continue;  // the node's turn: a bend
-      if (!self && excused(ca, s, r.p, cb, t, r.q)) {
-        // Excused there: the closest points of the two chords outside the excused region instead.
-        const auto boxes =
-            excused_boxes(ca, A.ch.p[ka], A.ch.p[ka + 1], sa0, sa1, cb, B.ch.p[kb], B.ch.p[kb + 1], tb0, tb1);
-        const auto outside = closest_unexcused(boxes, A.ch.p[ka], A.ch.p[ka + 1], B.ch.p[kb], B.ch.p[kb + 1]);
-        if (!outside) continue;
-        r = *outside;
-        s = sa0 + r.s * (sa1 - sa0);
-        t = tb0 + r.t * (tb1 - tb0);
-      }
-      const double d = std::sqrt(r.dist2);
-      if (!(d < r_sum)) continue;
-      out.push_back(PairContact::ordered(A.cable, s, sa0, sa1, r.p, B.cable, t, tb0, tb1, r.q, d));
+      const SegmentSegmentResult r = closest_segment_segment(A.ch.p[ka], A.ch.p[ka + 1], B.ch.p[kb], B.ch.p[kb + 1]);
+      if (auto c = judge_chord_pair(ctx.cables, {A.cable, A.ch.p[ka], A.ch.p[ka + 1], sa0, sa1},
+                                    {B.cable, B.ch.p[kb], B.ch.p[kb + 1], tb0, tb1}, r))
+        out.push_back(*c);
     }
   }
   return tests;
@@ -117,6 +96,54 @@ std::int64_t narrow_phase(const Context& ctx, const CableChords& A, std::size_t 
 constexpr std::size_t kPairsPerTask = 256;
 
 }  // namespace
+
+std::vector<BoxPair> bounded_block_pairs(Context& ctx, const std::vector<AABB>& boxes,
+                                         std::function<bool(std::uint32_t, std::uint32_t)> keep,
+                                         const std::function<int(std::uint32_t)>& cable_of) {
+  const ClashLimits& lim = ctx.req.limits;
+  BoxPairRequest bp;
+  bp.filter.keep = std::move(keep);
+  bp.filter.max_pairs = lim.max_block_pairs;
+  bp.max_overlaps = lim.max_block_overlaps;
+  bp.threads = ctx.req.threads;
+  BoxPairResult found = overlapping_box_pairs(boxes, bp);
+  ctx.counters.block_overlaps_estimate =
+      static_cast<std::int64_t>(std::llround(std::min(found.estimated_overlaps, 9e18)));
+  // A cable with the most overlapping blocks, named by the refusals (which need blocks).
+  const std::string busiest =
+      found.status == BoxPairStatus::Done ? "" : ctx.cables[static_cast<std::size_t>(cable_of(found.busiest))].id;
+  if (found.status == BoxPairStatus::TooManyOverlaps)
+    throw CableLimitError(busiest, "about " + full_precision(std::round(found.estimated_overlaps)) +
+                                       " pairs of chord blocks come within reach of each other (limit " +
+                                       full_precision(static_cast<double>(lim.max_block_overlaps)) + "; cable '" +
+                                       busiest + "' among them): " + kFoldBack);
+  if (found.status == BoxPairStatus::TooManyKept)
+    throw CableLimitError(busiest, "more than " + full_precision(static_cast<double>(lim.max_block_pairs)) +
+                                       " pairs of chord blocks of different cables, or of one cable πr apart, come "
+                                       "within reach of each other (cable '" + busiest + "' among them): " + kFoldBack);
+  ctx.counters.block_pairs = as_i64(found.pairs.size());
+  return std::move(found.pairs);
+}
+
+std::vector<PairContact> gather_contacts(Context& ctx, std::size_t n,
+                                         const std::function<std::int64_t(std::size_t, std::vector<PairContact>&)>& narrow) {
+  std::mutex mu;
+  std::vector<PairContact> contacts;
+  const std::size_t tasks = (n + kPairsPerTask - 1) / kPairsPerTask;
+  parallel_indices(tasks, ctx.req.threads, [&](std::size_t t) {
+    std::vector<PairContact> local;
+    std::int64_t tests = 0;
+    for (std::size_t k = t * kPairsPerTask; k < std::min(n, (t + 1) * kPairsPerTask); ++k) tests += narrow(k, local);
+    ctx.counters.pairs += tests;
+    if (!local.empty()) {
+      std::lock_guard<std::mutex> lock(mu);
+      contacts.insert(contacts.end(), local.begin(), local.end());
+      if (contacts.size() > ctx.req.limits.max_pair_contacts) refuse_contacts(ctx, contacts, "chords");
+    }
+  });
+  ctx.counters.pair_contacts = as_i64(contacts.size());
+  return contacts;
+}
 
 void certified_cable_pairs(Context& ctx, std::vector<ClashEntry>& out) {
   if (!ctx.req.check_cable_cable && !ctx.req.check_self) return;
@@ -150,9 +177,7 @@ void certified_cable_pairs(Context& ctx, std::vector<ClashEntry>& out) {
   // cables' blocks both inside one harness segment (bundled there on purpose: every
   // contact is excused), not a cable's blocks closer in s than π r. Why here: a large
   // bundle puts every block beside the blocks of every other cable in it.
-  const ClashLimits& lim = ctx.req.limits;
-  BoxPairRequest bp;
-  bp.filter.keep = [&](std::uint32_t i, std::uint32_t j) {
+  auto keep = [&](std::uint32_t i, std::uint32_t j) {
     const BlockRef& x = blocks[i];
     const BlockRef& y = blocks[j];
     if (x.cable == y.cable) {
@@ -163,46 +188,15 @@ void certified_cable_pairs(Context& ctx, std::vector<ClashEntry>& out) {
     }
     return ctx.req.check_cable_cable && !(block_segment[i] >= 0 && block_segment[i] == block_segment[j]);
   };
-  bp.filter.max_pairs = lim.max_block_pairs;
-  bp.max_overlaps = lim.max_block_overlaps;
-  bp.threads = ctx.req.threads;
-  BoxPairResult found = overlapping_box_pairs(boxes, bp);
-  ctx.counters.block_overlaps_estimate =
-      static_cast<std::int64_t>(std::llround(std::min(found.estimated_overlaps, 9e18)));
-  // A cable with the most overlapping blocks, named by the refusals (which need blocks).
-  const std::string busiest = found.status == BoxPairStatus::Done ? "" : ctx.cables[blocks[found.busiest].cable].id;
-  if (found.status == BoxPairStatus::TooManyOverlaps)
-    throw CableLimitError(busiest, "about " + full_precision(std::round(found.estimated_overlaps)) +
-                                       " pairs of chord blocks come within reach of each other (limit " +
-                                       full_precision(static_cast<double>(lim.max_block_overlaps)) + "; cable '" +
-                                       busiest + "' among them): " + kFoldBack);
-  if (found.status == BoxPairStatus::TooManyKept)
-    throw CableLimitError(busiest, "more than " + full_precision(static_cast<double>(lim.max_block_pairs)) +
-                                       " pairs of chord blocks of different cables, or of one cable πr apart, come "
-                                       "within reach of each other (cable '" + busiest + "' among them): " + kFoldBack);
-  std::vector<BoxPair>& pairs = found.pairs;
-  ctx.counters.block_pairs = as_i64(pairs.size());
+  std::vector<BoxPair> pairs =
+      bounded_block_pairs(ctx, boxes, keep, [&](std::uint32_t k) { return static_cast<int>(blocks[k].cable); });
   if (ctx.req.check_self)
     for (std::uint32_t i = 0; i < blocks.size(); ++i) pairs.emplace_back(i, i);
-  std::mutex mu;
-  std::vector<PairContact> contacts;
-  const std::size_t tasks = (pairs.size() + kPairsPerTask - 1) / kPairsPerTask;
-  parallel_indices(tasks, ctx.req.threads, [&](std::size_t t) {
-    std::vector<PairContact> local;
-    std::int64_t tests = 0;
-    for (std::size_t k = t * kPairsPerTask; k < std::min(pairs.size(), (t + 1) * kPairsPerTask); ++k) {
-      const BlockRef& x = blocks[pairs[k].first];
-      const BlockRef& y = blocks[pairs[k].second];
-      tests += narrow_phase(ctx, cc[x.cable], x.block, cc[y.cable], y.block, local);
-    }
-    ctx.counters.pairs += tests;
-    if (!local.empty()) {
-      std::lock_guard<std::mutex> lock(mu);
-      contacts.insert(contacts.end(), local.begin(), local.end());
-      if (contacts.size() > lim.max_pair_contacts) refuse_contacts(ctx, contacts, "chords");
-    }
+  std::vector<PairContact> contacts = gather_contacts(ctx, pairs.size(), [&](std::size_t k, std::vector<PairContact>& local) {
+    const BlockRef& x = blocks[pairs[k].first];
+    const BlockRef& y = blocks[pairs[k].second];
+    return narrow_phase(ctx, cc[x.cable], x.block, cc[y.cable], y.block, local);
   });
-  ctx.counters.pair_contacts = as_i64(contacts.size());
   group_pair_contacts(contacts, ctx.cables, out);
 }
 

@@ -15,11 +15,6 @@ namespace loom::audit {
 
 namespace {
 
-/// Default longest sphere-tracing step, in cable radii.
-constexpr double kDefaultMaxStepRadii = 50.0;
-/// Stretches of the sphere trace shorter than this many cable radii that cannot be proven
-/// clear are handed to the exact chord measurement.
-constexpr double kLeafRadii = 2.0;
 /// A sphere-tracing query cut short at the distance a decision needs stops this much
 /// (relative to the largest query radius) beyond it, so that rounding does not leave the
 /// bound a hair short of the decision.
@@ -33,11 +28,12 @@ constexpr double kProofErrorShare = 0.125;
 /// Sphere-traces one cable, measures what cannot be proven clear exactly, tracks stretches.
 class StructureTracer {
  public:
-  StructureTracer(Context& ctx, int cable)
+  StructureTracer(Context& ctx, int cable, const StructureHints* hints)
       : ctx_(ctx),
         cable_(cable),
         in_(ctx.cables[cable]),
         r_(in_.radius),
+        hints_(hints),
         // Attachments are excused here, chord by chord (excuse_attached), not by the tracker.
         tracker_(cable, r_, ctx.info, no_attachments(), [this](PartObservation& o) { measure_deferred(o); }) {
     L_ = in_.curve.length();
@@ -48,6 +44,7 @@ class StructureTracer {
     max_step_ = std::max(max_step_, leaf_);
     cut_margin_ = ctx.abs_err + kCutMarginRel * (thr_ + max_step_);
     rel_error_ = ctx.req.distance_rel_error;
+    if (hints_) summary_min_ = hints_->sampled_min;
   }
 
   void run() {
@@ -57,7 +54,26 @@ class StructureTracer {
     update_inside(s0.p);
     Sample a = s0;
     double s_prev = 0.0;
+    std::size_t next_hint = 0;  // the first stretch the bundle level decided that is not passed yet
+    const std::size_t n_hint = hints_ ? hints_->stretches.size() : 0;
     while (s_prev < L_) {
+      // A stretch the bundle level proved clear is a proven-clear gap; one it measured gives
+      // its chords' observations. Either is sampled again at its end only.
+      while (next_hint < n_hint && hints_->stretches[next_hint].s1 <= s_prev) ++next_hint;
+      if (next_hint < n_hint && hints_->stretches[next_hint].s0 <= s_prev) {
+        const HintStretch& hs = hints_->stretches[next_hint];
+        const double s_end = std::min(L_, hs.s1);
+        if (hs.chords) {
+          flush_free();
+          measured(hs);
+        } else {
+          free_.push_back({a, s_end});
+        }
+        a = sample(s_end, cap, thr_ + 0.5 * max_step_ + cut_margin_);
+        s_prev = s_end;
+        continue;
+      }
+      const double clear_start = next_hint < n_hint ? hints_->stretches[next_hint].s0 : L_;
       // A cut-short sample's bound gives the same step and radius once they reach their
       // caps (both grow with d); otherwise a higher bound, or its value, is needed now.
       const double reach_cap = cap - std::min(L_ - s_prev, max_step_);  // a.d that caps the radius
@@ -70,7 +86,7 @@ class StructureTracer {
       }
       const double rho = a.d - thr_;
       const double step = std::clamp(2.0 * rho, leaf_, max_step_);
-      const double s_next = std::min(L_, s_prev + step);
+      const double s_next = std::min({L_, s_prev + step, clear_start});
       // Enough for b: its own step and radius at their caps, and [a, b] proven clear.
       const double enough = std::max(thr_ + 0.5 * max_step_, 2.0 * thr_ + (s_next - s_prev) - a.d) + cut_margin_;
       Sample b = sample(s_next, std::min(a.d + (s_next - s_prev), cap), enough);
@@ -446,6 +462,29 @@ class StructureTracer {
     }
   }
 
+  /// The observations of a stretch the bundle level measured, chord by chord in the
+  /// cable's direction: each part closer than r + its required clearance (what near()
+  /// observes on a chord outside every part, with exact distances).
+  void measured(const HintStretch& hs) {
+    const std::vector<MeasuredChord>& chords = *hs.chords;
+    std::vector<PartObservation> obs;
+    for (std::size_t i = 0; i < chords.size(); ++i) {
+      const MeasuredChord& mc = chords[hs.reversed ? chords.size() - 1 - i : i];
+      obs.clear();
+      for (const ChordPartDistance& d : mc.parts) {
+        if (!(d.dist - r_ < ctx_.info[d.part].required)) continue;
+        PartObservation o;
+        o.part = d.part;
+        o.key = d.dist - r_;
+        o.point = d.point;
+        o.s = hs.s_at(mc.sigma0 + d.t * (mc.sigma1 - mc.sigma0));
+        obs.push_back(o);
+      }
+      const double sa = hs.s_at(mc.sigma0), sb = hs.s_at(mc.sigma1);
+      tracker_.step(obs, std::min(sa, sb), std::max(sa, sb));
+    }
+  }
+
   /// Sets the closed parts holding p strictly inside (the index's answer: all of them, so
   /// a keep-out zone drawn around a box clashes as well as the box).
   void update_inside(const Vec3& p) {
@@ -570,6 +609,7 @@ class StructureTracer {
   int cable_;
   const CableInput& in_;
   double r_;
+  const StructureHints* hints_;  ///< stretches proven clear beforehand (may be null)
   StretchTracker tracker_;
   double L_ = 0.0, thr_ = 0.0, leaf_ = 0.0, max_step_ = 0.0, margin_ = 0.0;
   double rel_error_ = 0.0;   ///< ClashRequest::distance_rel_error (0: exact sphere tracing)
@@ -591,8 +631,8 @@ class StructureTracer {
 }  // namespace
 
 void certified_structure(Context& ctx, int cable, CableCheckSummary& sum, std::vector<ClashEntry>& clashes,
-                         std::vector<Violation>& violations) {
-  StructureTracer tr(ctx, cable);
+                         std::vector<Violation>& violations, const StructureHints* hints) {
+  StructureTracer tr(ctx, cable, hints);
   tr.run();
   clashes = std::move(tr.tracker().clashes);
   violations = std::move(tr.tracker().violations);

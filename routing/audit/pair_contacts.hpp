@@ -6,6 +6,10 @@
 
 #include "routing/audit/clash_context.hpp"
 
+#include "index/box_pairs.hpp"
+
+#include <functional>
+
 #include <vector>
 
 namespace loom::audit {
@@ -58,5 +62,21 @@ inline const char* const kFoldBack = "a route folds back on itself or runs over 
 /// `found` contacts (lowest ids on a tie): which contacts were stored when the limit was
 /// passed depends on thread timing, the pair that dominates them hardly does.
 [[noreturn]] void refuse_contacts(const Context& ctx, const std::vector<PairContact>& found, const char* what);
+
+/// The broad phase of a certified pair pass (cable chords, or the pieces of the bundle
+/// level) under the request's ClashLimits: the pairs of overlapping chord-block boxes that
+/// `keep` keeps (overlapping_box_pairs), counted into block_overlaps_estimate and
+/// block_pairs. Refuses (std::invalid_argument) past max_block_overlaps or
+/// max_block_pairs, naming the cable of the busiest box (`cable_of`: box → cable).
+std::vector<BoxPair> bounded_block_pairs(Context& ctx, const std::vector<AABB>& boxes,
+                                         std::function<bool(std::uint32_t, std::uint32_t)> keep,
+                                         const std::function<int(std::uint32_t)>& cable_of);
+
+/// The narrow phase of a certified pair pass: narrow(k, out) for every block pair k < n
+/// (appending its contacts, returning its exact segment tests), on the request's threads;
+/// the contacts gathered, refused past max_pair_contacts, counted into pair_tests and
+/// pair_contacts.
+std::vector<PairContact> gather_contacts(Context& ctx, std::size_t n,
+                                         const std::function<std::int64_t(std::size_t, std::vector<PairContact>&)>& narrow);
 
 }  // namespace loom::audit

@@ -112,6 +112,8 @@ void StretchTracker::close(Open& st) {
     v.value = std::max(d.key, 0.0);
     v.limit = parts_[d.part].required;
     v.s = d.s;
+    v.s_begin = st.band.s_begin;
+    v.s_end = st.band.s_end;
     v.point = d.point;
     violations.push_back(v);
   }
