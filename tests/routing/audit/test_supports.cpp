@@ -6,6 +6,7 @@
 // no span is checked (clamps are still listed).
 #include "routing/audit/audit.hpp"
 #include "routing/audit/report_json.hpp"
+#include "common/support_fixtures.hpp"
 
 #include <gtest/gtest.h>
 
@@ -15,50 +16,14 @@
 namespace loom {
 namespace {
 
+using test::box_part;
+
 constexpr double kLength = 2000.0;  ///< port to port along x, mm
 constexpr double kHeight = 20.0;    ///< centreline above the plates' top face
 constexpr double kDiameter = 4.0;
 
-/// A closed axis-aligned box, outward-facing triangles.
-Part box_part(const std::string& name, const Vec3& lo, const Vec3& hi, PartRole role = PartRole::Structure) {
-  Part p;
-  p.name = name;
-  p.role = role;
-  p.closed = true;
-  for (int i = 0; i < 8; ++i)
-    p.mesh.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
-  p.mesh.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                      {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  return p;
-}
-
 /// One straight cable A → B at height kHeight, clamps at the given x (segment given).
-Harness straight(const std::vector<double>& clamp_x) {
-  Harness h;
-  h.name = "plate";
-  h.source_file = "plate.xml";
-  h.ports.push_back({"A", {0, 0, kHeight}, {1, 0, 0}, 1});
-  h.ports.push_back({"B", {kLength, 0, kHeight}, {-1, 0, 0}, 2});
-  Segment s;
-  s.from = "A";
-  s.to = "B";
-  s.interp = Interp::Polyline;
-  h.segments.push_back(s);
-  Cable c;
-  c.id = "C1";
-  c.ports[0] = "A";
-  c.ports[1] = "B";
-  c.physical.diameter = kDiameter;
-  h.cables.push_back(c);
-  for (double x : clamp_x) {
-    Clamp k;
-    k.id = "K" + std::to_string(static_cast<int>(x));
-    k.position = {x, 0, kHeight};
-    k.segment = 0;
-    h.clamps.push_back(k);
-  }
-  return h;
-}
+Harness straight(const std::vector<double>& clamp_x) { return test::straight_cable(kLength, kHeight, kDiameter, clamp_x); }
 
 AuditReport audit(const Harness& h, std::vector<Part> parts, bool spacing_given) {
   Scene sc;
