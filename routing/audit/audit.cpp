@@ -121,7 +121,6 @@ double run_together_radius(const HarnessTopology& topo, SegmentCurves& curves, c
 void audit_harness_supports(const Scene& scene, const ObstacleIndex* index, AuditReport& rep) {
   const RoutingSettings& r = scene.routing;
   rep.supports_checked = r.supports;
-  for (const Segment& s : scene.harness.segments) rep.segment_names.push_back(s.from + "/" + s.to);
   if (!r.supports && scene.harness.clamps.empty()) return;
   std::unique_ptr<BruteForceIndex> brute;
   if (!index) index = (brute = std::make_unique<BruteForceIndex>(scene.parts)).get();
@@ -312,12 +311,22 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
     rep.index_name = "none";
     rep.index_accuracy = "brute force over every triangle (double precision)";
   }
+  for (const Segment& s : scene.harness.segments) rep.segment_names.push_back(s.from + "/" + s.to);
   if (scene.has_harness)
     for (auto& n : attach_ports(scene.harness, scene.parts, req.routing_clearance, inputs, index)) rep.notes.push_back(n);
   const Stopwatch t1;
   // A cable whose audit would pass a limit is refused at its element of the harness file.
   rep.result = naming_cable_errors(scene.harness, [&] { return check_clashes(inputs, scene.parts, index, req); });
   if (scene.has_harness) audit_harness_supports(scene, index, rep);
+  if (scene.has_harness && !scene.routing.separation.empty())
+    rep.segregation = check_segregation(inputs, [&](int a, int b) {
+      const auto& cables = scene.harness.cables;
+      const auto cls = [&](int i) -> const std::string& {
+        return cables[static_cast<std::size_t>(scene.harness.find_cable(inputs[static_cast<std::size_t>(i)].id))]
+            .physical.cable_class;
+      };
+      return scene.routing.separation_between(cls(a), cls(b));
+    });
   rep.check_ms = t1.ms();
   rep.notes.insert(rep.notes.end(), rep.result.notes.begin(), rep.result.notes.end());
   return rep;

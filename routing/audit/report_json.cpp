@@ -116,6 +116,19 @@ json audit_report_json(const AuditReport& rep) {
     o["point"] = vec_json(sp.point);
     violations.push_back(o);
   }
+  for (const SegregationFinding& f : rep.segregation) {
+    json o;
+    o["kind"] = "segregation";
+    o["cable"] = rep.check_ids.at(static_cast<std::size_t>(f.cable));
+    o["other"] = rep.check_ids.at(static_cast<std::size_t>(f.other));
+    o["distance"] = f.distance;
+    o["required"] = f.required;
+    o["s"] = f.s;
+    o["s_other"] = f.s_other;
+    o["point"] = vec_json(f.point);
+    if (f.segment >= 0) o["segment"] = rep.segment_names.at(static_cast<std::size_t>(f.segment));
+    violations.push_back(o);
+  }
   j["violations"] = violations;
   j["clamps"] = clamps_json(rep);
   j["supports_checked"] = rep.supports_checked;
