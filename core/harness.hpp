@@ -22,6 +22,9 @@ struct CablePhysical {
   double diameter = 0.0;       ///< outer diameter (> 0), harness units
   double min_bend_radius = 0.0;  ///< smallest allowed centerline bend radius (≥ 0; 0 = unchecked)
   double cross_section = 0.0;  ///< conductor cross-section, harness units squared (0 = not given)
+  /// Segregation class, e.g. "power" or "signal" (empty: none); the scene's
+  /// [routing.separation] gives the least distance between two classes.
+  std::string cable_class;
 };
 
 /// One core of a multicore cable: it runs inside the cable's jacket from end to end.
@@ -92,8 +95,11 @@ struct Segment {
 /// A fixed support of the harness (a clip or fixing): the bundle is held at this point.
 struct Clamp {
   std::string id;
-  Vec3 position = Vec3::Zero();
+  Vec3 position = Vec3::Zero();  ///< on the bundle's centreline, harness units
   int segment = -1;  ///< index into Harness::segments of the segment it holds (−1: not given)
+  std::string part;  ///< the structure part it is fixed to, as last measured (empty: not known)
+  double bundle_diameter = 0.0;  ///< diameter of the bundle it holds, harness units (0: not known)
+  bool placed = false;  ///< true: placed by the router, false: given by the input file
   int line = 0;
 };
 

@@ -1,5 +1,7 @@
 #include "core/scene.hpp"
 
+#include <utility>
+
 namespace loom {
 
 const std::vector<std::string>& routing_planner_names() {
@@ -26,6 +28,12 @@ int Scene::find_part(const std::string& name) const {
   for (std::size_t i = 0; i < parts.size(); ++i)
     if (parts[i].name == name) return static_cast<int>(i);
   return -1;
+}
+
+double RoutingSettings::separation_between(const std::string& a, const std::string& b) const {
+  if (a.empty() || b.empty()) return 0.0;
+  const auto it = separation.find(a < b ? std::make_pair(a, b) : std::make_pair(b, a));
+  return it == separation.end() ? 0.0 : it->second;
 }
 
 }  // namespace loom

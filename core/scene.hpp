@@ -7,7 +7,9 @@
 #include "core/part.hpp"
 #include "core/units.hpp"
 
+#include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace loom {
@@ -38,6 +40,20 @@ struct RoutingSettings {
   /// stop on the time limit or on time-based convergence, so runs differ). With a budget,
   /// a seeded route is reproducible unless the time limit ends a plan first.
   Setting iterations;
+  /// Longest stretch of cable between two supports (ports or clamps within reach of
+  /// structure), scene units; default 450 mm (AC 43.13-1B allows 610 mm).
+  Setting clamp_spacing;
+  /// Largest gap between a clamped bundle's surface and the structure part the clamp is
+  /// fixed to, scene units; default 25 mm. The reach from the centreline adds the bundle radius.
+  Setting clamp_reach;
+  /// True when the scene sets clamp_spacing: only then are supports audited (unsupported-span)
+  /// and clamps placed after routing, so scenes written without supports in mind do not change.
+  bool supports = false;
+  /// [routing.separation]: least distance between the surfaces of cables of two classes,
+  /// scene units, keyed by the class pair in ascending order (symmetric).
+  std::map<std::pair<std::string, std::string>, double> separation;
+  /// The separation required between cables of classes a and b, or 0 when none is given.
+  double separation_between(const std::string& a, const std::string& b) const;
 };
 
 /// [simplify] of the scene file (α-SIM level of detail).

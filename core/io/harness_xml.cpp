@@ -288,6 +288,7 @@ class Reader {
     // points, branch by branch, then top-level ones; so read → write → read is the identity.
     std::stable_partition(h.segments.begin(), h.segments.end(),
                           [](const Segment& s) { return !s.parent_branch.empty(); });
+    resolve_clamp_segments(h);
     return h;
   }
 
@@ -322,9 +323,13 @@ class Reader {
         } else if (sn == "physical") {
           if (have_phys) fail(sub, "duplicate <physical>");
           have_phys = true;
-          only_attributes(sub, {"type", "color", "colour", "diameter", "min_bend_radius"});
+          only_attributes(sub, {"type", "color", "colour", "diameter", "min_bend_radius", "class"});
           leaf(sub);
           cab.physical.type = sub.attribute("type").value();
+          if (auto k = sub.attribute("class")) {
+            cab.physical.cable_class = k.value();
+            if (cab.physical.cable_class.empty()) fail(sub, "attribute 'class' is empty");
+          }
           if (sub.attribute("color") && sub.attribute("colour"))
             fail(sub, "both 'color' and 'colour' given: one would be ignored");
           cab.physical.color = sub.attribute("color") ? sub.attribute("color").value() : sub.attribute("colour").value();
@@ -461,14 +466,60 @@ class Reader {
         }
       } else if (n == "segment") {
         read_segment(c, h, "");
+      } else if (n == "clamp") {
+        read_clamp(c, h);
       } else {
         unknown_child(node, c);
       }
     }
   }
 
+  /// <clamp id x y z [segment="FROM/TO"] [part] [placed]/>: a support holding the bundle
+  /// at (x, y, z); its segment is resolved once every segment is read (resolve_clamp_segments).
+  void read_clamp(const pugi::xml_node& c, Harness& h) {
+    only_attributes(c, {"id", "x", "y", "z", "segment", "part", "placed"});
+    leaf(c);
+    Clamp k;
+    k.id = required(c, "id");
+    k.line = line(c);
+    k.position = point(c);
+    for (const Clamp& other : h.clamps)
+      if (other.id == k.id) fail(c, "duplicate clamp id (first on line " + std::to_string(other.line) + ")");
+    k.part = c.attribute("part").value();
+    if (auto a = c.attribute("placed")) {
+      const std::string v = a.value();
+      if (v != "true" && v != "false") fail(c, "placed must be 'true' or 'false', got '" + v + "'");
+      k.placed = v == "true";
+    }
+    clamp_nodes_.push_back(c);
+    h.clamps.push_back(std::move(k));
+  }
+
+  /// Sets each clamp's segment index from its `segment="FROM/TO"` attribute (either end
+  /// first): the attribute is compared whole with every segment's two spellings, so node
+  /// ids holding '/' still resolve unless two segments spell the same.
+  void resolve_clamp_segments(Harness& h) const {
+    for (std::size_t k = 0; k < h.clamps.size(); ++k) {
+      const pugi::xml_node c = clamp_nodes_[k];
+      const auto a = c.attribute("segment");
+      if (!a) continue;
+      const std::string want = a.value();
+      if (want.empty()) fail(c, "attribute 'segment' is empty");
+      int found = -1;
+      for (std::size_t s = 0; s < h.segments.size(); ++s) {
+        const Segment& seg = h.segments[s];
+        if (want != seg.from + "/" + seg.to && want != seg.to + "/" + seg.from) continue;
+        if (found >= 0) fail(c, "segment '" + want + "' names more than one segment");
+        found = static_cast<int>(s);
+      }
+      if (found < 0) fail(c, "unknown segment '" + want + "' (write it as FROM/TO, the ids of its two nodes)");
+      h.clamps[k].segment = found;
+    }
+  }
+
   LineMap lines_;
   std::string file_;
+  std::vector<pugi::xml_node> clamp_nodes_;  ///< the <clamp> element of each Harness::clamps entry
 };
 
 std::string fmt(double v) { return full_precision(v); }
@@ -548,6 +599,7 @@ std::string harness_to_xml(const Harness& h) {
     ph.append_attribute("color") = c.physical.color.c_str();
     ph.append_attribute("diameter") = fmt(c.physical.diameter).c_str();
     ph.append_attribute("min_bend_radius") = fmt(c.physical.min_bend_radius).c_str();
+    if (!c.physical.cable_class.empty()) ph.append_attribute("class") = c.physical.cable_class.c_str();
   }
   auto st = root.append_child("structure");
   for (const auto& p : h.ports) {
@@ -568,6 +620,17 @@ std::string harness_to_xml(const Harness& h) {
   for (const auto& s : h.segments)
     if (s.parent_branch.empty() || h.find_branch(s.parent_branch) < 0 || !nested_under(s, s.parent_branch))
       put_segment(st, s, false);
+  for (const Clamp& k : h.clamps) {
+    auto e = st.append_child("clamp");
+    e.append_attribute("id") = k.id.c_str();
+    put_point(e, k.position);
+    if (k.segment >= 0 && static_cast<std::size_t>(k.segment) < h.segments.size()) {
+      const Segment& seg = h.segments[static_cast<std::size_t>(k.segment)];
+      e.append_attribute("segment") = (seg.from + "/" + seg.to).c_str();
+    }
+    if (!k.part.empty()) e.append_attribute("part") = k.part.c_str();
+    if (k.placed) e.append_attribute("placed") = "true";
+  }
   std::ostringstream os;
   doc.save(os, "  ", pugi::format_default, pugi::encoding_utf8);
   return os.str();

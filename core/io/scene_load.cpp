@@ -227,6 +227,38 @@ void place_harness(const TomlReader& r, const toml::table& ht, Harness& h, Scene
   if (report) report->notes.insert(report->notes.end(), notes.begin(), notes.end());
 }
 
+/// [routing] clamp_spacing and clamp_reach (positive, finite, scene units) and the
+/// [routing.separation] table of class pairs (`power.signal = 50.0`, symmetric).
+void read_supports(const TomlReader& r, const toml::table& rt, RoutingSettings& out) {
+  for (const char* key : {"clamp_spacing", "clamp_reach"}) {
+    const auto v = r.number(rt, "routing", key);
+    if (!v) continue;
+    if (!(*v > 0.0)) r.fail(rt.get(key), std::string("routing.") + key, "must be positive, got " + full_precision(*v));
+    (std::string(key) == "clamp_spacing" ? out.clamp_spacing : out.clamp_reach) = {*v, "scene file"};
+  }
+  out.supports = rt.get("clamp_spacing") != nullptr;
+  const toml::node* sn = rt.get("separation");
+  if (!sn) return;
+  const toml::table* sep = sn->as_table();
+  if (!sep) r.fail(sn, "routing.separation", "expected a table [routing.separation] (power.signal = 50.0)");
+  for (const auto& [a, an] : *sep) {
+    const std::string where = "routing.separation." + std::string(a.str());
+    const toml::table* inner = an.as_table();
+    if (!inner) r.fail(&an, where, "expected CLASS.CLASS = distance, e.g. power.signal = 50.0");
+    for (const auto& [b, bn] : *inner) {
+      const std::string key = where + "." + std::string(b.str());
+      const auto d = r.number(*inner, where, std::string(b.str()).c_str());
+      if (!(*d > 0.0)) r.fail(&bn, key, "must be positive, got " + full_precision(*d));
+      const std::string ca(a.str()), cb(b.str());
+      const auto pair = ca < cb ? std::make_pair(ca, cb) : std::make_pair(cb, ca);
+      const auto [it, fresh] = out.separation.emplace(pair, *d);
+      if (!fresh && it->second != *d)
+        r.fail(&bn, key, "contradicts " + pair.first + "." + pair.second + " = " + full_precision(it->second) +
+                             " given for the same pair (the separation is symmetric)");
+    }
+  }
+}
+
 }  // namespace
 
 void apply_routes(Scene& scene, const std::filesystem::path& routes) {
@@ -304,8 +336,12 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
                              dmin > 0 ? "default: smallest cable diameter" : "default: 1 mm (no cables)"};
   scene.routing.time_limit = {1.0, "default: 1 s per cable or bundle"};
   scene.routing.iterations = {0.0, "default: none (stop on time and convergence)"};
+  scene.routing.clamp_spacing = {450.0 * mm, "default: 450 mm"};
+  scene.routing.clamp_reach = {25.0 * mm, "default: 25 mm"};
   if (const toml::table* rt = r.section(doc, "routing")) {
-    r.only_keys(*rt, "routing", {"clearance", "planner", "time_limit", "seed", "iterations"});
+    r.only_keys(*rt, "routing",
+                {"clearance", "planner", "time_limit", "seed", "iterations", "clamp_spacing", "clamp_reach", "separation"});
+    read_supports(r, *rt, scene.routing);
     if (auto v = r.number(*rt, "routing", "clearance")) {
       if (*v < 0) r.fail(rt->get("clearance"), "routing.clearance", "must not be negative");
       scene.routing.clearance = {*v, "scene file"};

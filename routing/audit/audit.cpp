@@ -115,6 +115,20 @@ double run_together_radius(const HarnessTopology& topo, SegmentCurves& curves, c
   return out;
 }
 
+/// The supports audit of a scene (clamps always; unsupported spans when the scene sets
+/// clamp_spacing), through the audit's index or, for the brute-force baseline, over every
+/// triangle.
+void audit_harness_supports(const Scene& scene, const ObstacleIndex* index, AuditReport& rep) {
+  const RoutingSettings& r = scene.routing;
+  rep.supports_checked = r.supports;
+  if (!r.supports && scene.harness.clamps.empty()) return;
+  std::unique_ptr<BruteForceIndex> brute;
+  if (!index) index = (brute = std::make_unique<BruteForceIndex>(scene.parts)).get();
+  rep.supports =
+      audit_supports(scene.harness, scene.parts, *index, r.clamp_spacing.value, r.clamp_reach.value, r.supports);
+  rep.notes.insert(rep.notes.end(), rep.supports.notes.begin(), rep.supports.notes.end());
+}
+
 /// Relative widening of the port's query box over the largest per-part reach (rounding only).
 constexpr double kReachRoundingRel = 1e-12;
 
@@ -297,11 +311,22 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
     rep.index_name = "none";
     rep.index_accuracy = "brute force over every triangle (double precision)";
   }
+  for (const Segment& s : scene.harness.segments) rep.segment_names.push_back(s.from + "/" + s.to);
   if (scene.has_harness)
     for (auto& n : attach_ports(scene.harness, scene.parts, req.routing_clearance, inputs, index)) rep.notes.push_back(n);
   const Stopwatch t1;
   // A cable whose audit would pass a limit is refused at its element of the harness file.
   rep.result = naming_cable_errors(scene.harness, [&] { return check_clashes(inputs, scene.parts, index, req); });
+  if (scene.has_harness) audit_harness_supports(scene, index, rep);
+  if (scene.has_harness && !scene.routing.separation.empty())
+    rep.segregation = check_segregation(inputs, [&](int a, int b) {
+      const auto& cables = scene.harness.cables;
+      const auto cls = [&](int i) -> const std::string& {
+        return cables[static_cast<std::size_t>(scene.harness.find_cable(inputs[static_cast<std::size_t>(i)].id))]
+            .physical.cable_class;
+      };
+      return scene.routing.separation_between(cls(a), cls(b));
+    });
   rep.check_ms = t1.ms();
   rep.notes.insert(rep.notes.end(), rep.result.notes.begin(), rep.result.notes.end());
   return rep;
@@ -353,6 +378,9 @@ void check_routes_match(const Harness& designed, const Harness& routes) {
     if (c.physical.diameter != want.physical.diameter)
       throw InputError(where, "diameter " + full_precision(c.physical.diameter) + ", but " +
                                   full_precision(want.physical.diameter) + scene_says);
+    if (c.physical.cable_class != want.physical.cable_class)
+      throw InputError(where, "class '" + c.physical.cable_class + "', but '" + want.physical.cable_class + "'" +
+                                  scene_says);
     if (c.physical.min_bend_radius != want.physical.min_bend_radius)
       throw InputError(where, "min_bend_radius " + full_precision(c.physical.min_bend_radius) + ", but " +
                                   full_precision(want.physical.min_bend_radius) + scene_says);

@@ -6,6 +6,8 @@
 #include "core/progress.hpp"
 #include "core/scene.hpp"
 #include "routing/audit/clash_check.hpp"
+#include "routing/audit/segregation.hpp"
+#include "routing/audit/supports.hpp"
 
 #include <filesystem>
 #include <optional>
@@ -53,9 +55,20 @@ struct AuditReport {
   double check_ms = 0.0;
   std::size_t triangles = 0;
   std::vector<std::string> notes;
+  /// Clamps and unsupported spans; spans are checked only when `supports_checked` (the
+  /// scene sets [routing] clamp_spacing), clamps are always listed.
+  SupportAudit supports;  ///< span cable indices refer to `cables` (harness order)
+  bool supports_checked = false;
+  /// Cables of separated classes too close or sharing a bundle (indices refer to check_ids).
+  std::vector<SegregationFinding> segregation;
+  /// Each harness segment as FROM/TO (the spelling of <clamp segment>), by segment index.
+  std::vector<std::string> segment_names;
 
   /// True when any clash or violation was found.
-  bool found_problems() const { return !result.clashes.empty() || !result.violations.empty(); }
+  bool found_problems() const {
+    return !result.clashes.empty() || !result.violations.empty() || !supports.spans.empty() ||
+           !segregation.empty();
+  }
   /// True when some harness cable could not be checked (a segment of its chain has no
   /// curve yet, e.g. an unplaced branch point): see `cables[i].reason`.
   bool any_unchecked() const {

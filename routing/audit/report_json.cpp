@@ -27,6 +27,24 @@ void put(json& j, const std::string& key, double v, const std::string& why) {
     j[key + "_note"] = why;
 }
 
+/// report.json "clamps": each clamp with the part it is fixed to (null: no structure within
+/// reach), the segment it holds as FROM/TO (null: none) and the bundle's diameter.
+json clamps_json(const AuditReport& rep) {
+  json out = json::array();
+  for (const ClampLoad& c : rep.supports.clamps) {
+    json o;
+    o["id"] = c.id;
+    o["point"] = vec_json(c.point);
+    o["part"] = c.part >= 0 ? json(rep.part_names.at(static_cast<std::size_t>(c.part))) : json(nullptr);
+    if (c.part >= 0) o["distance"] = c.distance;
+    o["segment"] = c.segment >= 0 ? json(rep.segment_names.at(static_cast<std::size_t>(c.segment))) : json(nullptr);
+    o["bundle_diameter"] = c.bundle_diameter;
+    o["placed"] = c.placed;
+    out.push_back(o);
+  }
+  return out;
+}
+
 }  // namespace
 
 json audit_report_json(const AuditReport& rep) {
@@ -87,7 +105,33 @@ json audit_report_json(const AuditReport& rep) {
     o["point"] = vec_json(v.point);
     violations.push_back(o);
   }
+  for (const UnsupportedSpan& sp : rep.supports.spans) {
+    json o;
+    o["kind"] = "unsupported-span";
+    o["cable"] = rep.cables.at(static_cast<std::size_t>(sp.cable)).id;
+    o["from_s"] = sp.from_s;
+    o["to_s"] = sp.to_s;
+    o["length"] = sp.to_s - sp.from_s;
+    o["spacing"] = sp.spacing;
+    o["point"] = vec_json(sp.point);
+    violations.push_back(o);
+  }
+  for (const SegregationFinding& f : rep.segregation) {
+    json o;
+    o["kind"] = "segregation";
+    o["cable"] = rep.check_ids.at(static_cast<std::size_t>(f.cable));
+    o["other"] = rep.check_ids.at(static_cast<std::size_t>(f.other));
+    o["distance"] = f.distance;
+    o["required"] = f.required;
+    o["s"] = f.s;
+    o["s_other"] = f.s_other;
+    o["point"] = vec_json(f.point);
+    if (f.segment >= 0) o["segment"] = rep.segment_names.at(static_cast<std::size_t>(f.segment));
+    violations.push_back(o);
+  }
   j["violations"] = violations;
+  j["clamps"] = clamps_json(rep);
+  j["supports_checked"] = rep.supports_checked;
 
   json cables = json::array();
   for (const AuditCable& c : rep.cables) {

@@ -6,6 +6,8 @@
 #include "index/simplify/alpha_sim.hpp"
 #include "index/embree_index.hpp"
 #include "routing/audit/clash_check.hpp"
+#include "routing/audit/supports.hpp"
+#include "routing/route/clamp_placement.hpp"
 #include "routing/curve/bend_repair.hpp"
 #include "routing/route/branch_layout.hpp"
 #include "routing/route/port_check.hpp"
@@ -162,6 +164,7 @@ class RouteRun {
   void audit_and_repair();
   AuditReport audit_now();
   std::set<int> segments_to_repair() const;
+  void place_supports();
   void note_reproducibility();
   void note_nominal_lengths();
 
@@ -673,6 +676,24 @@ void RouteRun::audit_and_repair() {
   }
   rep_.timing.repair = t0.ms();
   for (const auto& f : failed_segments_) rep_.notes.push_back("segment " + f + " could not be routed");
+  if (scene_.routing.supports && audit_options_.index) place_supports();
+}
+
+/// Replaces the clamps an earlier run placed by clamps along the final curves
+/// (place_clamps), and audits the supports again with them (the rest of the audit does not
+/// depend on clamps).
+void RouteRun::place_supports() {
+  const Stopwatch t0;
+  const double spacing = scene_.routing.clamp_spacing.value, reach = scene_.routing.clamp_reach.value;
+  h_.clamps.erase(std::remove_if(h_.clamps.begin(), h_.clamps.end(), [](const Clamp& c) { return c.placed; }),
+                  h_.clamps.end());
+  const ClampPlacement placed = place_clamps(h_, scene_.parts, *audit_options_.index, spacing, reach);
+  h_.clamps.insert(h_.clamps.end(), placed.clamps.begin(), placed.clamps.end());
+  rep_.clamps_placed = placed.clamps.size();
+  rep_.share_within_reach = placed.share_within_reach();
+  routed_scene_.harness.clamps = h_.clamps;  // audit_now keeps every segment, so indices hold
+  rep_.audit.supports = audit_supports(routed_scene_.harness, scene_.parts, *audit_options_.index, spacing, reach, true);
+  rep_.timing.audit += t0.ms();
 }
 
 /// Says why another run with the same seed may give other routes (RouteReport::unreproducible,

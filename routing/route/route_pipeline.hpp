@@ -91,6 +91,10 @@ struct RouteReport {
   /// threaded planner, each segment whose plan the time limit ended). Also in `notes`.
   std::vector<std::string> unreproducible;
   double clearance = 0.0;                ///< required clearance used
+  /// Supports (the scene sets clamp_spacing): clamps placed, and the share of the routed
+  /// cable length whose bundle is within clamp_reach of structure (−1: not measured).
+  std::size_t clamps_placed = 0;
+  double share_within_reach = -1.0;
   std::vector<std::string> notes;
   /// DESIGN §4: 3 if a cable could not be routed, else 1 if clashes/violations remain, else 0.
   int exit_code() const { return !unrouted.empty() ? 3 : audit.exit_code(); }
