@@ -13,6 +13,13 @@
 
 namespace loom::kbl_dom {
 
+/// How loom parses KBL text, reading and writing alike. The writer keeps declarations,
+/// processing instructions and comments, so the reader parses them too: a text the reader
+/// accepts must parse again when it is written back (a malformed comment, skipped unread
+/// by pugixml's default flags, made the writer fail on a file the reader had taken).
+constexpr unsigned kKblParseFlags =
+    pugi::parse_default | pugi::parse_doctype | pugi::parse_declaration | pugi::parse_pi | pugi::parse_comments;
+
 /// The element name without a namespace prefix ("kbl:Node" → "Node").
 inline std::string_view local_name(const pugi::xml_node& n) {
   const char* name = n.name();

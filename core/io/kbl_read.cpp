@@ -905,7 +905,7 @@ Harness KblReader::read(const pugi::xml_document& doc, std::shared_ptr<const std
 Harness parse_harness_kbl(std::string text, const std::string& name_for_errors) {
   auto owned = std::make_shared<const std::string>(std::move(text));
   pugi::xml_document doc;
-  const auto res = doc.load_buffer(owned->data(), owned->size(), pugi::parse_default | pugi::parse_doctype);
+  const auto res = doc.load_buffer(owned->data(), owned->size(), kbl_dom::kKblParseFlags);
   const LineMap lines(*owned);
   if (!res) throw InputError({name_for_errors, lines.line(res.offset), ""}, std::string("malformed XML: ") + res.description());
   for (auto n : doc.children())

@@ -286,8 +286,7 @@ void KblWriter::drop_unused_points(const std::set<std::string>& candidates) {
 }
 
 std::string KblWriter::write() {
-  const auto res = doc_.load_buffer(o_.text->data(), o_.text->size(),
-                                    pugi::parse_default | pugi::parse_declaration | pugi::parse_pi | pugi::parse_comments);
+  const auto res = doc_.load_buffer(o_.text->data(), o_.text->size(), kbl_dom::kKblParseFlags);
   if (!res) throw std::invalid_argument("harness_to_kbl: the KBL text kept from " + h_.source_file + " does not parse");
   root_ = doc_.document_element();
   kbl_dom::for_each_node(root_, [&](const pugi::xml_node& n) {

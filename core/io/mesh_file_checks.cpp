@@ -8,6 +8,7 @@
 #include <array>
 #include <cctype>
 #include <charconv>
+#include <cstring>
 #include <cmath>
 #include <cstdlib>
 #include <cstdint>
@@ -85,8 +86,26 @@ int line_at(const std::string& text, std::size_t at) {
 /// they are all of it) ends, holding no NUL byte. Why: Assimp's line reader looks for a
 /// newline past the end of its buffer: a header without end_header spun forever, one with a
 /// NUL read out of bounds (SIGSEGV).
+/// Where the header's end_header keyword starts, as Assimp finds it: the first word of a
+/// line (after blanks), followed by a blank or the line's end; npos if no line holds it.
+/// Why not any "end_header": Assimp reads "end_headerrty" as another header line and, with
+/// no real end after it, spun forever at the end of the file.
+std::size_t find_end_header(const std::string& head) {
+  constexpr std::size_t kLen = 10;  // "end_header"
+  for (std::size_t line = 0; line < head.size();) {
+    std::size_t at = head.find_first_not_of(" \t", line);
+    if (at != std::string::npos && head.compare(at, kLen, "end_header") == 0 &&
+        (at + kLen == head.size() || std::strchr(" \t\r\n", head[at + kLen]) != nullptr))
+      return at;
+    const std::size_t nl = head.find('\n', line);
+    if (nl == std::string::npos) break;
+    line = nl + 1;
+  }
+  return std::string::npos;
+}
+
 void check_ply_header_ends(const std::string& head, bool whole, const std::filesystem::path& path) {
-  const std::size_t end = head.find("end_header");
+  const std::size_t end = find_end_header(head);
   const std::size_t nul = head.find('\0');
   if (nul < end)
     throw InputError({path.string(), line_at(head, nul), "PLY header"}, "holds a NUL byte (a binary or corrupt file?)");
@@ -104,7 +123,7 @@ bool read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
   const std::string head = file_bytes(path, kMaxHeader);
   if (head.compare(0, 3, "ply") != 0) return false;  // Assimp finds no PLY reader for it
   check_ply_header_ends(head, head.size() < kMaxHeader, path);
-  const std::size_t end = head.find("end_header");
+  const std::size_t end = find_end_header(head);
   const std::size_t data_at = head.find('\n', end);
   out.data_at = data_at + 1;
   out.header_lines = line_at(head, data_at);

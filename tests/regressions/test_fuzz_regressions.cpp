@@ -20,6 +20,7 @@
 
 #include "core/error.hpp"
 #include "core/io/harness_xml.hpp"
+#include "core/io/kbl_read.hpp"
 #include "core/io/mesh_node_checks.hpp"
 #include "core/io/mesh_read.hpp"
 #include "core/io/toml_checks.hpp"
@@ -372,7 +373,7 @@ TEST(FuzzRegression, EveryKeptFindingIsRefusedNamingTheFile) {
       fs::create_directories(d);
       const std::string name = entry.path().filename().string();
       fs::copy_file(entry.path(), d / name);
-      const bool harness = entry.path().extension() == ".xml";
+      const bool harness = entry.path().extension() == ".xml" || entry.path().extension() == ".kbl";
       write(d / "scene.toml", harness ? "[scene]\n[harness]\nfile = '" + name + "'\n"
                                       : "[scene]\n[[part]]\nfile = '" + name + "'\n");
       const auto r = run_bounded("info " + (d / "scene.toml").string() + " --quiet");
@@ -381,7 +382,38 @@ TEST(FuzzRegression, EveryKeptFindingIsRefusedNamingTheFile) {
       ++seen;
     }
   }
-  EXPECT_GE(seen, 8);
+  EXPECT_GE(seen, 10);
+}
+
+// A processing instruction with a malformed target (<?ele'na ...?>, libFuzzer from a real
+// KBL's header): the reader's parse skipped it, the writer's, which keeps instructions,
+// refused it, and writing routed.kbl threw past the command's error handling.
+TEST(FuzzRegression, KblMalformedInstructionReadButNotWritable) {
+  const std::string kbl = slurp(fs::path(LOOM_TEST_DATA) / "formboard/mini-2d.kbl");
+  const std::size_t decl_end = kbl.find("?>") + 2;
+  ASSERT_NE(decl_end, std::string::npos + 2);
+  const std::string bad = kbl.substr(0, decl_end) + "\n<?ele'na version=\"2.8\"?>" + kbl.substr(decl_end);
+  const std::string e = input_error([&] { loom::parse_harness_kbl(bad, "h.kbl"); });
+  EXPECT_NE(e.find("h.kbl:2: malformed XML"), std::string::npos) << e;
+  // A well-formed instruction, as CAD exports write them, is read.
+  const std::string good = kbl.substr(0, decl_end) + "\n<?pc checksum=\"695947884\"?>" + kbl.substr(decl_end);
+  EXPECT_EQ(loom::parse_harness_kbl(good, "h.kbl").cables.size(), loom::parse_harness_kbl(kbl, "h.kbl").cables.size());
+}
+
+// "end_headerrty" where end_header belongs (libFuzzer): the pre-check found the substring
+// and passed the file; Assimp, which wants end_header as a word of its own, read on past
+// the end of the file forever.
+TEST(FuzzRegression, PlyEndHeaderRunIntoTheNextWordHung) {
+  const fs::path d = scratch();
+  write(d / "run.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_headerrty float y\n1\n");
+  const auto r = bounded_info_of_part(d, "run.ply");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("run.ply:6: end_header: PLY header does not end"), std::string::npos) << r.out;
+  // Blanks before it and a carriage return after it still end the header.
+  write(d / "ok.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                      "property float z\nelement face 1\nproperty list uchar int vertex_indices\n  end_header\r\n"
+                      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  EXPECT_EQ(loom::read_mesh_file(d / "ok.ply").triangle_count(), 1u);
 }
 
 // A mesh PLY whose header never reaches end_header: Assimp's line reader spun forever (and
