@@ -12,6 +12,10 @@
 # other than InputError prints the target, the report and the input in base64, and the
 # script exits 1 after the remaining targets have run.
 #
+# Runs are reproducible: libFuzzer starts from LOOM_FUZZ_SEED (default 1), so a run from the
+# repository's seeds explores the same inputs in the same order; a shorter run (a slower
+# machine) explores a prefix of a longer one.
+#
 # Environment: LOOM_FUZZ_BUILD_DIR (default build-fuzz), LOOM_JOBS (default nproc),
 # LOOM_FUZZ_TIMEOUT (seconds one input may take, default 30), LOOM_FUZZ_RSS_MB (default
 # 2048), LOOM_FUZZ_MAX_SEED (bytes, default 65536), LOOM_SHARED_DATA (default
@@ -23,6 +27,7 @@ jobs="${LOOM_JOBS:-$(nproc)}"
 per_input="${LOOM_FUZZ_TIMEOUT:-30}"
 rss_mb="${LOOM_FUZZ_RSS_MB:-2048}"
 max_seed="${LOOM_FUZZ_MAX_SEED:-65536}"
+seed="${LOOM_FUZZ_SEED:-1}"
 shared="${LOOM_SHARED_DATA:-$root/../shared/data}"
 
 # The tests run under the sanitizers (--unit-tests): the suites that feed loom hostile or
@@ -126,7 +131,7 @@ for t in "${targets[@]}"; do
   rm -rf "$TMPDIR" && mkdir -p "$TMPDIR"
   echo "fuzz.sh: fuzz_$t for $seconds s ($(ls "$corpus" | wc -l) corpus files)"
   rc=0
-  nice -n 10 "$build/tests/fuzz/fuzz_$t" $dict_opt -max_total_time="$seconds" -timeout="$per_input" \
+  nice -n 10 "$build/tests/fuzz/fuzz_$t" $dict_opt -max_total_time="$seconds" -seed="$seed" -timeout="$per_input" \
     -rss_limit_mb="$rss_mb" -artifact_prefix="$art/" -print_final_stats=1 "$corpus" >"$log" 2>&1 || rc=$?
   rm -rf "$TMPDIR"
   execs="$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n1)"
