@@ -14,6 +14,7 @@
 //                triangle-scaling scene; BUILD_QUALITY as EmbreeOptions, -1 = automatic)
 //   bench_audit --assembly TRIS_PER_PART [MAX_COPIES]   (the assembly series alone, printed)
 #include "bench/audit_scenes.hpp"
+#include "bench/audit_timing.hpp"
 #include "bench/forwarding_index.hpp"
 #include "index/embree_index.hpp"
 #include "routing/audit/clash_check.hpp"
@@ -67,18 +68,9 @@ BenchScene with_far_copies(const BenchScene& base, int copies) {
   return sc;
 }
 
-double now_ms() {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-/// Process CPU time (all threads), ms: the work done, robust to other load on the machine.
-double cpu_ms() { return 1000.0 * static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
-
-struct Timed {
-  ClashResult res;
-  double ms = 0.0;      ///< wall clock, best run
-  double cpu = 0.0;     ///< process CPU time of that run
-};
+using bench::cpu_ms;
+using bench::now_ms;
+using bench::Timed;
 
 /// `req` with only the chosen kinds of check switched on.
 ClashRequest with_checks(ClashRequest req, bool structure, bool cable_cable, bool self, bool bend) {
@@ -90,20 +82,8 @@ ClashRequest with_checks(ClashRequest req, bool structure, bool cable_cable, boo
 }
 
 /// Best of `reps` runs.
-Timed timed_check(const BenchScene& sc, const ObstacleIndex* idx, ClashRequest req, int reps = 3) {
-  Timed t;
-  t.ms = 1e300;
-  for (int i = 0; i < reps; ++i) {
-    const double t0 = now_ms(), c0 = cpu_ms();
-    ClashResult r = check_clashes(sc.cables, sc.parts, idx, req);
-    const double dt = now_ms() - t0, dc = cpu_ms() - c0;
-    if (dt < t.ms) {
-      t.ms = dt;
-      t.cpu = dc;
-      t.res = std::move(r);
-    }
-  }
-  return t;
+Timed timed_check(const BenchScene& sc, const ObstacleIndex* idx, const ClashRequest& req, int reps = 3) {
+  return bench::timed_check(sc.cables, sc.parts, idx, req, reps);
 }
 
 using ClashKey = std::tuple<int, int, int>;  // kind, cable, part or other cable

@@ -16,6 +16,7 @@
 //   bench_harness_audit --probe WIRES [THREADS]      (bundle level alone, per-check CPU split)
 #include "bench/audit_compare.hpp"
 #include "bench/audit_scenes.hpp"
+#include "bench/audit_timing.hpp"
 #include "bench/harness_gen.hpp"
 #include "core/harness_topology.hpp"
 #include "index/embree_index.hpp"
@@ -34,13 +35,6 @@
 using namespace loom;
 
 namespace {
-
-double now_ms() {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-/// Process CPU time (all threads), ms: the work done, robust to other load on the machine.
-double cpu_ms() { return 1000.0 * static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
 
 /// A harness audited: its cables as the checker sees them, the parts and their index.
 struct HarnessScene {
@@ -69,27 +63,14 @@ HarnessScene make_harness_scene(const std::string& name, const bench::HarnessSha
   return sc;
 }
 
-struct Timed {
-  ClashResult res;
-  double ms = 0.0;   ///< wall clock, best run
-  double cpu = 0.0;  ///< process CPU time of that run
-};
+using bench::cpu_ms;
+using bench::now_ms;
+using bench::Timed;
 
+/// Best of `reps` runs of the audit (bench::timed_check).
 Timed timed(const std::vector<CableInput>& cables, const std::vector<Part>& parts, const ObstacleIndex* index,
-            ClashRequest req, int reps) {
-  Timed t;
-  t.ms = 1e300;
-  for (int i = 0; i < reps; ++i) {
-    const double t0 = now_ms(), c0 = cpu_ms();
-    ClashResult r = check_clashes(cables, parts, index, req);
-    const double dt = now_ms() - t0, dc = cpu_ms() - c0;
-    if (dt < t.ms) {
-      t.ms = dt;
-      t.cpu = dc;
-      t.res = std::move(r);
-    }
-  }
-  return t;
+            const ClashRequest& req, int reps) {
+  return bench::timed_check(cables, parts, index, req, reps);
 }
 
 ClashRequest request(bool per_cable, int threads) {
