@@ -29,6 +29,7 @@
 #include "routing/curve/cable_geometry.hpp"
 #include "routing/scan/point_cloud_io.hpp"
 #include "common/run_loom.hpp"
+#include "common/test_files.hpp"
 #include "common/shared_data.hpp"
 
 namespace {
@@ -37,32 +38,12 @@ namespace fs = std::filesystem;
 using loom::InputError;
 
 /// A fresh scratch directory for the running test.
-fs::path scratch() {
-  const fs::path d = fs::temp_directory_path() /
-                     ("loom_input_regression_" + std::string(testing::UnitTest::GetInstance()->current_test_info()->name()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path scratch() { return loom::testing::scratch_dir("loom_input_regression_"); }
 
-void write(const fs::path& p, const std::string& bytes) { std::ofstream(p, std::ios::binary) << bytes; }
+void write(const fs::path& p, const std::string& bytes) { loom::testing::write_file(p, bytes); }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(f), {});
-}
-
-/// The InputError message of `f()`, or "" with a test failure if it throws none.
-template <typename F>
-std::string input_error(F f) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError";
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return {};
-}
+using loom::testing::input_error;
+using loom::testing::slurp;
 
 /// Runs `loom ARGS` (stderr merged) and returns exit status and output.
 std::pair<int, std::string> loom(const std::string& args) {
