@@ -184,6 +184,20 @@ struct HandHarness {
   }
 };
 
+/// Three ports L0, L1, L2 left of the origin gathered into node A at the origin (through
+/// branch point A2): the start of a trunk that leaves A.
+void add_left_fan(HandHarness& hh) {
+  hh.branch("A", {0, 0, 0});
+  hh.branch("A2", {-40, 40, 0});
+  hh.port("L0", {-40, -40, 0}, {1, 1, 0});
+  hh.port("L1", {-80, 60, 0}, {2, -1, 0});
+  hh.port("L2", {-80, 20, 0}, {2, 1, 0});
+  hh.segment("L0", "A");
+  hh.segment("A2", "A");
+  hh.segment("L1", "A2");
+  hh.segment("L2", "A2");
+}
+
 const std::vector<double> kDiameters{1.2, 2.0, 3.0, 1.6, 2.6};
 
 /// The per-cable and bundle audits agree (compare_findings, with the oracle).
@@ -273,15 +287,7 @@ TEST(BundleAudit, ACableLeavingItsBundleIntoAnother) {
   // bundle that climbs and crosses the first 2 above its axis at x = 250. Cables that shared
   // the trunk and the node B clash at the crossing (not within B's breakout), by radii.
   HandHarness hh;
-  hh.branch("A", {0, 0, 0});
-  hh.branch("A2", {-40, 40, 0});
-  hh.port("L0", {-40, -40, 0}, {1, 1, 0});
-  hh.port("L1", {-80, 60, 0}, {2, -1, 0});
-  hh.port("L2", {-80, 20, 0}, {2, 1, 0});
-  hh.segment("L0", "A");
-  hh.segment("A2", "A");
-  hh.segment("L1", "A2");
-  hh.segment("L2", "A2");
+  add_left_fan(hh);
   hh.branch("B", {100, 0, 0});
   hh.segment("A", "B");
   hh.branch("C", {400, 0, 0});
@@ -326,15 +332,7 @@ TEST(BundleAudit, ATrunkFoldedOnItself) {
   // thicker than 2.2 has one self clash at 2.2 − 2r; cables of the trunk never clash with
   // each other there (bundled); the hairpin bends tighter than any cable may.
   HandHarness hh;
-  hh.branch("A", {0, 0, 0});
-  hh.branch("A2", {-40, 40, 0});
-  hh.port("L0", {-40, -40, 0}, {1, 1, 0});
-  hh.port("L1", {-80, 60, 0}, {2, -1, 0});
-  hh.port("L2", {-80, 20, 0}, {2, 1, 0});
-  hh.segment("L0", "A");
-  hh.segment("A2", "A");
-  hh.segment("L1", "A2");
-  hh.segment("L2", "A2");
+  add_left_fan(hh);
   hh.branch("B", {0, 0, 2.2});
   std::vector<Vec3> hairpin;
   for (int k = 1; k <= 20; ++k) hairpin.emplace_back(10.0 * k, 0, 0);
