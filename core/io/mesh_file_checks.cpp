@@ -30,6 +30,23 @@ std::vector<std::string> words(const std::string& line) {
   return w;
 }
 
+/// `t` with every byte outside printable ASCII written as \xNN, for a message that names a
+/// corrupt token (a NUL would end the message where it is printed).
+std::string printable(const std::string& t) {
+  static const char* kHex = "0123456789abcdef";
+  std::string out;
+  for (const unsigned char c : t) {
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+    } else {
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    }
+  }
+  return out;
+}
+
 /// A decimal count; false for anything else. Values beyond 64 bits saturate (they are
 /// refused by the size checks like any other count the file cannot hold).
 bool parse_count(const std::string& t, std::uint64_t& v) {
@@ -117,11 +134,41 @@ void check_ply_header_ends(const std::string& head, bool whole, const std::files
   throw InputError({path.string(), line_at(head, last), "end_header"}, "PLY header does not end (truncated file?)");
 }
 
-/// The header of a PLY file; false for a header this check cannot parse (left to Assimp).
-bool read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
+/// One `property` line of a PLY header (words `w`, line `line_no`) into `p`. Throws
+/// InputError for a type that is not a PLY type.
+PlyProperty read_ply_property(const std::vector<std::string>& w, int line_no, const std::filesystem::path& path) {
+  PlyProperty p;
+  p.list = w.size() == 5 && w[1] == "list";
+  if (!p.list && w.size() != 3)
+    throw InputError({path.string(), line_no, "property"},
+                     "expected 'property TYPE NAME' or 'property list COUNT_TYPE TYPE NAME'");
+  p.count_bytes = p.list ? ply_scalar_bytes(w[2]) : 0;
+  p.count_signed = p.list && ply_scalar_signed(w[2]);
+  const std::string& type = p.list ? w[3] : w[1];
+  p.bytes = ply_scalar_bytes(type);
+  p.floating = type.rfind("float", 0) == 0 || type == "double";
+  // Assimp reads an unknown type as a property of no bytes and goes on with the data
+  // misaligned, into faces that abort its triangulation (ai_assert).
+  const std::string& bad = p.list && p.count_bytes == 0 ? w[2] : type;
+  if (p.bytes == 0 || (p.list && p.count_bytes == 0))
+    throw InputError({path.string(), line_no, "property"},
+                     "'" + printable(bad) + "' is not a PLY type (char uchar short ushort int uint float double, "
+                     "or int8 ... float64)");
+  return p;
+}
+
+/// The header of a PLY file. Every header line must be one this check understands: Assimp
+/// reads what it does not understand its own way (a `format` line it cannot parse left
+/// the data misaligned, into faces that abort its triangulation), so anything else is
+/// refused here, naming the line.
+void read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
   constexpr std::size_t kMaxHeader = 1 << 20;  // PLY headers are a few hundred bytes
   const std::string head = file_bytes(path, kMaxHeader);
-  if (head.compare(0, 3, "ply") != 0) return false;  // Assimp finds no PLY reader for it
+  // Assimp looks for the magic anywhere in the first bytes and then reads on from there
+  // (a file of "\0\0\xc0\x7fply\n..." hung in its reader): only a file that starts with it
+  // is a PLY file.
+  if (head.compare(0, 3, "ply") != 0)
+    throw InputError({path.string(), 1, "PLY header"}, "the file does not start with 'ply' (not a PLY file)");
   check_ply_header_ends(head, head.size() < kMaxHeader, path);
   const std::size_t end = find_end_header(head);
   const std::size_t data_at = head.find('\n', end);
@@ -129,42 +176,40 @@ bool read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
   out.header_lines = line_at(head, data_at);
   std::istringstream is(head.substr(0, end));
   int line_no = 0;
+  bool has_format = false;
   for (std::string line; std::getline(is, line);) {
     ++line_no;
     const auto w = words(line);
-    if (w.empty()) continue;
-    if (w[0] == "format" && w.size() >= 2) {
-      if (w[1] == "ascii") out.format = PlyLayout::Format::Ascii;
-      else if (w[1] == "binary_little_endian") out.format = PlyLayout::Format::BinaryLittle;
-      else if (w[1] == "binary_big_endian") out.format = PlyLayout::Format::BinaryBig;
-      else return false;
-    } else if (w[0] == "element" && w.size() == 3) {
+    auto refuse = [&](const std::string& what, const std::string& why) {
+      throw InputError({path.string(), line_no, what}, why);
+    };
+    if (w.empty() || w[0] == "comment" || w[0] == "obj_info" || (line_no == 1 && w[0] == "ply")) continue;
+    if (w[0] == "format") {
+      const std::string name = w.size() >= 2 ? w[1] : std::string();
+      if (name == "ascii") out.format = PlyLayout::Format::Ascii;
+      else if (name == "binary_little_endian") out.format = PlyLayout::Format::BinaryLittle;
+      else if (name == "binary_big_endian") out.format = PlyLayout::Format::BinaryBig;
+      else refuse("format", "'" + printable(name) + "' is not a PLY format (ascii, binary_little_endian, binary_big_endian)");
+      if (w.size() != 3 || has_format) refuse("format", "expected one 'format " + name + " 1.0' line");
+      has_format = true;
+    } else if (w[0] == "element") {
       PlyElementExtent e;
+      if (w.size() != 3 || !parse_count(w[2], e.count)) refuse("element", "expected 'element NAME COUNT' with a whole COUNT");
       e.name = w[1];
       e.line = line_no;
-      if (!parse_count(w[2], e.count)) return false;
       out.extents.push_back(e);
       out.properties.emplace_back();
-    } else if (w[0] == "property" && !out.extents.empty()) {
-      PlyProperty p;
-      p.list = w.size() == 5 && w[1] == "list";
-      p.count_bytes = p.list ? ply_scalar_bytes(w[2]) : 0;
-      p.count_signed = p.list && ply_scalar_signed(w[2]);
-      const std::string& type = p.list ? w[3] : (w.size() >= 2 ? w[1] : w[0]);
-      p.bytes = ply_scalar_bytes(type);
-      p.floating = type.rfind("float", 0) == 0 || type == "double";
-      // Assimp reads an unknown type as a property of no bytes and goes on with the data
-      // misaligned, into faces that abort its triangulation (ai_assert).
-      const std::string& bad = p.list && p.count_bytes == 0 ? w[2] : type;
-      if (p.bytes == 0 || (p.list && p.count_bytes == 0))
-        throw InputError({path.string(), line_no, "property"},
-                         "'" + bad + "' is not a PLY type (char uchar short ushort int uint float double, "
-                         "or int8 ... float64)");
+    } else if (w[0] == "property") {
+      if (out.extents.empty()) refuse("property", "a property before any element");
+      const PlyProperty p = read_ply_property(w, line_no, path);
       out.extents.back().min_bytes += p.list ? p.count_bytes : p.bytes;
       out.properties.back().push_back(p);
+    } else {
+      refuse(printable(w[0]), "'" + printable(w[0]) +
+                                  "' is not a PLY header keyword (format, element, property, comment, obj_info, end_header)");
     }
   }
-  return true;
+  if (!has_format) throw InputError({path.string(), 1, "format"}, "the PLY header has no format line");
 }
 
 /// Sequential reads over a file in blocks, so that walking a large PLY body costs one pass
@@ -382,10 +427,9 @@ void check_ply_ascii_body(const std::filesystem::path& path, const PlyLayout& la
 /// The PLY header's elements against the bytes after it (an instance takes at least one
 /// byte in ASCII, a line, and at least its fixed properties' bytes in binary, a list at
 /// least its length field), then every list's length against the bytes left after it.
-/// A header this check cannot parse is left to Assimp.
 void check_ply(const std::filesystem::path& path) {
   PlyLayout layout;
-  if (!read_ply_layout(path, layout)) return;
+  read_ply_layout(path, layout);
   std::error_code ec;
   const auto size = static_cast<std::uint64_t>(std::filesystem::file_size(path, ec));
   if (ec || size < layout.data_at) return;
@@ -396,23 +440,6 @@ void check_ply(const std::filesystem::path& path) {
 }
 
 // --- OFF ---------------------------------------------------------------------------------
-
-/// `t` with every byte outside printable ASCII written as \xNN, for a message that names a
-/// corrupt token (a NUL would end the message where it is printed).
-std::string printable(const std::string& t) {
-  static const char* kHex = "0123456789abcdef";
-  std::string out;
-  for (const unsigned char c : t) {
-    if (c >= 0x20 && c < 0x7f) {
-      out += static_cast<char>(c);
-    } else {
-      out += "\\x";
-      out += kHex[c >> 4];
-      out += kHex[c & 15];
-    }
-  }
-  return out;
-}
 
 /// The OFF header's vertex and face counts, whole numbers, against the file size: each vertex
 /// and face takes at least one line.
@@ -431,12 +458,16 @@ void check_off(const std::filesystem::path& path) {
       lines.push_back(line_no);
     }
   }
-  if (tokens.size() < 3) return;
   std::size_t at = 0;
-  const std::string& magic = tokens[0];
-  if (magic.size() >= 3 && magic.compare(magic.size() - 3, 3, "OFF") == 0) at = 1;
+  if (!tokens.empty() && tokens[0].size() >= 3 && tokens[0].compare(tokens[0].size() - 3, 3, "OFF") == 0) at = 1;
+  // Without both counts there is nothing to check them against, but Assimp reads counts
+  // from whatever follows (the digits of "4294945910 255OBFF" as 4294945910 vertices and
+  // 255 faces) and allocates by them: a header without two counts is refused.
+  if (at + 1 >= tokens.size())
+    throw InputError({path.string(), tokens.empty() ? 1 : lines.back(), "OFF header"},
+                     "expected [magic] vertex and face counts, found " + std::to_string(tokens.size() - at) +
+                         " token(s) after the magic (an empty or truncated file?)");
   std::uint64_t nv = 0, nf = 0;
-  if (at + 1 >= tokens.size()) return;
   // A count that is not all digits is refused, not left to Assimp: its reader takes the
   // leading digits ("1000000000x" as 10⁹ faces) and allocates by them before reading any.
   for (const std::size_t k : {at, at + 1})
@@ -469,7 +500,8 @@ void check_off(const std::filesystem::path& path) {
       continue;
     }
     std::uint64_t k = 0;
-    if (!parse_count(w[0], k) || k + 1 > w.size()) return;  // Assimp reports malformed faces
+    // k ≥ w.size() rather than k + 1 > w.size(): a saturated count would wrap to 0.
+    if (!parse_count(w[0], k) || k >= w.size()) return;  // Assimp reports malformed faces
     for (std::size_t i = 1; i <= k; ++i) {
       std::uint64_t index = 0;
       if (!parse_count(w[i], index) || index >= nv)

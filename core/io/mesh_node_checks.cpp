@@ -1,6 +1,7 @@
 #include "core/io/mesh_node_checks.hpp"
 
 #include "core/error.hpp"
+#include "core/io/glb_container.hpp"
 #include "core/io/input_file.hpp"
 #include "core/io/line_map.hpp"
 #include "core/io/mesh_file_checks.hpp"
@@ -305,21 +306,49 @@ class Dae {
 
 // --- glTF ---------------------------------------------------------------------------------
 
-/// The JSON of a glTF file, or of a GLB file's first (JSON) chunk; empty if there is none.
+/// The JSON of a glTF file, or of a GLB file's JSON chunk (its container checked first).
 std::string gltf_json(const std::filesystem::path& path, bool binary) {
   if (!binary) return file_bytes(path);
-  const std::string head = file_bytes(path, 20);
-  if (head.size() < 20 || head.compare(0, 4, "glTF") != 0) return {};
-  auto u32 = [&](std::size_t at) {
-    std::uint32_t v = 0;
-    for (int k = 3; k >= 0; --k) v = (v << 8) | static_cast<unsigned char>(head[at + static_cast<std::size_t>(k)]);
-    return v;
-  };
-  const std::uint32_t length = u32(12);
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
-  if (ec || 20 + static_cast<std::uint64_t>(length) > size) return {};
-  return file_bytes(path, 20 + static_cast<std::size_t>(length)).substr(20);
+  const GlbLayout glb = read_glb_layout(path);
+  return file_bytes(path, static_cast<std::size_t>(glb.json_offset + glb.json_length))
+      .substr(static_cast<std::size_t>(glb.json_offset));
+}
+
+/// Every buffer's byteLength against the bytes that can back it: a GLB's body buffer (no
+/// uri) against its BIN chunk, a file buffer against that file, a data URI against its
+/// decoded size. Why: Assimp allocates a buffer by its declared byteLength before reading it.
+void check_gltf_buffers(const nlohmann::json& doc, const std::filesystem::path& path, bool binary) {
+  if (!doc.contains("buffers")) return;
+  const nlohmann::json& buffers = doc["buffers"];
+  if (!buffers.is_array() && !buffers.is_object()) return;
+  const std::uint64_t bin = binary ? read_glb_layout(path).bin_length : 0;
+  for (const auto& [id, b] : buffers.items()) {
+    if (!b.is_object() || !b.contains("byteLength")) continue;
+    const std::string what = "buffer " + id;
+    const nlohmann::json& n = b["byteLength"];
+    if (!n.is_number_unsigned())
+      throw InputError({path.string(), 0, what}, "byteLength " + n.dump() + " is not a whole number of bytes");
+    const std::uint64_t length = n.get<std::uint64_t>();
+    std::uint64_t room = 0;
+    std::string backing;
+    const std::string uri = b.contains("uri") && b["uri"].is_string() ? b["uri"].get<std::string>() : std::string();
+    if (uri.empty()) {
+      room = bin;
+      backing = binary ? "the BIN chunk's " : "no data: ";
+    } else if (uri.rfind("data:", 0) == 0) {
+      room = uri.size() - std::min(uri.size(), uri.find(',') + 1);  // ≥ the decoded bytes
+      backing = "its data URI's ";
+    } else {
+      std::error_code ec;
+      const auto file = path.parent_path() / uri;
+      room = static_cast<std::uint64_t>(std::filesystem::file_size(file, ec));
+      if (ec) continue;  // a missing buffer file: Assimp reports it
+      backing = "file " + file.string() + "'s ";
+    }
+    if (length > room)
+      throw InputError({path.string(), 0, what}, "byteLength " + std::to_string(length) + " is more than " + backing +
+                                                     std::to_string(room) + " bytes");
+  }
 }
 
 /// The corners of a glTF mesh: per primitive, its index accessor's count, else its POSITION
@@ -374,7 +403,9 @@ void check_dae_file(const std::filesystem::path& path) {
 
 void check_gltf_file(const std::filesystem::path& path, bool binary) {
   const nlohmann::json doc = nlohmann::json::parse(gltf_json(path, binary), nullptr, false);
-  if (doc.is_discarded() || !doc.is_object() || !doc.contains("nodes")) return;
+  if (doc.is_discarded() || !doc.is_object()) return;
+  check_gltf_buffers(doc, path, binary);
+  if (!doc.contains("nodes")) return;
   const nlohmann::json& nodes = doc["nodes"];
   NodeGraph g;
   std::unordered_map<std::string, std::size_t> index;  // node id → graph node

@@ -416,6 +416,129 @@ TEST(FuzzRegression, PlyMeshUnterminatedHeaderHung) {
   EXPECT_NE(r.out.find("nul.ply:3: PLY header: holds a NUL byte"), std::string::npos) << r.out;
 }
 
+// "format binary_big_enproperty uint16 ..." (libFuzzer): the pre-check could not parse the
+// format, left the file to Assimp, which read the header its own way, misaligned the data
+// and aborted in its triangulation (ai_assert numOut != mNumFaces). Every header line the
+// check does not understand is refused now, naming its line.
+TEST(FuzzRegression, PlyFormatLineNotParsedAborted) {
+  const fs::path d = scratch();
+  const std::string vertices = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+  const std::string faces = "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string body = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {"ply\nformat binary_big_enproperty uint16 x\n" + vertices + faces,
+       "f.ply:2: format: 'binary_big_enproperty' is not a PLY format"},
+      {"ply\nformat ascii 1.0\n" + vertices + "pproperty int8 w\n" + faces, "f.ply:7: pproperty: 'pproperty' is not a PLY header keyword"},
+      {"ply\n" + vertices + faces, "f.ply:1: format: the PLY header has no format line"},
+      {"ply\nformat ascii 1.0\nelement vertex\n" + faces, "f.ply:3: element: expected 'element NAME COUNT'"},
+      {"ply\nformat ascii 1.0\nproperty float x\n" + vertices + faces, "f.ply:3: property: a property before any element"},
+  };
+  for (const auto& [text, expected] : cases) {
+    write(d / "f.ply", text + body);
+    const auto r = bounded_info_of_part(d, "f.ply");
+    EXPECT_EQ(r.status, 2) << r.out;
+    EXPECT_NE(r.out.find(expected), std::string::npos) << r.out;
+  }
+  // Comments and obj_info lines anywhere in the header are read as before.
+  write(d / "ok.ply", "ply\nformat ascii 1.0\ncomment made by hand\n" + vertices + "obj_info a triangle\n" + faces + body);
+  EXPECT_EQ(loom::read_mesh_file(d / "ok.ply").triangle_count(), 1u);
+}
+
+// "4294945910  255OBFF" with no magic and only comments after it (libFuzzer): the pre-check
+// needed three tokens to check the counts and let the file through; Assimp took 4294945910
+// as the vertex count and allocated 3.5 GB.
+TEST(FuzzRegression, OffCountsWithoutMagicAllocated) {
+  const fs::path d = scratch();
+  write(d / "a.off", "4294945910  255OBFF\n# OOFF\n# STTOFF\n# ");
+  auto r = bounded_info_of_part(d, "a.off");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("a.off:1: OFF header: face count '255OBFF' is not a count"), std::string::npos) << r.out;
+  write(d / "b.off", "4294945910\n");
+  r = bounded_info_of_part(d, "b.off");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("b.off:1: OFF header: expected [magic] vertex and face counts, found 1 token(s)"),
+            std::string::npos)
+      << r.out;
+  write(d / "c.off", "OFF\n");
+  r = bounded_info_of_part(d, "c.off");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("c.off:1: OFF header: expected [magic] vertex and face counts, found 0 token(s)"),
+            std::string::npos)
+      << r.out;
+}
+
+// A face whose vertex count is beyond 64 bits (libFuzzer): the count saturated to 2^64 − 1,
+// the check's "count + 1 > words" wrapped to 0 and it read past the face's words (ASan
+// heap-buffer-overflow in the pre-check itself).
+TEST(FuzzRegression, OffFaceVertexCountWrappedPastItsWords) {
+  const fs::path d = scratch();
+  write(d / "f.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n99999999999999999999999 0 1 2\n");
+  const auto r = bounded_info_of_part(d, "f.off");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("f.off"), std::string::npos) << r.out;
+}
+
+// Four bytes before "ply" (libFuzzer): the pre-check took the file for something else and
+// left it to Assimp, which found the magic a few bytes in and hung reading the header.
+TEST(FuzzRegression, PlyMagicNotAtStartHung) {
+  const fs::path d = scratch();
+  write(d / "m.ply", std::string("\0\0\xc0\x7f", 4) + "ply\nformat ascii 1.0\nelement vertex 1\nend_header\n0\n");
+  const auto r = bounded_info_of_part(d, "m.ply");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("m.ply:1: PLY header: the file does not start with 'ply'"), std::string::npos) << r.out;
+}
+
+/// A GLB (glTF 2.0 binary) of one triangle: `json` in the JSON chunk, `bin` in the BIN chunk,
+/// each padded to 4 bytes as the format asks.
+std::string glb_file(std::string json, std::string bin) {
+  while (json.size() % 4) json += ' ';
+  while (bin.size() % 4) bin += '\0';
+  auto u32 = [](std::uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+  const std::uint32_t total = static_cast<std::uint32_t>(12 + 8 + json.size() + 8 + bin.size());
+  return "glTF" + u32(2) + u32(total) + u32(static_cast<std::uint32_t>(json.size())) + "JSON" + json +
+         u32(static_cast<std::uint32_t>(bin.size())) + std::string("BIN\0", 4) + bin;
+}
+
+// A GLB whose header declares 4,294,966,532 bytes and whose JSON chunk 4.1 GB (libFuzzer):
+// the pre-check found no JSON to check and let the file through; Assimp allocated the chunk
+// by its declared length. The container is checked first now, and every buffer's byteLength
+// against the bytes behind it.
+TEST(FuzzRegression, GlbChunkLengthBeyondFileAllocated) {
+  const fs::path d = scratch();
+  std::string bin;
+  for (const float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) bin.append(reinterpret_cast<const char*>(&v), 4);
+  auto json = [](int byte_length) {
+    return R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+           R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"buffers":[{"byteLength":)" +
+           std::to_string(byte_length) + R"(}],"bufferViews":[{"buffer":0,"byteLength":36}],)"
+           R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","max":[1,1,0],"min":[0,0,0]}]})";
+  };
+  const std::string good = glb_file(json(36), bin);
+  write(d / "good.glb", good);
+  EXPECT_EQ(loom::read_mesh_file(d / "good.glb").triangle_count(), 1u);
+  struct Case {
+    std::string bytes, expected;
+  };
+  std::string total_too_long = good, chunk_too_long = good, not_json_first = good;
+  total_too_long[8] = '\xff';  // total length: low byte
+  total_too_long[9] = '\xff';
+  chunk_too_long[14] = '\x7f';  // JSON chunk length: third byte
+  not_json_first.replace(16, 4, "JSOX");
+  const Case cases[] = {
+      {total_too_long, "g.glb: GLB header: declares 65535 bytes, the file holds " + std::to_string(good.size())},
+      {chunk_too_long, "g.glb: GLB chunk 0: declares "},
+      {not_json_first, "g.glb: GLB chunk 0: the first chunk is not JSON"},
+      {glb_file(json(4096), bin), "g.glb: buffer 0: byteLength 4096 is more than the BIN chunk's 36 bytes"},
+      {good.substr(0, 10), "g.glb: GLB header: not a binary glTF file"},
+  };
+  for (const Case& c : cases) {
+    write(d / "g.glb", c.bytes);
+    const auto r = bounded_info_of_part(d, "g.glb");
+    EXPECT_EQ(r.status, 2) << r.out;
+    EXPECT_NE(r.out.find(c.expected), std::string::npos) << c.expected << "\n" << r.out;
+  }
+}
+
 // --- STEP ------------------------------------------------------------------------------------
 
 // The wing section's actuator envelope without the DIRECTION its first VECTOR refers to:
