@@ -46,6 +46,12 @@ struct RoutingSettings {
   /// Largest gap between a clamped bundle's surface and the structure part the clamp is
   /// fixed to, scene units; default 25 mm. The reach from the centreline adds the bundle radius.
   Setting clamp_reach;
+  /// Extra planning cost per unit length of a route farther than clamp_reach (+ bundle
+  /// radius) from structure, relative to its length cost (PlanObjective::support_weight);
+  /// used when `supports`. Default 0: on the wing section weight 1 made planning ~10× slower
+  /// for one point more of length within reach, while pull_to_structure, which always runs
+  /// when `supports`, removes every unsupported span at no planning cost (docs/route.md).
+  Setting support_weight;
   /// True when the scene sets clamp_spacing: only then are supports audited (unsupported-span)
   /// and clamps placed after routing, so scenes written without supports in mind do not change.
   bool supports = false;

@@ -236,6 +236,10 @@ void read_supports(const TomlReader& r, const toml::table& rt, RoutingSettings& 
     if (!(*v > 0.0)) r.fail(rt.get(key), std::string("routing.") + key, "must be positive, got " + full_precision(*v));
     (std::string(key) == "clamp_spacing" ? out.clamp_spacing : out.clamp_reach) = {*v, "scene file"};
   }
+  if (const auto v = r.number(rt, "routing", "support_weight")) {
+    if (!(*v >= 0.0)) r.fail(rt.get("support_weight"), "routing.support_weight", "must not be negative, got " + full_precision(*v));
+    out.support_weight = {*v, "scene file"};
+  }
   out.supports = rt.get("clamp_spacing") != nullptr;
   const toml::node* sn = rt.get("separation");
   if (!sn) return;
@@ -338,9 +342,11 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
   scene.routing.iterations = {0.0, "default: none (stop on time and convergence)"};
   scene.routing.clamp_spacing = {450.0 * mm, "default: 450 mm"};
   scene.routing.clamp_reach = {25.0 * mm, "default: 25 mm"};
+  scene.routing.support_weight = {0.0, "default: 0 (off; the route is pulled to structure after planning)"};
   if (const toml::table* rt = r.section(doc, "routing")) {
     r.only_keys(*rt, "routing",
-                {"clearance", "planner", "time_limit", "seed", "iterations", "clamp_spacing", "clamp_reach", "separation"});
+                {"clearance", "planner", "time_limit", "seed", "iterations", "clamp_spacing", "clamp_reach",
+                 "support_weight", "separation"});
     read_supports(r, *rt, scene.routing);
     if (auto v = r.number(*rt, "routing", "clearance")) {
       if (*v < 0) r.fail(rt->get("clearance"), "routing.clearance", "must not be negative");

@@ -202,8 +202,19 @@ class TubeObjective : public ob::OptimizationObjective {
         w_clear_(terms.clearance_weight),
         w_pref_(terms.preference_weight),
         band_(terms.clearance_band > 0.0 ? terms.clearance_band : required),
-        step_(tube_resolution(required)) {
+        step_(tube_resolution(required)),
+        w_sup_(terms.support_weight),
+        sup_reach_(terms.support_reach),
+        sup_band_(terms.support_band > 0.0 ? terms.support_band : terms.support_reach) {
     description_ = "tube length + clearance";
+    if (w_sup_ > 0.0) {
+      for (int i = 0; i < index.part_count(); ++i) {
+        const bool supports = terms.part_supports.empty() ||
+                              (static_cast<std::size_t>(i) < terms.part_supports.size() && terms.part_supports[i]);
+        (supports ? supporting_ : non_supporting_).push_back(i);
+      }
+      if (supporting_.empty()) w_sup_ = 0.0;  // nothing can hold a clamp: the term is constant
+    }
     for (std::size_t i = 0; i < terms.part_preference.size(); ++i) {
       if (static_cast<int>(i) >= index.part_count()) break;
       if (terms.part_preference[i] == PartPreference::Near) near_.push_back(static_cast<int>(i));
@@ -220,7 +231,7 @@ class TubeObjective : public ob::OptimizationObjective {
   }
 
   /// True if the cost is w_len × length (no distance queries needed).
-  bool pure_length() const { return (w_clear_ == 0.0 && near_.empty()) && avoid_.empty(); }
+  bool pure_length() const { return w_clear_ == 0.0 && near_.empty() && avoid_.empty() && w_sup_ == 0.0; }
 
   ob::Cost stateCost(const ob::State* s) const override {
     double constant_for = 0.0;
@@ -293,7 +304,33 @@ class TubeObjective : public ob::OptimizationObjective {
       r += w_pref_ * (1.0 - ramp(d));
       constant_for = std::min(constant_for, flat_for(d));
     }
+    if (w_sup_ > 0.0) {
+      // σ is constant (0) within reach − step and (1) beyond reach + band: 1-Lipschitz
+      // distance gives how far it stays so.
+      const double d = support_distance(p);
+      r += w_sup_ * std::clamp((d - sup_reach_) / sup_band_, 0.0, 1.0);
+      const double inside = sup_reach_ - d, outside = d - sup_reach_ - sup_band_;
+      constant_for = std::min(constant_for, std::max({0.0, inside, outside}));
+    }
     return r;
+  }
+
+  /// Distance from p to the nearest supporting part, capped kSkipSteps steps beyond reach +
+  /// band (σ is 1 there whatever the distance; the margin lets segment_cost skip ahead).
+  /// One query over all parts decides it unless its answer is a part that cannot hold a
+  /// clamp; then the supporting parts are asked one by one.
+  double support_distance(const Vec3& p) const {
+    const double cap = sup_reach_ + sup_band_ + kSkipSteps * step_;
+    const ClosestHit hit = index_.closest(p, cap);
+    if (!hit.found()) return cap;
+    if (non_supporting_.empty() || std::find(non_supporting_.begin(), non_supporting_.end(), hit.part) == non_supporting_.end())
+      return hit.distance;
+    double d = cap;
+    for (int part : supporting_) {
+      const ClosestHit h = index_.closest_on_part(p, part, d);
+      if (h.found()) d = std::min(d, h.distance);
+    }
+    return d;
   }
 
   bool is_near(int part) const { return std::find(near_.begin(), near_.end(), part) != near_.end(); }
@@ -301,7 +338,9 @@ class TubeObjective : public ob::OptimizationObjective {
   const ObstacleIndex& index_;
   double required_;
   double w_len_, w_clear_, w_pref_, band_, step_;
+  double w_sup_, sup_reach_, sup_band_;
   std::vector<int> near_, avoid_;
+  std::vector<int> supporting_, non_supporting_;  ///< part ids that can / cannot carry a clamp
 };
 
 // --- planning context -------------------------------------------------------------------
@@ -365,6 +404,11 @@ void validate_settings(const PlanSettings& s) {
   check_finite_nonneg(o.clearance_weight, "objective clearance_weight");
   check_finite_nonneg(o.clearance_band, "objective clearance_band");
   check_finite_nonneg(o.preference_weight, "objective preference_weight");
+  check_finite_nonneg(o.support_weight, "objective support_weight");
+  check_finite_nonneg(o.support_reach, "objective support_reach");
+  check_finite_nonneg(o.support_band, "objective support_band");
+  if (o.support_weight > 0.0 && o.support_reach + o.support_band <= 0.0)
+    throw std::invalid_argument("plan: objective support_weight > 0 needs support_reach or support_band > 0");
   check_finite_nonneg(s.convergence_epsilon, "convergence_epsilon");
   if (!std::isfinite(s.convergence_window) || !(s.convergence_window > 0.0) || s.convergence_window > 1.0)
     throw std::invalid_argument("plan: convergence_window must be in (0, 1]");

@@ -52,16 +52,27 @@ struct PortSpec {
 };
 
 /// The route cost: ∫ rate(C(s)) ds over the centre line, with
-/// rate = length_weight + clearance_weight·φ(d) + preference_weight·(Σ_avoid φ(d_p) + (1 − φ(d_near))),
+/// rate = length_weight + clearance_weight·φ(d) + preference_weight·(Σ_avoid φ(d_p) + (1 − φ(d_near)))
+///        + support_weight·σ(d_support),
 /// φ(d) = clamp(1 − (d − required)/band, 0, 1): 1 at the required distance, 0 beyond
 /// required + band. d is the distance to the nearest part (0 when that part is Near),
-/// d_p to each Avoid part, d_near to the nearest Near part. Lengths in scene units.
+/// d_p to each Avoid part, d_near to the nearest Near part. σ(d) = clamp((d − support_reach)
+/// / support_band, 0, 1): 0 where a clamp on a supporting part can hold the centre line, 1
+/// from support_reach + support_band on; d_support is the distance to the nearest supporting
+/// part. So an unsupported stretch costs (length_weight + support_weight) per unit length: a
+/// route takes a detour along structure while it is shorter than support_weight /
+/// length_weight times the unsupported length it saves. Lengths in scene units.
 struct PlanObjective {
   double length_weight = 1.0;      ///< cost per unit length (> 0)
   double clearance_weight = 1.0;   ///< extra cost per unit length at the required distance (≥ 0)
   double clearance_band = 0.0;     ///< width of the clearance term (scene units); 0 = required distance
   double preference_weight = 1.0;  ///< weight of the per-part preferences (≥ 0)
   std::vector<PartPreference> part_preference;  ///< by part id; missing ids are Neutral
+  double support_weight = 0.0;     ///< extra cost per unit length out of clamp reach (≥ 0; 0: off)
+  double support_reach = 0.0;      ///< centre-line distance a clamp holds from a supporting part (> 0 when on)
+  double support_band = 0.0;       ///< width of σ's ramp (scene units); 0 = support_reach
+  /// By part id: the part can carry a clamp (structure; keep-outs cannot). Empty = all parts.
+  std::vector<bool> part_supports;
 };
 
 /// Everything about a route except its two ports and its time budget (shared by all the

@@ -1,5 +1,7 @@
 #include "routing/route/route_pipeline.hpp"
 
+#include "routing/route/support_pull.hpp"
+
 #include "core/stopwatch.hpp"
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
@@ -11,6 +13,7 @@
 #include "routing/curve/bend_repair.hpp"
 #include "routing/route/branch_layout.hpp"
 #include "routing/route/port_check.hpp"
+#include "routing/route/support_pull.hpp"
 #include "routing/curve/cable_geometry.hpp"
 
 #include <algorithm>
@@ -154,6 +157,7 @@ class RouteRun {
   PlanRequest plan_request(int s, const SegmentExits& x) const;
   PlanResult blocked_end(const SegmentExits& x, bool& branch_blocked) const;
   PlanResult plan_with_retry(const Segment& seg, PlanRequest& req, SegmentRouteInfo& info);
+  int pull_to_supports(const SegmentExits& x, std::vector<Vec3>& key_points) const;
   void record_unrouted(int s, const PlanResult& plan, bool branch_blocked);
   void build_splines();
   void build_curve(int s);
@@ -370,6 +374,12 @@ PlanRequest RouteRun::plan_request(int s, const SegmentExits& x) const {
   req.seed = rep_.seed + static_cast<unsigned>(s);
   req.time_limit = time_limit_;
   req.max_iterations = rep_.iterations;
+  if (scene_.routing.supports) {
+    // Prefer ways a clamp can hold: within clamp_reach of the bundle surface from structure.
+    req.objective.support_weight = scene_.routing.support_weight.value;
+    req.objective.support_reach = x.radius + scene_.routing.clamp_reach.value;
+    for (const Part& p : planning_parts_) req.objective.part_supports.push_back(p.role == PartRole::Structure);
+  }
   req.start = {a_stub, (b_stub - a_stub).norm() > 0 ? Vec3((b_stub - a_stub).normalized()) : Vec3::UnitX()};
   req.goal = {b_stub, (a_stub - b_stub).norm() > 0 ? Vec3((a_stub - b_stub).normalized()) : Vec3::UnitX()};
   return req;
@@ -479,6 +489,7 @@ void RouteRun::plan_segment(int s) {
     return;
   }
   info.planned = true;
+  if (scene_.routing.supports) info.support_points = pull_to_supports(x, plan.key_points);
   SegmentGeometry g;
   g.a = x.ea.position;
   g.a_stub = x.a_stub;
@@ -490,6 +501,22 @@ void RouteRun::plan_segment(int s) {
   g.interp.end_tangent = -x.eb.exit;
   geom_[s] = g;
   rep_.segments.push_back(info);
+}
+
+/// Inserts key points into `key_points` (stub end to stub end) where the route runs longer
+/// than clamp_spacing out of clamp reach of structure (pull_to_structure); returns how many.
+int RouteRun::pull_to_supports(const SegmentExits& x, std::vector<Vec3>& key_points) const {
+  SupportPullSettings ps;
+  ps.spacing = scene_.routing.clamp_spacing.value;
+  ps.reach = x.radius + scene_.routing.clamp_reach.value;
+  ps.required = x.required;
+  if (!(ps.reach > ps.required)) return 0;  // no stand-off between clearance and reach to aim at
+  ps.start_is_port = x.ea.is_port;
+  ps.end_is_port = x.eb.is_port;
+  for (const Part& p : planning_parts_) ps.part_supports.push_back(p.role == PartRole::Structure);
+  SupportPullResult pulled = pull_to_structure(*plan_index_, key_points, ps);
+  key_points = std::move(pulled.points);
+  return pulled.inserted;
 }
 
 /// Rounds the corners of segment `s` as far as the planning obstacles allow: tries the

@@ -58,6 +58,9 @@ struct SegmentRouteInfo {
   std::size_t key_points = 0; ///< interior key points in the routed file
   int repair_rounds = 0;      ///< densification rounds after the audit
   int replans = 0;            ///< re-plans that were kept because the bend repair failed
+  /// Key points inserted to bring unsupported stretches within clamp reach of structure
+  /// (pull_to_structure; only when the scene sets clamp_spacing).
+  int support_points = 0;
   std::string bend_status;    ///< outcome of the bend-radius repair
   /// True if the time limit ended any plan of this segment (first plan, clearance retry or
   /// bend re-plan) before its iteration budget: this segment's route is not reproducible.

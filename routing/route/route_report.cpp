@@ -94,6 +94,7 @@ json route_report_json(const RouteReport& rep) {
         o["key_points"] = info.key_points;
         o["repair_rounds"] = info.repair_rounds;
         o["replans"] = info.replans;
+        o["support_points"] = info.support_points;
         o["bend_repair"] = info.bend_status;
       }
     }

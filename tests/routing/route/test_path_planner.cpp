@@ -641,6 +641,46 @@ TEST(PathPlanner, ClearanceTermKeepsTheRouteAway) {
   EXPECT_GT(loose.length, tight.length);
 }
 
+TEST(PathPlanner, SupportTermBringsTheRouteWithinReachOfStructure) {
+  // A floor slab 40 below the straight way (centre line 50 − 10 above its top): without the
+  // support term nothing of the route is within reach 12 of the slab; with it an
+  // out-of-reach stretch costs 5× its length, so the route dips to the slab. The best dip
+  // (down 28, along, up 28 between stub ends 80 apart) has about 0.46 of its length within
+  // reach. Oracle: closed-form distances, sampled every 0.1; the planner's key points sit on
+  // the ramp's foot, so "within reach" is read with 1 of slack.
+  const Scene s{{{Vec3(0, 0, 0), Vec3(100, 100, 10)}}};
+  const BruteForceIndex index(s.parts());
+  constexpr double kReach = 12.0;
+  auto share_within_reach = [&](const PlanResult& r) {
+    double in = 0.0, all = 0.0;
+    for (std::size_t i = 1; i < r.key_points.size(); ++i) {
+      const Vec3 a = r.key_points[i - 1], b = r.key_points[i];
+      const int n = std::max(1, static_cast<int>((b - a).norm() / 0.1));
+      for (int k = 0; k < n; ++k) {
+        const double ds = (b - a).norm() / n;
+        all += ds;
+        if (s.distance(a + (b - a) * ((k + 0.5) / n)) <= kReach + 1.0) in += ds;
+      }
+    }
+    return in / all;
+  };
+  PlanRequest req = base_request("informedrrtstar");
+  req.max_iterations = 1500;
+  const PlanResult floating = plan_path(index, req);
+  req.objective.support_weight = 4.0;
+  req.objective.support_reach = kReach;
+  req.objective.support_band = 4.0;
+  const PlanResult supported = plan_path(index, req);
+  expect_valid_route(s, req, floating);
+  expect_valid_route(s, req, supported);
+  EXPECT_LT(share_within_reach(floating), 0.05);
+  EXPECT_GT(share_within_reach(supported), 0.4);
+  EXPECT_GT(supported.length, floating.length + 30.0);  // the price of support: the dip
+  // A part that cannot carry a clamp attracts nothing: the route floats as before.
+  req.objective.part_supports = {false};
+  EXPECT_LT(share_within_reach(plan_path(index, req)), 0.05);
+}
+
 // --- multi-query roadmap ------------------------------------------------------------------
 
 TEST(RoadmapPlanner, ReusesTheRoadmapAcrossQueries) {
