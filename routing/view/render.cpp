@@ -17,6 +17,7 @@
 #include <memory>
 #include <set>
 #include <string>
+#include <vector>
 
 namespace loom {
 
@@ -29,6 +30,7 @@ constexpr std::array<std::uint8_t, 3> kClash{224, 32, 32};
 constexpr std::array<std::uint8_t, 3> kBend{255, 140, 0};
 constexpr std::array<std::uint8_t, 3> kClearance{224, 192, 0};
 constexpr std::array<std::uint8_t, 3> kOutline{40, 20, 20};
+constexpr std::array<std::uint8_t, 3> kClamp{0, 144, 168};
 /// Lambert shading: ambient share and the light's share of the base colour.
 constexpr double kAmbient = 0.3;
 constexpr double kDiffuse = 0.7;
@@ -122,6 +124,48 @@ std::string png_bytes(const Image& img) {
   return out;
 }
 
+/// Most cable points the camera choice looks at (tube vertices, evenly subsampled).
+constexpr std::size_t kVisibilitySamples = 2048;
+/// Share of a cable's colour seen through the structure that hides it.
+constexpr double kSeeThrough = 0.45;
+
+/// The eight viewing directions (target → eye) of the framing camera: the default first,
+/// then its mirror images through the axis planes.
+std::vector<Vec3> view_candidates() {
+  std::vector<Vec3> out;
+  for (double sz : {1.0, -1.0})
+    for (double sy : {1.0, -1.0})
+      for (double sx : {1.0, -1.0}) out.push_back(Vec3(sx * kViewFrom.x(), sy * kViewFrom.y(), sz * kViewFrom.z()));
+  return out;
+}
+
+/// The framing camera from whichever candidate direction sees the most of `points` (cable
+/// tube vertices) unhidden by the parts; ties keep the earlier candidate. `visible` gets
+/// the chosen camera's share of unhidden points.
+RenderCamera least_hidden_camera(const AABB& box, double aspect, const EmbreeIndex* parts,
+                                 const std::vector<Vec3>& points, double& visible) {
+  RenderCamera best = frame_camera(box, aspect);
+  visible = 1.0;
+  if (!parts || points.empty()) return best;
+  const std::size_t stride = std::max<std::size_t>(1, points.size() / kVisibilitySamples);
+  std::size_t best_seen = 0, looked = 0;
+  bool first = true;
+  for (const Vec3& from : view_candidates()) {
+    const RenderCamera cam = frame_camera(box, aspect, from);
+    std::size_t seen = 0;
+    looked = 0;
+    for (std::size_t i = 0; i < points.size(); i += stride, ++looked)
+      seen += !parts->ray(points[i], cam.eye - points[i], 1.0).found();
+    if (first || seen > best_seen) {
+      best = cam;
+      best_seen = seen;
+      first = false;
+    }
+  }
+  visible = looked ? static_cast<double>(best_seen) / static_cast<double>(looked) : 1.0;
+  return best;
+}
+
 }  // namespace
 
 std::array<std::uint8_t, 3> Image::at(int x, int y) const {
@@ -146,7 +190,9 @@ std::array<std::uint8_t, 3> cable_colour(std::size_t i) {
   return {to8(r), to8(g), to8(b)};
 }
 
-RenderCamera frame_camera(const AABB& box, double aspect) {
+RenderCamera frame_camera(const AABB& box, double aspect) { return frame_camera(box, aspect, kViewFrom); }
+
+RenderCamera frame_camera(const AABB& box, double aspect, const Vec3& view_from) {
   RenderCamera cam;
   const Vec3 c = box.center();
   const double radius = std::max(0.5 * box.size().norm(), 1e-9);
@@ -154,7 +200,7 @@ RenderCamera frame_camera(const AABB& box, double aspect) {
   const double half_h = std::atan(std::tan(half_v) * aspect);
   const double dist = kFrameMargin * radius / std::sin(std::min(half_v, half_h));
   cam.target = c;
-  cam.eye = c + kViewFrom * dist;
+  cam.eye = c + view_from.normalized() * dist;
   return cam;
 }
 
@@ -218,11 +264,14 @@ Image render_scene(const Scene& scene, const Harness& harness, const nlohmann::j
   AABB frame_box = harness_box;
   if (frame_box.empty()) frame_box = scene.bounds();
   if (frame_box.empty()) frame_box.extend(Vec3::Zero());
-  const RenderCamera cam = opt.camera ? *opt.camera : frame_camera(frame_box, static_cast<double>(opt.width) / opt.height);
-
   std::unique_ptr<EmbreeIndex> parts_index, tube_index;
   if (!scene.parts.empty()) parts_index = std::make_unique<EmbreeIndex>(scene.parts);
   if (!tubes.empty()) tube_index = std::make_unique<EmbreeIndex>(tubes);
+  std::vector<Vec3> cable_points;
+  for (const Part& t : tubes) cable_points.insert(cable_points.end(), t.mesh.vertices.begin(), t.mesh.vertices.end());
+  const RenderCamera cam = opt.camera ? *opt.camera
+                                      : least_hidden_camera(frame_box, static_cast<double>(opt.width) / opt.height,
+                                                            parts_index.get(), cable_points, st.visible_cable_share);
 
   Image img;
   img.width = opt.width;
@@ -237,17 +286,24 @@ Image render_scene(const Scene& scene, const Harness& harness, const nlohmann::j
       const Vec3 dir = (b.f + nx * b.r + ny * b.u).normalized();
       RayHit hp, ht;
       if (parts_index) hp = parts_index->ray(cam.eye, dir);
-      if (tube_index) ht = tube_index->ray(cam.eye, dir, hp.t);
-      std::array<std::uint8_t, 3> colour = kBackground;
-      const RayHit* hit = ht.found() ? &ht : (hp.found() ? &hp : nullptr);
-      if (hit) {
-        std::array<std::uint8_t, 3> base;
-        if (hit == &ht) base = cable_colour(tube_cable[static_cast<std::size_t>(ht.part)]);
-        else base = scene.parts[static_cast<std::size_t>(hp.part)].role == PartRole::KeepOut ? kKeepOut : kStructure;
-        Vec3 n = hit->normal;
+      if (tube_index) ht = tube_index->ray(cam.eye, dir);
+      const Vec3 light = (-dir + kLightLift * b.u).normalized();
+      auto lit = [&](const RayHit& h, const std::array<std::uint8_t, 3>& base) {
+        Vec3 n = h.normal;
         if (n.dot(dir) > 0.0) n = -n;
-        const Vec3 light = (-dir + kLightLift * b.u).normalized();
-        colour = shade(base, kAmbient + kDiffuse * std::max(0.0, n.dot(light)));
+        return shade(base, kAmbient + kDiffuse * std::max(0.0, n.dot(light)));
+      };
+      std::array<std::uint8_t, 3> colour = kBackground;
+      if (ht.found() && (!hp.found() || ht.t <= hp.t)) {
+        colour = lit(ht, cable_colour(tube_cable[static_cast<std::size_t>(ht.part)]));
+      } else if (hp.found()) {
+        colour = lit(hp, scene.parts[static_cast<std::size_t>(hp.part)].role == PartRole::KeepOut ? kKeepOut : kStructure);
+        // Structure is see-through where it hides a cable: the harness is what the picture shows.
+        if (ht.found()) {
+          const auto behind = lit(ht, cable_colour(tube_cable[static_cast<std::size_t>(ht.part)]));
+          for (std::size_t k = 0; k < 3; ++k)
+            colour[k] = static_cast<std::uint8_t>(std::lround((1.0 - kSeeThrough) * colour[k] + kSeeThrough * behind[k]));
+        }
       }
       put(img, x, y, colour);
     }
@@ -259,20 +315,23 @@ Image render_scene(const Scene& scene, const Harness& harness, const nlohmann::j
   // Markers over everything: violations first, clashes on top.
   const double mr = opt.marker_radius_px > 0.0 ? opt.marker_radius_px
                                                : std::max(4.0, std::min(opt.width, opt.height) / 120.0);
-  auto draw = [&](const char* key, bool clash) {
+  auto draw = [&](const char* key, bool clash, double radius_px, const std::array<std::uint8_t, 3>* fixed) {
     if (!report.contains(key) || !report[key].is_array()) return;
     for (const auto& e : report[key]) {
       const auto p = point_of(e);
       if (!p) continue;
       const auto px = project_to_pixel(cam, opt.width, opt.height, *p);
-      if (!px || px->x() < -mr || px->y() < -mr || px->x() > opt.width + mr || px->y() > opt.height + mr) continue;
+      if (!px || px->x() < -radius_px || px->y() < -radius_px || px->x() > opt.width + radius_px ||
+          px->y() > opt.height + radius_px)
+        continue;
       const std::string kind = e.value("kind", std::string());
-      disc(img, *px, mr, clash ? kClash : (kind == "bend-radius" ? kBend : kClearance));
+      disc(img, *px, radius_px, fixed ? *fixed : clash ? kClash : (kind == "bend-radius" ? kBend : kClearance));
       ++st.markers;
     }
   };
-  draw("violations", false);
-  draw("clashes", true);
+  draw("clamps", false, 0.6 * mr, &kClamp);
+  draw("violations", false, mr, nullptr);
+  draw("clashes", true, mr, nullptr);
   st.ms = t0.ms();
   if (stats) *stats = st;
   return img;

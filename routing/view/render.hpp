@@ -54,21 +54,29 @@ struct Image {
 struct RenderStats {
   std::size_t rays = 0;            ///< primary rays cast (one per pixel)
   std::size_t tube_triangles = 0;  ///< triangles of the swept cable tubes
-  std::size_t markers = 0;         ///< clash/violation discs drawn (in view)
+  std::size_t markers = 0;         ///< clash/violation/clamp discs drawn (in view)
+  /// Share of the cable tubes' points the framing camera sees unhidden by parts (1 when
+  /// the camera was given or there are no parts).
+  double visible_cable_share = 1.0;
   double ms = 0.0;                 ///< wall time of index build + ray casting
 };
 
 /// A camera looking at `box` from the front-right-above so that all of it is in view for the
 /// given width/height aspect ratio.
 RenderCamera frame_camera(const AABB& box, double aspect);
+/// The same framing from direction `view_from` (target → eye, any length > 0).
+RenderCamera frame_camera(const AABB& box, double aspect, const Vec3& view_from);
 
 /// Pixel coordinates (x right, y down, pixel centres at +0.5) of a world point, or nullopt if
 /// it is behind the camera.
 std::optional<Eigen::Vector2d> project_to_pixel(const RenderCamera& cam, int width, int height, const Vec3& p);
 
 /// Ray-casts the scene's parts and the harness's routed cables; draws the report's clashes
-/// (red) and violations (bend radius orange, clearance yellow). Throws InputError for a size
-/// below 1×1.
+/// (red), violations (bend radius orange, clearance yellow) and clamps (small teal discs,
+/// counted in RenderStats::markers). Without opt.camera the camera
+/// frames the harness from whichever of eight diagonal directions hides the least of it
+/// behind parts, and structure in front of a cable is drawn see-through (45 % cable colour).
+/// Throws InputError for a size below 1×1.
 Image render_scene(const Scene& scene, const Harness& harness, const nlohmann::json& report,
                    const RenderOptions& opt = {}, RenderStats* stats = nullptr);
 

@@ -257,6 +257,25 @@ std::string view_data_json(const Scene& scene, const Harness& harness, const nlo
       if (marker_json(e, q, s)) ++st.violations;
       else s += "null";
     }
+  // Clamps (route-placed and the harness's own), with the bundle they hold.
+  s += "],\"clamps\":[";
+  first = true;
+  if (report.contains("clamps") && report["clamps"].is_array())
+    for (const auto& c : report["clamps"]) {
+      if (!c.contains("point") || !c["point"].is_array() || c["point"].size() != 3) continue;
+      nlohmann::json o;
+      o["id"] = c.contains("id") && c["id"].is_string() ? c["id"] : nlohmann::json("?");
+      if (c.contains("part") && c["part"].is_string()) o["part"] = c["part"];
+      o["d"] = std::round(finite_or(c, "bundle_diameter", 0.0) / q) * q;
+      o["placed"] = c.contains("placed") && c["placed"].is_boolean() && c["placed"].get<bool>();
+      nlohmann::json pt = nlohmann::json::array();
+      for (const auto& v : c["point"]) pt.push_back(v.is_number() ? quantize(v.get<double>(), q) : 0);
+      o["p"] = pt;
+      if (!first) s += ',';
+      first = false;
+      s += json_text(o);
+      ++st.clamps;
+    }
   s += "],\"bounds\":";
   std::vector<Vec3> corners;
   if (!box.empty()) corners = {box.min, box.max};
@@ -325,6 +344,7 @@ li:hover{background:#eef} li.selected{background:#ffe27a}
 <div id="side"><h1 id="title"></h1><div id="summary" class="muted"></div><div id="msg"></div>
 <h2>Clashes (<span id="clash-count">0</span>)</h2><ol id="clash-list" start="0"></ol>
 <h2>Violations (<span id="violation-count">0</span>)</h2><ol id="violation-list" start="0"></ol>
+<h2>Clamps (<span id="clamp-count">0</span>)</h2><ol id="clamp-list" start="0"></ol>
 <h2>Cables (<span id="cable-count">0</span>)</h2><ol id="cable-list" start="0"></ol>
 <h2>Parts</h2><ul id="parts"></ul>
 <p class="muted">Drag: orbit · right-drag: pan · wheel: zoom. Click an item to fly to it.</p></div>
@@ -340,7 +360,7 @@ function st(k, v) { body.setAttribute('data-' + k, String(v)); }
 function el(id) { return document.getElementById(id); }
 function P(a, i) { return [a[3 * i] * q, a[3 * i + 1] * q, a[3 * i + 2] * q]; }
 function fmt(x) { return x === undefined ? '?' : String(Math.round(x * 1000) / 1000); }
-var MARK = { clash: 0xe02020, 'bend-radius': 0xff8c00, clearance: 0xe0c000 };
+var MARK = { clash: 0xe02020, 'bend-radius': 0xff8c00, clearance: 0xe0c000, clamp: 0x0090a8 };
 var SELECTED = 0xd000ff;
 var palette = [];
 D.cables.forEach(function (c, i) { palette.push('hsl(' + ((i * 137.508) % 360).toFixed(1) + ',70%,45%)'); });
@@ -355,7 +375,7 @@ el('summary').textContent = D.parts.length + ' parts, ' + shown + ' of ' + total
   D.budget + '), units ' + D.units;
 
 // --- the lists: items carry what the camera needs to fly to them -------------------------
-var items = { clash: [], violation: [], cable: [] };
+var items = { clash: [], violation: [], clamp: [], cable: [] };
 var view = null;
 function addItem(kind, i, text, center, radius, swatch) {
   var li = document.createElement('li');
@@ -375,6 +395,10 @@ D.violations.forEach(function (v, i) {
   if (!v) return;
   addItem('violation', i, v.kind + ' ' + v.cable + ': ' + fmt(v.value) + ' (limit ' + fmt(v.limit) + ')', P(v.p, 0), 0);
 });
+D.clamps.forEach(function (c, i) {
+  addItem('clamp', i, c.id + (c.part ? ' on ' + c.part : ' (no structure within reach)') + ', bundle \u00d8 ' + fmt(c.d) +
+          (c.placed ? ' (placed)' : ''), P(c.p, 0), 0);
+});
 D.cables.forEach(function (c, i) {
   var n = c.p.length / 3, lo = [1e300, 1e300, 1e300], hi = [-1e300, -1e300, -1e300];
   for (var k = 0; k < n; ++k) { var p = P(c.p, k); for (var a = 0; a < 3; ++a) { lo[a] = Math.min(lo[a], p[a]); hi[a] = Math.max(hi[a], p[a]); } }
@@ -384,6 +408,8 @@ D.cables.forEach(function (c, i) {
 });
 el('clash-count').textContent = items.clash.filter(Boolean).length;
 el('violation-count').textContent = items.violation.filter(Boolean).length;
+el('clamp-count').textContent = D.clamps.length;
+st('clamp-count', D.clamps.length);
 el('cable-count').textContent = D.cables.length;
 st('clash-count', items.clash.filter(Boolean).length);
 st('violation-count', items.violation.filter(Boolean).length);
@@ -459,10 +485,11 @@ function initThree() {
   });
 
   // Markers are drawn over everything: a clash point lies where a cable meets a part.
-  var markers = { clash: [], violation: [] };
+  var markers = { clash: [], violation: [], clamp: [] };
   var sphere = new THREE.SphereBufferGeometry(markerR, 16, 12);
+  var cube = new THREE.BoxBufferGeometry(1.2 * markerR, 1.2 * markerR, 1.2 * markerR);
   function marker(kind, i, e, color) {
-    var m = new THREE.Mesh(sphere, new THREE.MeshBasicMaterial({ color: color, depthTest: false }));
+    var m = new THREE.Mesh(kind === 'clamp' ? cube : sphere, new THREE.MeshBasicMaterial({ color: color, depthTest: false }));
     m.position.copy(V(P(e.p, 0)));
     m.renderOrder = 10;
     m.userData.color = color;
@@ -471,6 +498,7 @@ function initThree() {
   }
   D.clashes.forEach(function (c, i) { if (c) marker('clash', i, c, MARK.clash); });
   D.violations.forEach(function (v, i) { if (v) marker('violation', i, v, MARK[v.kind] || MARK.clearance); });
+  D.clamps.forEach(function (c, i) { marker('clamp', i, c, MARK.clamp); });
 
   var controls = new THREE.OrbitControls(camera, renderer.domElement);
   controls.target.copy(center);
@@ -544,9 +572,9 @@ try {
   st('webgl', 'unavailable: ' + e.message);
 }
 
-// Test hook: #select=clash:2 (or #select=2 for a clash) clicks that list item.
+// Test hook: #select=clash:2 (or #select=2 for a clash; also violation:, clamp:, cable:) clicks that list item.
 function applyHash() {
-  var m = /select=(?:(clash|violation|cable):)?(\d+)/.exec(location.hash);
+  var m = /select=(?:(clash|violation|clamp|cable):)?(\d+)/.exec(location.hash);
   if (!m) return;
   var it = items[m[1] || 'clash'][+m[2]];
   if (it) it.li.click();

@@ -38,6 +38,7 @@ struct ViewStats {
   std::size_t cables_drawn = 0;     ///< cables with a centerline (routed)
   std::size_t clashes = 0;          ///< report.json clashes[] shown as markers
   std::size_t violations = 0;       ///< report.json violations[] shown as markers
+  std::size_t clamps = 0;           ///< report.json clamps[] shown as markers (cubes)
   double quantum = 0.0;             ///< coordinate rounding used (scene units)
   std::uintmax_t bytes = 0;         ///< size of the page
 };

@@ -253,6 +253,43 @@ TEST(Render, TubeTriangleBudgetIsHeldAndNamesTheCable) {
   }
 }
 
+// A wall on the −y side hides the cable from the default direction (front-right-above,
+// from −y). The framing camera turns to the +y side, where nothing hides it; a camera given
+// on the −y side sees the cable through the wall, tinted (the pixel differs from the same
+// picture without the cable).
+TEST(Render, CameraTurnsAwayFromTheWallAndStructureIsSeeThrough) {
+  Scene scene = small_scene();
+  Part wall;
+  wall.name = "wall";
+  wall.mesh = testmesh::box(Vec3(-400, -40, -300), Vec3(400, -30, 400));
+  scene.parts = {wall};
+  RenderOptions opt;
+  opt.width = 160;
+  opt.height = 120;
+  RenderStats st;
+  render_scene(scene, scene.harness, nlohmann::json::object(), opt, &st);
+  EXPECT_GT(st.visible_cable_share, 0.99);
+
+  const HarnessTopology topo(scene.harness);
+  const auto cl = cable_centerline(topo, 0);
+  ASSERT_TRUE(cl);
+  SweepOptions so;
+  so.chord_tolerance = 0.3;
+  const AABB box = sweep_tube(*cl, 3.0, so).mesh.bounds();
+  opt.camera = frame_camera(box, 160.0 / 120.0);  // the default direction: eye at −y
+  ASSERT_LT(opt.camera->eye.y(), -40.0);
+  const Image through = render_scene(scene, scene.harness, nlohmann::json::object(), opt, &st);
+  Scene no_cable = scene;
+  no_cable.harness = Harness{};
+  const Image plain = render_scene(no_cable, no_cable.harness, nlohmann::json::object(), opt);
+  const auto px = project_to_pixel(*opt.camera, 160, 120, Vec3(0, 0, 24));
+  ASSERT_TRUE(px);
+  const auto a = through.at(static_cast<int>(px->x()), static_cast<int>(px->y()));
+  const auto b = plain.at(static_cast<int>(px->x()), static_cast<int>(px->y()));
+  EXPECT_NE(a, b) << "the cable behind the wall does not show through";
+  EXPECT_NE(b, (std::array<std::uint8_t, 3>{244, 245, 247})) << "the wall is not in front of the cable";
+}
+
 TEST(Render, WritesPng) {
   Image img;
   img.width = 5;

@@ -141,6 +141,11 @@ Fixture small_scene() {
     ],
     "violations": [
       {"kind": "bend-radius", "cable": "W2", "value": 4.0, "limit": 10.0, "point": [0.0, 40.0, 30.0], "s": 88.0}
+    ],
+    "clamps": [
+      {"id": "clamp-1", "point": [0.0, 0.0, 12.0], "part": "block", "bundle_diameter": 4.2, "placed": true},
+      {"id": "K7", "part": "block"},
+      {"id": "K8", "point": [30.0, 0.0, 12.0], "part": null, "bundle_diameter": 4.2, "placed": false}
     ]})");
   return f;
 }
@@ -171,6 +176,16 @@ TEST(ViewData, MatchesSceneAndReport) {
   }
   ASSERT_EQ(d["violations"].size(), 1u);
   EXPECT_EQ(d["violations"][0]["kind"], "bend-radius");
+  // Clamps with a point are drawn (a clamp without one cannot be placed on the page).
+  ASSERT_EQ(d["clamps"].size(), 2u);
+  EXPECT_EQ(st.clamps, 2u);
+  EXPECT_EQ(d["clamps"][0]["id"], "clamp-1");
+  EXPECT_EQ(d["clamps"][0]["part"], "block");
+  EXPECT_TRUE(d["clamps"][0]["placed"].get<bool>());
+  EXPECT_NEAR(d["clamps"][0]["d"].get<double>(), 4.2, q);
+  EXPECT_NEAR(d["clamps"][0]["p"][2].get<double>() * q, 12.0, 0.5 * q + 1e-12);
+  EXPECT_FALSE(d["clamps"][1].contains("part"));
+  EXPECT_FALSE(d["clamps"][1]["placed"].get<bool>());
   // Cables run from their first port to their second and pass their path point.
   ASSERT_EQ(d["cables"].size(), 2u);
   EXPECT_EQ(st.cables_drawn, 2u);
@@ -270,7 +285,14 @@ TEST(ViewPage, OpensInHeadlessChromium) {
   EXPECT_NE(list.find("data-index=\"1\" class=\"selected\""), std::string::npos) << list;
   EXPECT_EQ(body_attr(dom, "camera-target"), "10.00,0.00,2.50");
 
-  // 4. A screenshot, kept beside the test output.
+  // 4. The clamp list holds the clamps that have a point; selecting one flies to it.
+  EXPECT_EQ(body_attr(dom, "clamp-count"), "2");
+  const std::string clamp_dom = chromium(dir, url + "#select=clamp:1", "--dump-dom");
+  EXPECT_EQ(body_attr(clamp_dom, "selected"), "clamp:1");
+  EXPECT_EQ(body_attr(clamp_dom, "camera-target"), "30.00,0.00,12.00");
+  EXPECT_NE(clamp_dom.find("K8 (no structure within reach)"), std::string::npos);
+
+  // 5. A screenshot, kept beside the test output.
   chromium(dir, url, "--screenshot='" + (dir / "view.png").string() + "'");
   EXPECT_GT(std::filesystem::file_size(dir / "view.png"), 10000u);
 }
