@@ -75,7 +75,7 @@ std::string wing_scene_toml() {
   part(o, "connector-tip", "connector-bracket.step", tip);
   o << "\n[harness]\nfile = \"harness.xml\"\n"
     << "\n[routing]\nclearance  = " << fl(kSceneClearance) << "\nplanner    = \"informedrrtstar\"\ntime_limit = 0.5\nseed       = 1\n"
-    << "iterations = " << kSceneIterations << "\n"
+    << "iterations = " << kSceneIterations << "\nclamp_spacing = " << fl(kSceneClampSpacing) << "\n"
     << "\n[simplify]\ndim_pre = " << fl(kSceneDimPre) << "\n";
   return o.str();
 }

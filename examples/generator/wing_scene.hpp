@@ -21,6 +21,10 @@ constexpr double kSceneDimPre = 8.0;
 /// longest plan ~0.2 s of the 0.5 s time limit; 200 is also clean but ~1% longer.
 constexpr int kSceneIterations = 500;
 
+/// Longest unsupported stretch written to [routing] clamp_spacing, mm: `route` pulls the
+/// trunk to structure and places clamps at most this far apart (AC 43.13-1B allows 610 mm).
+constexpr double kSceneClampSpacing = 450.0;
+
 /// The scene.toml text; file names are relative to the scene file's directory.
 std::string wing_scene_toml();
 
