@@ -60,6 +60,16 @@ loom::testing::LoomRun bounded_info_of_part(const fs::path& dir, const std::stri
   return run_bounded("info " + (dir / "scene.toml").string() + " --quiet");
 }
 
+/// Writes `bytes` as `dir`/`file`, the one part of a scene, and expects `loom info` to refuse
+/// it (exit 2) with `expected` in its message.
+void expect_part_refused(const fs::path& dir, const std::string& file, const std::string& bytes,
+                         const std::string& expected) {
+  write(dir / file, bytes);
+  const auto r = bounded_info_of_part(dir, file);
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find(expected), std::string::npos) << expected << "\n" << r.out;
+}
+
 // --- DAE -------------------------------------------------------------------------------------
 
 const char* kDaeHead =
@@ -433,12 +443,7 @@ TEST(FuzzRegression, PlyFormatLineNotParsedAborted) {
       {"ply\nformat ascii 1.0\nelement vertex\n" + faces, "f.ply:3: element: expected 'element NAME COUNT'"},
       {"ply\nformat ascii 1.0\nproperty float x\n" + vertices + faces, "f.ply:3: property: a property before any element"},
   };
-  for (const auto& [text, expected] : cases) {
-    write(d / "f.ply", text + body);
-    const auto r = bounded_info_of_part(d, "f.ply");
-    EXPECT_EQ(r.status, 2) << r.out;
-    EXPECT_NE(r.out.find(expected), std::string::npos) << r.out;
-  }
+  for (const auto& [text, expected] : cases) expect_part_refused(d, "f.ply", text + body, expected);
   // Comments and obj_info lines anywhere in the header are read as before.
   write(d / "ok.ply", "ply\nformat ascii 1.0\ncomment made by hand\n" + vertices + "obj_info a triangle\n" + faces + body);
   EXPECT_EQ(loom::read_mesh_file(d / "ok.ply").triangle_count(), 1u);
@@ -449,22 +454,11 @@ TEST(FuzzRegression, PlyFormatLineNotParsedAborted) {
 // as the vertex count and allocated 3.5 GB.
 TEST(FuzzRegression, OffCountsWithoutMagicAllocated) {
   const fs::path d = scratch();
-  write(d / "a.off", "4294945910  255OBFF\n# OOFF\n# STTOFF\n# ");
-  auto r = bounded_info_of_part(d, "a.off");
-  EXPECT_EQ(r.status, 2) << r.out;
-  EXPECT_NE(r.out.find("a.off:1: OFF header: face count '255OBFF' is not a count"), std::string::npos) << r.out;
-  write(d / "b.off", "4294945910\n");
-  r = bounded_info_of_part(d, "b.off");
-  EXPECT_EQ(r.status, 2) << r.out;
-  EXPECT_NE(r.out.find("b.off:1: OFF header: expected [magic] vertex and face counts, found 1 token(s)"),
-            std::string::npos)
-      << r.out;
-  write(d / "c.off", "OFF\n");
-  r = bounded_info_of_part(d, "c.off");
-  EXPECT_EQ(r.status, 2) << r.out;
-  EXPECT_NE(r.out.find("c.off:1: OFF header: expected [magic] vertex and face counts, found 0 token(s)"),
-            std::string::npos)
-      << r.out;
+  expect_part_refused(d, "a.off", "4294945910  255OBFF\n# OOFF\n# STTOFF\n# ",
+                      "a.off:1: OFF header: face count '255OBFF' is not a count");
+  expect_part_refused(d, "b.off", "4294945910\n",
+                      "b.off:1: OFF header: expected [magic] vertex and face counts, found 1 token(s)");
+  expect_part_refused(d, "c.off", "OFF\n", "c.off:1: OFF header: expected [magic] vertex and face counts, found 0 token(s)");
 }
 
 // A face whose vertex count is beyond 64 bits (libFuzzer): the count saturated to 2^64 − 1,
@@ -472,20 +466,15 @@ TEST(FuzzRegression, OffCountsWithoutMagicAllocated) {
 // heap-buffer-overflow in the pre-check itself).
 TEST(FuzzRegression, OffFaceVertexCountWrappedPastItsWords) {
   const fs::path d = scratch();
-  write(d / "f.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n99999999999999999999999 0 1 2\n");
-  const auto r = bounded_info_of_part(d, "f.off");
-  EXPECT_EQ(r.status, 2) << r.out;
-  EXPECT_NE(r.out.find("f.off"), std::string::npos) << r.out;
+  expect_part_refused(d, "f.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n99999999999999999999999 0 1 2\n", "f.off");
 }
 
 // Four bytes before "ply" (libFuzzer): the pre-check took the file for something else and
 // left it to Assimp, which found the magic a few bytes in and hung reading the header.
 TEST(FuzzRegression, PlyMagicNotAtStartHung) {
   const fs::path d = scratch();
-  write(d / "m.ply", std::string("\0\0\xc0\x7f", 4) + "ply\nformat ascii 1.0\nelement vertex 1\nend_header\n0\n");
-  const auto r = bounded_info_of_part(d, "m.ply");
-  EXPECT_EQ(r.status, 2) << r.out;
-  EXPECT_NE(r.out.find("m.ply:1: PLY header: the file does not start with 'ply'"), std::string::npos) << r.out;
+  expect_part_refused(d, "m.ply", std::string("\0\0\xc0\x7f", 4) + "ply\nformat ascii 1.0\nelement vertex 1\nend_header\n0\n",
+                      "m.ply:1: PLY header: the file does not start with 'ply'");
 }
 
 /// A GLB (glTF 2.0 binary) of one triangle: `json` in the JSON chunk, `bin` in the BIN chunk,
@@ -531,12 +520,7 @@ TEST(FuzzRegression, GlbChunkLengthBeyondFileAllocated) {
       {glb_file(json(4096), bin), "g.glb: buffer 0: byteLength 4096 is more than the BIN chunk's 36 bytes"},
       {good.substr(0, 10), "g.glb: GLB header: not a binary glTF file"},
   };
-  for (const Case& c : cases) {
-    write(d / "g.glb", c.bytes);
-    const auto r = bounded_info_of_part(d, "g.glb");
-    EXPECT_EQ(r.status, 2) << r.out;
-    EXPECT_NE(r.out.find(c.expected), std::string::npos) << c.expected << "\n" << r.out;
-  }
+  for (const Case& c : cases) expect_part_refused(d, "g.glb", c.bytes, c.expected);
 }
 
 // --- STEP ------------------------------------------------------------------------------------
