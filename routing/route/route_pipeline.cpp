@@ -10,6 +10,7 @@
 #include "routing/route/clamp_placement.hpp"
 #include "routing/curve/bend_repair.hpp"
 #include "routing/route/branch_layout.hpp"
+#include "routing/route/bundle_obstacles.hpp"
 #include "routing/route/port_check.hpp"
 #include "routing/curve/cable_geometry.hpp"
 
@@ -54,6 +55,7 @@ struct SegmentGeometry {
   Centerline curve;
   Vec3 a, a_stub, b_stub, b;  ///< the ends and their stub ends, as planned
   PlanRequest request;        ///< what the planner was asked (for re-planning)
+  int rank = 0;               ///< position in the routing order (bundles before it are obstacles)
 };
 
 
@@ -153,11 +155,16 @@ class RouteRun {
   SegmentExits segment_exits(int s) const;
   PlanRequest plan_request(int s, const SegmentExits& x) const;
   PlanResult blocked_end(const SegmentExits& x, bool& branch_blocked) const;
-  PlanResult plan_with_retry(const Segment& seg, PlanRequest& req, SegmentRouteInfo& info);
+  PlanResult plan_with_retry(const Segment& seg, const ObstacleIndex& index, PlanRequest& req,
+                             SegmentRouteInfo& info);
+  std::unique_ptr<HarnessAwareIndex> obstacles_for(int s, int rank) const;
+  PlanResult plan_one(const ObstacleIndex& index, const PlanRequest& req, SegmentRouteInfo& info) const;
+  void add_bundle_tube(int s);
+  std::string blocker_name(const ObstacleIndex& index, int part) const;
   void record_unrouted(int s, const PlanResult& plan, bool branch_blocked);
   void build_splines();
   void build_curve(int s);
-  BendRepairResult round_corners(int s, const SegmentGeometry& g) const;
+  BendRepairResult round_corners(int s, const SegmentGeometry& g, const ObstacleIndex& index) const;
   void replan_bend_failures();
   SegmentRouteInfo& info_of(int s);
   bool bend_failed(int s);
@@ -186,6 +193,8 @@ class RouteRun {
   AABB box_;
   double eps_ = 0.0;  ///< coincident key points
   std::map<int, SegmentGeometry> geom_;
+  std::map<int, BundleTube> tubes_;  ///< each planned segment's bundle as an obstacle for later ones
+  std::map<int, int> rank_;          ///< routing-order position of each segment
   std::set<std::string> failed_segments_;
   std::unique_ptr<EmbreeIndex> exact_owned_;
   Scene routed_scene_;
@@ -296,6 +305,7 @@ void RouteRun::plan_segments() {
   const auto& order = topo_.routing_order();
   seed_ompl_once(rep_.seed);
   ProgressCounter planned(opt_.progress, "plan", order.size(), "segments");
+  for (std::size_t k = 0; k < order.size(); ++k) rank_[order[k]] = static_cast<int>(k);
   for (std::size_t k = 0; k < order.size(); ++k, planned.add()) plan_segment(order[k]);
   planned.finish();
 }
@@ -410,17 +420,18 @@ PlanResult RouteRun::blocked_end(const SegmentExits& x, bool& branch_blocked) co
   return blocked;
 }
 
-/// Plans `req`; if that fails and parts ask for extra clearance, plans again with the routing
-/// clearance alone (`req` keeps the clearance the kept plan used).
-PlanResult RouteRun::plan_with_retry(const Segment& seg, PlanRequest& req, SegmentRouteInfo& info) {
-  PlanResult plan = plan_path(*plan_index_, req);
+/// Plans `req` among `index`; if that fails and parts ask for extra clearance, plans again
+/// with the routing clearance alone (`req` keeps the clearance the kept plan used).
+PlanResult RouteRun::plan_with_retry(const Segment& seg, const ObstacleIndex& index, PlanRequest& req,
+                                     SegmentRouteInfo& info) {
+  PlanResult plan = plan_one(index, req, info);
   info.time_limited = plan.time_limited;
   if (!plan.solved() && part_extra_ > 0.0) {
     // Per-part extra clearance is applied to every part while planning (conservative);
     // if that closes every corridor, plan with the routing clearance and let the audit
     // report where a part's own extra clearance is not met.
     req.clearance = rep_.clearance;
-    PlanResult retry = plan_path(*plan_index_, req);
+    PlanResult retry = plan_one(index, req, info);
     info.time_limited = info.time_limited || retry.time_limited;
     if (retry.solved()) {
       plan = retry;
@@ -429,6 +440,70 @@ PlanResult RouteRun::plan_with_retry(const Segment& seg, PlanRequest& req, Segme
     }
   }
   return plan;
+}
+
+/// One plan with the run's planner.
+PlanResult RouteRun::plan_one(const ObstacleIndex& index, const PlanRequest& req, SegmentRouteInfo& info) const {
+  (void)info;
+  return plan_path(index, req);
+}
+
+/// The planning obstacles of segment `s` at routing-order position `rank`: the parts and the
+/// bundle of every segment planned before it, each cut back near a node the two share (there
+/// they meet legitimately: within the audit's junction reach, twice the breakout, and at
+/// least far enough that the breakout stubs leave clear of each other).
+std::unique_ptr<HarnessAwareIndex> RouteRun::obstacles_for(int s, int rank) const {
+  const Segment& sg = h_.segments[s];
+  const double required = ends_[s].radius + rep_.clearance + part_extra_;
+  std::vector<BundleTube> tubes;
+  for (const auto& [t, tube] : tubes_) {
+    if (!opt_.harness_aware) break;
+    if (t == s || rank_.at(t) >= rank) continue;
+    const Segment& st = h_.segments[t];
+    std::vector<std::vector<Vec3>> runs{tube.points};
+    for (const std::string& n : {sg.from, sg.to}) {
+      if (n != st.from && n != st.to) continue;
+      const double breakout = breakout_length(topo_, n);
+      const double reach = std::max(2.0 * breakout, breakout + required + tube.radius);
+      const Vec3 at = *h_.node_position(n);
+      std::vector<std::vector<Vec3>> kept;
+      for (const auto& r : runs)
+        for (auto& piece : clip_near_node(r, at, reach)) kept.push_back(std::move(piece));
+      runs = std::move(kept);
+    }
+    for (auto& r : runs) tubes.push_back({t, std::move(r), tube.radius});
+  }
+  return std::make_unique<HarnessAwareIndex>(*plan_index_, tubes);
+}
+
+/// Keeps the bundle of planned segment `s` as an obstacle for the segments planned after it:
+/// its curve as build_curve will make it, sampled every bundle radius, the radius grown by
+/// the chord sag of that sampling at the bend radius.
+void RouteRun::add_bundle_tube(int s) {
+  const SegmentGeometry& g = geom_.at(s);
+  const double radius = ends_[s].radius, bend = ends_[s].min_bend_radius;
+  Centerline curve;
+  if (bend > 0.0) {
+    const auto obstacles = obstacles_for(s, g.rank);
+    curve = round_corners(s, g, *obstacles).curve;
+  } else {
+    curve = Centerline::interpolate(g.points, g.interp);
+  }
+  const double step = std::max(radius, 1e-6 * std::max(1.0, box_.diagonal()));
+  BundleTube tube;
+  tube.segment = s;
+  for (const auto& sp : curve.sample_by_arc_length(step)) tube.points.push_back(sp.second);
+  tube.radius = radius + step * step / (8.0 * std::max(bend, radius));
+  tubes_[s] = std::move(tube);
+}
+
+/// What blocked a plan, for its message: a part by name or the bundle of a segment.
+std::string RouteRun::blocker_name(const ObstacleIndex& index, int part) const {
+  if (part >= 0 && part < static_cast<int>(planning_parts_.size())) return "part '" + planning_parts_[part].name + "'";
+  const auto* aware = dynamic_cast<const HarnessAwareIndex*>(&index);
+  const int t = aware ? aware->bundle_segment(part) : -1;
+  if (t < 0) return "";
+  return "the bundle of segment " + h_.segments[t].from + " -> " + h_.segments[t].to + ", routed before it";
 }
 
 /// One entry per cable through segment `s`: the first segment (in routing order) that
@@ -459,6 +534,7 @@ void RouteRun::plan_segment(int s) {
   bool branch_blocked = false;
   const PlanResult blocked = blocked_end(x, branch_blocked);
   const Stopwatch t0;
+  const auto obstacles = obstacles_for(s, rank_.at(s));
   PlanResult plan;
   if (!blocked.message.empty()) {
     plan = blocked;
@@ -466,12 +542,13 @@ void RouteRun::plan_segment(int s) {
     plan.status = PlanStatus::Solved;
     plan.key_points = {x.a_stub, x.b_stub};
   } else {
-    plan = plan_with_retry(seg, req, info);
+    plan = plan_with_retry(seg, *obstacles, req, info);
   }
   rep_.timing.plan += t0.ms();
-  if (!plan.solved() && plan.blocking_part >= 0 && plan.blocking_part < static_cast<int>(planning_parts_.size()) &&
-      plan.message.find("'" + planning_parts_[plan.blocking_part].name + "'") == std::string::npos)
-    plan.message += " (part '" + planning_parts_[plan.blocking_part].name + "')";
+  if (!plan.solved() && plan.blocking_part >= 0) {
+    const std::string who = blocker_name(*obstacles, plan.blocking_part);
+    if (!who.empty() && plan.message.find(who) == std::string::npos) plan.message += " (" + who + ")";
+  }
   info.plan = plan;
   if (!plan.solved()) {
     record_unrouted(s, plan, branch_blocked);
@@ -488,7 +565,9 @@ void RouteRun::plan_segment(int s) {
   g.points = assemble(g, plan.key_points, eps_);
   g.interp.start_tangent = x.ea.exit;
   g.interp.end_tangent = -x.eb.exit;
+  g.rank = rank_.at(s);
   geom_[s] = g;
+  add_bundle_tube(s);
   rep_.segments.push_back(info);
 }
 
@@ -496,7 +575,7 @@ void RouteRun::plan_segment(int s) {
 /// budgets from generous (a corner rounded to the full bend radius moves up to ~0.4 R) to
 /// tight, and keeps the first repaired curve whose samples stay clear of the (simplified)
 /// parts, else the last tried; the exact audit that follows is the judge.
-BendRepairResult RouteRun::round_corners(int s, const SegmentGeometry& g) const {
+BendRepairResult RouteRun::round_corners(int s, const SegmentGeometry& g, const ObstacleIndex& index) const {
   const double min_bend = ends_[s].min_bend_radius;
   const double radius = ends_[s].radius;
   const double need = radius + 0.5 * rep_.clearance;
@@ -513,7 +592,7 @@ BendRepairResult RouteRun::round_corners(int s, const SegmentGeometry& g) const 
     bool clear = true;
     for (const auto& [sa, p] : br.curve.sample_by_arc_length(step)) {
       (void)sa;
-      if (plan_index_->any_within(p, need) && (p - g.points.front()).norm() > need &&
+      if (index.any_within(p, need) && (p - g.points.front()).norm() > need &&
           (p - g.points.back()).norm() > need) {
         clear = false;
         break;
@@ -535,7 +614,7 @@ void RouteRun::build_curve(int s) {
   SegmentGeometry& g = geom_[s];
   std::string status = "not checked";
   if (ends_[s].min_bend_radius > 0.0) {
-    const BendRepairResult chosen = round_corners(s, g);
+    const BendRepairResult chosen = round_corners(s, g, *obstacles_for(s, g.rank));
     g.curve = chosen.curve;
     g.points = chosen.points.empty() ? g.points : chosen.points;
     status = chosen.status == BendRepairStatus::Failed ? "failed: " + chosen.reason
@@ -580,7 +659,8 @@ void RouteRun::replan_bend_failures() {
       req.time_limit = g.request.time_limit * std::pow(2.0, attempt);
       req.max_iterations = g.request.max_iterations << attempt;  // twice the budget, as the time
       const Stopwatch t0;
-      const PlanResult plan = plan_path(*plan_index_, req);
+      SegmentRouteInfo scratch;
+      const PlanResult plan = plan_one(*obstacles_for(s, g.rank), req, scratch);
       rep_.timing.plan += t0.ms();
       // Whether the re-plan is kept depends on its result: a timed-out one makes the segment
       // irreproducible either way.

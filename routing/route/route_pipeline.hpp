@@ -44,6 +44,10 @@ struct RouteOptions {
   /// always uses the scene's exact parts.
   std::shared_ptr<const std::vector<Part>> planning_parts;
   int max_repair_rounds = 4; ///< audit → densify → re-spline rounds per segment
+  /// Plan each segment among the parts and the bundles routed before it (bundle radius +
+  /// clearance; cut back near the nodes they share). false: among the parts only, as
+  /// before harness-aware planning (for comparisons).
+  bool harness_aware = true;
   /// Progress of the stages: "simplify" (parts), "index" (planning index built), "plan"
   /// (segments), "audit" (cables, each audit round); may be empty.
   ProgressFn progress;
