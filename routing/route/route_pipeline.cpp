@@ -442,10 +442,14 @@ PlanResult RouteRun::plan_with_retry(const Segment& seg, const ObstacleIndex& in
   return plan;
 }
 
-/// One plan with the run's planner.
+/// One plan with the run's planner: the portfolio (its budgets kept in `info`) or one OMPL
+/// planner.
 PlanResult RouteRun::plan_one(const ObstacleIndex& index, const PlanRequest& req, SegmentRouteInfo& info) const {
-  (void)info;
-  return plan_path(index, req);
+  if (req.planner != kPortfolioPlanner) return plan_path(index, req);
+  PortfolioOutcome out = plan_portfolio(index, req);
+  PlanResult plan = out.plan;
+  info.portfolio = std::move(out);
+  return plan;
 }
 
 /// The planning obstacles of segment `s` at routing-order position `rank`: the parts and the
@@ -678,6 +682,7 @@ void RouteRun::replan_bend_failures() {
         info_of(s).time_limited = timed;
       } else {
         info_of(s).plan = plan;
+        info_of(s).portfolio = scratch.portfolio;
         info_of(s).replans = attempt;
       }
     }
@@ -783,7 +788,7 @@ void RouteRun::note_reproducibility() {
     rep_.unreproducible.push_back("no iteration budget: the planners stop on the time limit and on time-based "
                                   "convergence, so another run may give other routes (set --iterations or "
                                   "[routing] iterations)");
-  else if (planner_is_threaded(rep_.planner))
+  else if (rep_.planner != kPortfolioPlanner && planner_is_threaded(rep_.planner))
     rep_.unreproducible.push_back("planner " + rep_.planner +
                                   " grows its roadmap in a second thread: its routes are not reproducible, "
                                   "even with an iteration budget");

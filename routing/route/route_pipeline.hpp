@@ -9,10 +9,12 @@
 #include "core/scene.hpp"
 #include "routing/audit/audit.hpp"
 #include "routing/route/path_planner.hpp"
+#include "routing/route/planner_portfolio.hpp"
 
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -66,6 +68,8 @@ struct SegmentRouteInfo {
   /// True if the time limit ended any plan of this segment (first plan, clearance retry or
   /// bend re-plan) before its iteration budget: this segment's route is not reproducible.
   bool time_limited = false;
+  /// With the portfolio planner: the budgets of the plan kept and what its stages did.
+  std::optional<PortfolioOutcome> portfolio;
 };
 
 /// Why a cable has no route.
