@@ -55,7 +55,7 @@ struct SegmentGeometry {
   Centerline curve;
   Vec3 a, a_stub, b_stub, b;  ///< the ends and their stub ends, as planned
   PlanRequest request;        ///< what the planner was asked (for re-planning)
-  int rank = 0;               ///< position in the routing order (bundles before it are obstacles)
+  std::vector<int> visible;   ///< segments whose bundles were its obstacles when it was planned
 };
 
 
@@ -151,13 +151,17 @@ class RouteRun {
   void layout_branches();
   EndFrame end_frame(int seg, bool from_end) const;
   void plan_segments();
-  void plan_segment(int s);
+  void plan_segment(int s, const std::vector<int>& visible);
   SegmentExits segment_exits(int s) const;
   PlanRequest plan_request(int s, const SegmentExits& x) const;
   PlanResult blocked_end(const SegmentExits& x, bool& branch_blocked) const;
   PlanResult plan_with_retry(const Segment& seg, const ObstacleIndex& index, PlanRequest& req,
                              SegmentRouteInfo& info);
-  std::unique_ptr<HarnessAwareIndex> obstacles_for(int s, int rank) const;
+  std::unique_ptr<HarnessAwareIndex> obstacles_for(int s, const std::vector<int>& visible) const;
+  std::vector<int> routed_now(int except) const;
+  void store_info(const SegmentRouteInfo& info);
+  void reorder_blocked();
+  bool replan_among(int t, const std::vector<int>& visible);
   PlanResult plan_one(const ObstacleIndex& index, const PlanRequest& req, SegmentRouteInfo& info) const;
   void add_bundle_tube(int s);
   std::string blocker_name(const ObstacleIndex& index, int part) const;
@@ -194,7 +198,8 @@ class RouteRun {
   double eps_ = 0.0;  ///< coincident key points
   std::map<int, SegmentGeometry> geom_;
   std::map<int, BundleTube> tubes_;  ///< each planned segment's bundle as an obstacle for later ones
-  std::map<int, int> rank_;          ///< routing-order position of each segment
+  std::map<int, int> blocked_by_;    ///< failed segment → the segment whose bundle blocked it
+  std::map<int, bool> branch_blocked_;  ///< failed segment → a branch point of it lies in a part
   std::set<std::string> failed_segments_;
   std::unique_ptr<EmbreeIndex> exact_owned_;
   Scene routed_scene_;
@@ -305,9 +310,9 @@ void RouteRun::plan_segments() {
   const auto& order = topo_.routing_order();
   seed_ompl_once(rep_.seed);
   ProgressCounter planned(opt_.progress, "plan", order.size(), "segments");
-  for (std::size_t k = 0; k < order.size(); ++k) rank_[order[k]] = static_cast<int>(k);
-  for (std::size_t k = 0; k < order.size(); ++k, planned.add()) plan_segment(order[k]);
+  for (std::size_t k = 0; k < order.size(); ++k, planned.add()) plan_segment(order[k], routed_now(order[k]));
   planned.finish();
+  reorder_blocked();
 }
 
 /// Each end of segment `s` leaves straight along its exit direction: a port along the
@@ -452,17 +457,28 @@ PlanResult RouteRun::plan_one(const ObstacleIndex& index, const PlanRequest& req
   return plan;
 }
 
-/// The planning obstacles of segment `s` at routing-order position `rank`: the parts and the
-/// bundle of every segment planned before it, each cut back near a node the two share (there
-/// they meet legitimately: within the audit's junction reach, twice the breakout, and at
-/// least far enough that the breakout stubs leave clear of each other).
-std::unique_ptr<HarnessAwareIndex> RouteRun::obstacles_for(int s, int rank) const {
+/// The segments routed so far but `except` (whose bundles the next plan avoids); none when
+/// planning is not harness-aware.
+std::vector<int> RouteRun::routed_now(int except) const {
+  std::vector<int> out;
+  if (!opt_.harness_aware) return out;
+  for (const auto& kv : tubes_)
+    if (kv.first != except) out.push_back(kv.first);
+  return out;
+}
+
+/// The planning obstacles of segment `s`: the parts and the bundle of every segment in
+/// `visible`, each cut back near a node the two share (there they meet legitimately: within
+/// the audit's junction reach, twice the breakout, and at least far enough that the breakout
+/// stubs leave clear of each other).
+std::unique_ptr<HarnessAwareIndex> RouteRun::obstacles_for(int s, const std::vector<int>& visible) const {
   const Segment& sg = h_.segments[s];
   const double required = ends_[s].radius + rep_.clearance + part_extra_;
   std::vector<BundleTube> tubes;
-  for (const auto& [t, tube] : tubes_) {
-    if (!opt_.harness_aware) break;
-    if (t == s || rank_.at(t) >= rank) continue;
+  for (int t : visible) {
+    const auto found = tubes_.find(t);
+    if (t == s || found == tubes_.end()) continue;
+    const BundleTube& tube = found->second;
     const Segment& st = h_.segments[t];
     std::vector<std::vector<Vec3>> runs{tube.points};
     for (const std::string& n : {sg.from, sg.to}) {
@@ -488,7 +504,7 @@ void RouteRun::add_bundle_tube(int s) {
   const double radius = ends_[s].radius, bend = ends_[s].min_bend_radius;
   Centerline curve;
   if (bend > 0.0) {
-    const auto obstacles = obstacles_for(s, g.rank);
+    const auto obstacles = obstacles_for(s, g.visible);
     curve = round_corners(s, g, *obstacles).curve;
   } else {
     curve = Centerline::interpolate(g.points, g.interp);
@@ -524,13 +540,13 @@ void RouteRun::record_unrouted(int s, const PlanResult& plan, bool branch_blocke
 
 /// Plans segment `s` (unless the input already has its path or spline) and keeps its
 /// key-point polyline, or records why its cables have no route.
-void RouteRun::plan_segment(int s) {
+void RouteRun::plan_segment(int s, const std::vector<int>& visible) {
   const Segment& seg = h_.segments[s];
   SegmentRouteInfo info;
   info.segment = s;
   if (seg.bspline || !seg.path.empty()) {
     info.kept_from_input = true;
-    rep_.segments.push_back(info);
+    store_info(info);
     return;
   }
   const SegmentExits x = segment_exits(s);
@@ -538,7 +554,7 @@ void RouteRun::plan_segment(int s) {
   bool branch_blocked = false;
   const PlanResult blocked = blocked_end(x, branch_blocked);
   const Stopwatch t0;
-  const auto obstacles = obstacles_for(s, rank_.at(s));
+  const auto obstacles = obstacles_for(s, visible);
   PlanResult plan;
   if (!blocked.message.empty()) {
     plan = blocked;
@@ -552,11 +568,13 @@ void RouteRun::plan_segment(int s) {
   if (!plan.solved() && plan.blocking_part >= 0) {
     const std::string who = blocker_name(*obstacles, plan.blocking_part);
     if (!who.empty() && plan.message.find(who) == std::string::npos) plan.message += " (" + who + ")";
+    if (const int t = obstacles->bundle_segment(plan.blocking_part); t >= 0) blocked_by_[s] = t;
   }
   info.plan = plan;
   if (!plan.solved()) {
+    branch_blocked_[s] = branch_blocked;
     record_unrouted(s, plan, branch_blocked);
-    rep_.segments.push_back(info);
+    store_info(info);
     return;
   }
   info.planned = true;
@@ -569,10 +587,73 @@ void RouteRun::plan_segment(int s) {
   g.points = assemble(g, plan.key_points, eps_);
   g.interp.start_tangent = x.ea.exit;
   g.interp.end_tangent = -x.eb.exit;
-  g.rank = rank_.at(s);
+  g.visible = visible;
   geom_[s] = g;
   add_bundle_tube(s);
+  store_info(info);
+}
+
+/// Records how segment `s` was routed: replaces its entry (a re-plan) or appends one.
+void RouteRun::store_info(const SegmentRouteInfo& info) {
+  for (auto& i : rep_.segments)
+    if (i.segment == info.segment) {
+      i = info;
+      return;
+    }
   rep_.segments.push_back(info);
+}
+
+/// Re-plans routed segment `t` among the bundles of `visible` (its request as first
+/// planned); on success its key points, bundle and route info are replaced. False (nothing
+/// changed) if it finds no route.
+bool RouteRun::replan_among(int t, const std::vector<int>& visible) {
+  SegmentGeometry& g = geom_.at(t);
+  PlanRequest req = g.request;
+  SegmentRouteInfo info;
+  info.segment = t;
+  const Stopwatch t0;
+  const auto obstacles = obstacles_for(t, visible);
+  const PlanResult plan = plan_with_retry(h_.segments[t], *obstacles, req, info);
+  rep_.timing.plan += t0.ms();
+  if (!plan.solved()) return false;
+  g.request = req;
+  g.visible = visible;
+  g.points = assemble(g, plan.key_points, eps_);
+  info.plan = plan;
+  info.planned = true;
+  store_info(info);
+  add_bundle_tube(t);
+  return true;
+}
+
+/// Where the routing order was wrong for a segment: one blocked by the bundle of a segment
+/// routed before it is planned again among every other routed bundle, and the blocker is
+/// re-planned around it. Both plans are kept only if both succeed; otherwise the first plan
+/// and its diagnosis stand. The unrouted cables are then recounted in routing order.
+void RouteRun::reorder_blocked() {
+  bool changed = false;
+  for (const auto& [s, t] : std::map<int, int>(blocked_by_)) {
+    if (geom_.count(s) || !geom_.count(t)) continue;
+    const SegmentRouteInfo saved = info_of(s);
+    std::vector<int> without_t = routed_now(s);
+    without_t.erase(std::remove(without_t.begin(), without_t.end(), t), without_t.end());
+    plan_segment(s, without_t);
+    if (geom_.count(s) && replan_among(t, routed_now(t))) {
+      changed = true;
+      rep_.notes.push_back("segment " + h_.segments[s].from + " -> " + h_.segments[s].to +
+                           " was blocked by the bundle of segment " + h_.segments[t].from + " -> " +
+                           h_.segments[t].to + ": planned before it, which was re-planned around it");
+      continue;
+    }
+    geom_.erase(s);
+    tubes_.erase(s);
+    store_info(saved);
+  }
+  if (!changed) return;
+  rep_.unrouted.clear();
+  failed_segments_.clear();
+  for (const auto& info : rep_.segments)
+    if (!info.planned && !info.kept_from_input) record_unrouted(info.segment, info.plan, branch_blocked_[info.segment]);
 }
 
 /// Rounds the corners of segment `s` as far as the planning obstacles allow: tries the
@@ -618,7 +699,7 @@ void RouteRun::build_curve(int s) {
   SegmentGeometry& g = geom_[s];
   std::string status = "not checked";
   if (ends_[s].min_bend_radius > 0.0) {
-    const BendRepairResult chosen = round_corners(s, g, *obstacles_for(s, g.rank));
+    const BendRepairResult chosen = round_corners(s, g, *obstacles_for(s, g.visible));
     g.curve = chosen.curve;
     g.points = chosen.points.empty() ? g.points : chosen.points;
     status = chosen.status == BendRepairStatus::Failed ? "failed: " + chosen.reason
@@ -664,7 +745,7 @@ void RouteRun::replan_bend_failures() {
       req.max_iterations = g.request.max_iterations << attempt;  // twice the budget, as the time
       const Stopwatch t0;
       SegmentRouteInfo scratch;
-      const PlanResult plan = plan_one(*obstacles_for(s, g.rank), req, scratch);
+      const PlanResult plan = plan_one(*obstacles_for(s, g.visible), req, scratch);
       rep_.timing.plan += t0.ms();
       // Whether the re-plan is kept depends on its result: a timed-out one makes the segment
       // irreproducible either way.
