@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
+#include <stdexcept>
 
 namespace loom {
 
@@ -171,6 +171,7 @@ ClosestHit HarnessAwareIndex::nearest_capsule(const Vec3& a, const Vec3& b, doub
 std::optional<AABB> HarnessAwareIndex::part_bounds(int part) const {
   if (part < parts_.part_count()) return parts_.part_bounds(part);
   const int k = part - parts_.part_count();
+  if (k >= static_cast<int>(tube_segment_.size())) throw std::out_of_range("HarnessAwareIndex: bad part id");
   AABB box;
   for (const Capsule& c : caps_)
     if (c.tube == k) {
@@ -214,6 +215,8 @@ ClosestHit HarnessAwareIndex::segment_closest(const Vec3& a, const Vec3& b, doub
 ClosestHit HarnessAwareIndex::segment_closest_on_part(const Vec3& a, const Vec3& b, int part, double max_radius,
                                                       double* segment_param) const {
   if (part < parts_.part_count()) return parts_.segment_closest_on_part(a, b, part, max_radius, segment_param);
+  if (part - parts_.part_count() >= static_cast<int>(tube_segment_.size()))
+    throw std::out_of_range("HarnessAwareIndex: bad part id");
   return nearest_capsule(a, b, max_radius, part - parts_.part_count(), segment_param);
 }
 

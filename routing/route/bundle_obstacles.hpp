@@ -73,7 +73,7 @@ class HarnessAwareIndex : public ObstacleIndex {
   };
   int build(int first, int count);
   /// Nearest capsule surface to segment ab (a == b: a point) within max_radius; `only_tube`
-  /// ≥ 0 restricts the search to that tube. Returns the capsule hit in *cap (−1 if none).
+  /// ≥ 0 restricts the search to that tube; *param (if given) receives the parameter on ab.
   ClosestHit nearest_capsule(const Vec3& a, const Vec3& b, double max_radius, int only_tube, double* param) const;
 
   const ObstacleIndex& parts_;

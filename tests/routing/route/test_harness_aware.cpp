@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,10 @@ TEST(HarnessAware, CapsuleQueriesMatchBruteForce) {
     }
   }
   EXPECT_EQ(index.bundle_segment(0), -1);  // a part
+  EXPECT_THROW(index.part_bounds(1 + 12), std::out_of_range);
+  EXPECT_THROW(index.segment_closest_on_part(Vec3::Zero(), Vec3::UnitX(), 1 + 12, 1.0, nullptr), std::out_of_range);
+  ASSERT_TRUE(index.part_bounds(1).has_value());  // tube 0: its points inflated by its radius
+  EXPECT_TRUE(index.part_bounds(1)->contains(tubes[0].points.front()));
 }
 
 TEST(HarnessAware, ClipNearNodeCutsTheBallOut) {
