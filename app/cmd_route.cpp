@@ -19,6 +19,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <iostream>
@@ -29,6 +30,26 @@
 namespace loom::app {
 
 namespace {
+
+/// One line on the portfolio planner's budgets (scaled with the scene) and what they bought.
+void print_portfolio_budgets(const RouteReport& rep) {
+  std::size_t planned = 0, optimised = 0;
+  double scale_lo = 0.0, scale_hi = 0.0, corridor_s = 0.0, optimise_s = 0.0;
+  for (const auto& info : rep.segments) {
+    if (!info.portfolio) continue;
+    const PortfolioBudget& b = info.portfolio->budget;
+    scale_lo = planned ? std::min(scale_lo, b.scale) : b.scale;
+    scale_hi = planned ? std::max(scale_hi, b.scale) : b.scale;
+    corridor_s = std::max(corridor_s, b.feasibility_seconds);
+    optimise_s = std::max(optimise_s, b.optimise_seconds);
+    ++planned;
+    optimised += info.portfolio->optimised;
+  }
+  if (planned == 0) return;
+  std::printf("  portfolio: corridor budget %.3g-%.3gx (up to %.3g s), optimiser %.3g s; %zu of %zu segments "
+              "shortened by informed RRT*\n",
+              scale_lo, scale_hi, corridor_s, optimise_s, optimised, planned);
+}
 
 void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
   const auto& a = rep.audit;
@@ -49,6 +70,7 @@ void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
                 "%zu unsupported spans\n",
                 rep.clamps_placed, 100.0 * rep.share_within_reach, a.supports.spans.size());
   print_support_findings(a, 10);
+  print_portfolio_budgets(rep);
   for (const auto& u : rep.unrouted)
     std::printf("  NOT ROUTED %s (segment %s): %s — %s\n", u.cable.c_str(), u.segment.c_str(), u.reason.c_str(),
                 u.message.c_str());

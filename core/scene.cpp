@@ -6,8 +6,8 @@ namespace loom {
 
 const std::vector<std::string>& routing_planner_names() {
   static const std::vector<std::string> names = {
-      "abitstar", "bfmt",   "bitstar", "fmt",        "informedrrtstar", "lazyprm",  "lazyprmstar",
-      "prm",      "prmstar", "rrt",    "rrtconnect", "rrtsharp",        "rrtstar",  "sorrtstar"};
+      "abitstar", "bfmt", "bitstar", "fmt", "informedrrtstar", "lazyprm", "lazyprmstar", "portfolio",
+      "prm", "prmstar", "rrt", "rrtconnect", "rrtsharp", "rrtstar", "sorrtstar"};
   return names;
 }
 

@@ -33,7 +33,9 @@ const std::vector<std::string>& routing_planner_names();
 
 struct RoutingSettings {
   Setting clearance;       ///< required gap between cable surface and structure
-  std::string planner = "informedrrtstar";
+  /// One of routing_planner_names(); default the portfolio (RRT-Connect's corridor, then
+  /// Informed RRT* within the budget: routing/route/planner_portfolio.hpp).
+  std::string planner = "portfolio";
   Setting time_limit;      ///< seconds per cable or bundle
   unsigned seed = 1;
   /// Planner iterations per cable or bundle, 1..kMaxPlanIterations; 0 = none (the planners

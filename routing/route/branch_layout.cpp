@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace loom {
 
@@ -15,6 +16,8 @@ namespace {
 constexpr int kWeiszfeldIterations = 100;
 /// Moving a branch point clear: shells tried, each one required clearance further out.
 constexpr int kClearShells = 40;
+/// Separating branch points: shells tried, each a quarter of the gap needed further out.
+constexpr int kSeparateShells = 40;
 /// Compass search: sweeps over a chain of unplaced points, and evaluations per point.
 constexpr int kCompassSweeps = 3;
 constexpr int kCompassMaxSteps = 400;
@@ -106,7 +109,35 @@ std::vector<std::string> place_branch_points(Harness& h, const HarnessTopology& 
       if (den > 0) pos[b] = num / den;
     }
 
-  auto is_clear = [&](int b, const Vec3& q) { return !index.inside(q) && !index.any_within(q, opt.clearance_of(b)); };
+  // How far apart two branch points must stay: neighbours by both their breakouts (each
+  // leaves its node straight for that long before it may bend), any other two by the larger
+  // bundle diameter meeting at either (closer, their bundles would overlap).
+  std::map<int, double> diameter;
+  for (std::size_t b = 0; b < h.branches.size(); ++b)
+    for (int s : topo.incident_segments(h.branches[b].id))
+      diameter[static_cast<int>(b)] = std::max(diameter[static_cast<int>(b)], 2.0 * ends[s].radius);
+  auto min_gap = [&](int b, int o) {
+    const std::string &ib = h.branches[b].id, &io = h.branches[o].id;
+    for (int s : topo.incident_segments(ib))
+      if (other_end(h.segments[s], ib) == io)
+        return std::max(breakout_length(topo, ib) + breakout_length(topo, io), std::max(diameter[b], diameter[o]));
+    return std::max(diameter[b], diameter[o]);
+  };
+  auto branch_at = [&](int o) -> std::optional<Vec3> {
+    if (h.branches[o].position) return *h.branches[o].position;
+    auto it = pos.find(o);
+    return it == pos.end() ? std::nullopt : std::optional<Vec3>(it->second);
+  };
+  auto separated = [&](int b, const Vec3& q) {
+    for (std::size_t o = 0; o < h.branches.size(); ++o) {
+      if (static_cast<int>(o) == b) continue;
+      const auto at = branch_at(static_cast<int>(o));
+      if (at && (q - *at).norm() < min_gap(b, static_cast<int>(o))) return false;
+    }
+    return true;
+  };
+  auto is_free = [&](int b, const Vec3& q) { return !index.inside(q) && !index.any_within(q, opt.clearance_of(b)); };
+  auto is_clear = [&](int b, const Vec3& q) { return is_free(b, q) && separated(b, q); };
   // The cost of a position: leg lengths plus the bend deficit of every port leg. A port leg
   // runs B → stub end S → port P; at S it turns by θ from (S − B) into the connector axis,
   // and a corner rounded to radius R needs R·tan(θ/2) of straight run on each side: the
@@ -134,14 +165,14 @@ std::vector<std::string> place_branch_points(Harness& h, const HarnessTopology& 
     // legs shortest on the first shell that has one.
     const double need = opt.clearance_of(b);
     Vec3 p = pos[b];
-    if (!is_clear(b, p)) {
+    if (!is_free(b, p)) {
       bool found = false;
       for (int shell = 1; shell <= kClearShells && !found; ++shell) {
         double best = std::numeric_limits<double>::infinity();
         Vec3 best_p = p;
         for (const auto& d : dirs) {
           const Vec3 q = p + d * (need * shell);
-          if (!is_clear(b, q)) continue;
+          if (!is_free(b, q)) continue;
           double len = 0;
           for (int s : topo.incident_segments(h.branches[b].id)) len += (leg_target(b, s) - q).norm();
           if (len < best) best = len, best_p = q;
@@ -153,6 +184,32 @@ std::vector<std::string> place_branch_points(Harness& h, const HarnessTopology& 
                          "cannot place this branch point clear of the structure near its neighbours");
     }
     pos[b] = p;
+  }
+  // Router-placed points collapse onto each other (the median of a chain of unplaced points
+  // is often shared): move each one that is too near another branch point to the cheapest
+  // position clear of the parts and apart from the others, on shells a quarter of the
+  // gap it needs apart.
+  for (int b : unplaced) {
+    if (separated(b, pos[b])) continue;
+    double gap = 0.0;
+    for (std::size_t o = 0; o < h.branches.size(); ++o)
+      if (static_cast<int>(o) != b) gap = std::max(gap, min_gap(b, static_cast<int>(o)));
+    const double step = std::max(0.25 * gap, opt.clearance_of(b));
+    bool found = false;
+    for (int shell = 1; shell <= kSeparateShells && !found; ++shell) {
+      double best = std::numeric_limits<double>::infinity();
+      Vec3 best_p = pos[b];
+      for (const auto& d : dirs) {
+        const Vec3 q = pos[b] + d * (step * shell);
+        if (!is_clear(b, q)) continue;
+        const double c = cost(b, q);
+        if (c < best) best = c, best_p = q;
+      }
+      if (std::isfinite(best)) pos[b] = best_p, found = true;
+    }
+    if (!found)
+      throw InputError({h.source_file, h.branches[b].line, "branch '" + h.branches[b].id + "'"},
+                       "cannot place this branch point clear of the structure and apart from the other branch points");
   }
   // Compass search over clear positions: the cost is not smooth (deficits switch on and
   // off) and each evaluation is cheap, so a derivative-free pattern search is the right tool.

@@ -45,8 +45,10 @@ struct BranchPlacementOptions {
 /// positions minimising the summed leg length plus `bend_deficit_weight` × the leg length
 /// missing for each port leg to turn into its connector axis within the bend radius
 /// (R·tan(θ/2) on each side of the corner, plus the breakout run at the branch).
-/// Returns the ids placed, in branch order. Throws InputError naming the branch when no
-/// clear position exists near its neighbours.
+/// Placed points keep apart from every other branch point: neighbours by the sum of their
+/// breakout lengths, any two by the larger bundle diameter meeting at either; fixed branch
+/// points and ports are never moved. Returns the ids placed, in branch order. Throws
+/// InputError naming the branch when no clear, separated position exists near its neighbours.
 std::vector<std::string> place_branch_points(Harness& h, const HarnessTopology& topo, const ObstacleIndex& index,
                                              const std::vector<SegmentEnds>& ends,
                                              const BranchPlacementOptions& opt);

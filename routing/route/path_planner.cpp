@@ -808,8 +808,11 @@ const char* reason_name(NoPathReason r) {
 std::vector<std::string> planner_names() {
   // The scene model's list is the one users see; every name on it must have a table entry
   // (find_planner throws otherwise: PathPlanner.EveryPlannerNameSolvesAnEasyScene plans with each).
-  for (const std::string& n : routing_planner_names()) find_planner(n);
-  return routing_planner_names();
+  // "portfolio" is on the scene's list but not an OMPL planner (planner_portfolio.hpp).
+  std::vector<std::string> names;
+  for (const std::string& n : routing_planner_names())
+    if (n != "portfolio") names.push_back(find_planner(n).name);
+  return names;
 }
 
 bool planner_is_optimizing(const std::string& name) { return find_planner(name).optimizing; }

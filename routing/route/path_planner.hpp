@@ -168,7 +168,8 @@ struct PlanResult {
   bool solved() const { return status == PlanStatus::Solved; }
 };
 
-/// The planner names accepted by PlanSettings::planner, sorted.
+/// The planner names accepted by PlanSettings::planner, sorted (routing_planner_names()
+/// without "portfolio", which route_scene runs through plan_portfolio).
 std::vector<std::string> planner_names();
 /// True if the named planner optimises the objective (runs until convergence/budget).
 /// Throws std::invalid_argument for an unknown name.

@@ -12,6 +12,7 @@
 #include "routing/route/clamp_placement.hpp"
 #include "routing/curve/bend_repair.hpp"
 #include "routing/route/branch_layout.hpp"
+#include "routing/route/bundle_obstacles.hpp"
 #include "routing/route/port_check.hpp"
 #include "routing/route/support_pull.hpp"
 #include "routing/curve/cable_geometry.hpp"
@@ -57,6 +58,7 @@ struct SegmentGeometry {
   Centerline curve;
   Vec3 a, a_stub, b_stub, b;  ///< the ends and their stub ends, as planned
   PlanRequest request;        ///< what the planner was asked (for re-planning)
+  std::vector<int> visible;   ///< segments whose bundles were its obstacles when it was planned
 };
 
 
@@ -152,16 +154,25 @@ class RouteRun {
   void layout_branches();
   EndFrame end_frame(int seg, bool from_end) const;
   void plan_segments();
-  void plan_segment(int s);
+  void plan_segment(int s, const std::vector<int>& visible);
   SegmentExits segment_exits(int s) const;
   PlanRequest plan_request(int s, const SegmentExits& x) const;
   PlanResult blocked_end(const SegmentExits& x, bool& branch_blocked) const;
-  PlanResult plan_with_retry(const Segment& seg, PlanRequest& req, SegmentRouteInfo& info);
-  int pull_to_supports(const SegmentExits& x, std::vector<Vec3>& key_points) const;
+  PlanResult plan_with_retry(const Segment& seg, const ObstacleIndex& index, PlanRequest& req,
+                             SegmentRouteInfo& info);
+  std::unique_ptr<HarnessAwareIndex> obstacles_for(int s, const std::vector<int>& visible) const;
+  std::vector<int> routed_now(int except) const;
+  void store_info(const SegmentRouteInfo& info);
+  void reorder_blocked();
+  bool replan_among(int t, const std::vector<int>& visible);
+  PlanResult plan_one(const ObstacleIndex& index, const PlanRequest& req, SegmentRouteInfo& info) const;
+  void add_bundle_tube(int s);
+  std::string blocker_name(const ObstacleIndex& index, int part) const;
+  int pull_to_supports(const ObstacleIndex& index, const SegmentExits& x, std::vector<Vec3>& key_points) const;
   void record_unrouted(int s, const PlanResult& plan, bool branch_blocked);
   void build_splines();
   void build_curve(int s);
-  BendRepairResult round_corners(int s, const SegmentGeometry& g) const;
+  BendRepairResult round_corners(int s, const SegmentGeometry& g, const ObstacleIndex& index) const;
   void replan_bend_failures();
   SegmentRouteInfo& info_of(int s);
   bool bend_failed(int s);
@@ -190,6 +201,9 @@ class RouteRun {
   AABB box_;
   double eps_ = 0.0;  ///< coincident key points
   std::map<int, SegmentGeometry> geom_;
+  std::map<int, BundleTube> tubes_;  ///< each planned segment's bundle as an obstacle for later ones
+  std::map<int, int> blocked_by_;    ///< failed segment → the segment whose bundle blocked it
+  std::map<int, bool> branch_blocked_;  ///< failed segment → a branch point of it lies in a part
   std::set<std::string> failed_segments_;
   std::unique_ptr<EmbreeIndex> exact_owned_;
   Scene routed_scene_;
@@ -300,8 +314,9 @@ void RouteRun::plan_segments() {
   const auto& order = topo_.routing_order();
   seed_ompl_once(rep_.seed);
   ProgressCounter planned(opt_.progress, "plan", order.size(), "segments");
-  for (std::size_t k = 0; k < order.size(); ++k, planned.add()) plan_segment(order[k]);
+  for (std::size_t k = 0; k < order.size(); ++k, planned.add()) plan_segment(order[k], routed_now(order[k]));
   planned.finish();
+  reorder_blocked();
 }
 
 /// Each end of segment `s` leaves straight along its exit direction: a port along the
@@ -420,17 +435,18 @@ PlanResult RouteRun::blocked_end(const SegmentExits& x, bool& branch_blocked) co
   return blocked;
 }
 
-/// Plans `req`; if that fails and parts ask for extra clearance, plans again with the routing
-/// clearance alone (`req` keeps the clearance the kept plan used).
-PlanResult RouteRun::plan_with_retry(const Segment& seg, PlanRequest& req, SegmentRouteInfo& info) {
-  PlanResult plan = plan_path(*plan_index_, req);
+/// Plans `req` among `index`; if that fails and parts ask for extra clearance, plans again
+/// with the routing clearance alone (`req` keeps the clearance the kept plan used).
+PlanResult RouteRun::plan_with_retry(const Segment& seg, const ObstacleIndex& index, PlanRequest& req,
+                                     SegmentRouteInfo& info) {
+  PlanResult plan = plan_one(index, req, info);
   info.time_limited = plan.time_limited;
   if (!plan.solved() && part_extra_ > 0.0) {
     // Per-part extra clearance is applied to every part while planning (conservative);
     // if that closes every corridor, plan with the routing clearance and let the audit
     // report where a part's own extra clearance is not met.
     req.clearance = rep_.clearance;
-    PlanResult retry = plan_path(*plan_index_, req);
+    PlanResult retry = plan_one(index, req, info);
     info.time_limited = info.time_limited || retry.time_limited;
     if (retry.solved()) {
       plan = retry;
@@ -439,6 +455,85 @@ PlanResult RouteRun::plan_with_retry(const Segment& seg, PlanRequest& req, Segme
     }
   }
   return plan;
+}
+
+/// One plan with the run's planner: the portfolio (its budgets kept in `info`) or one OMPL
+/// planner.
+PlanResult RouteRun::plan_one(const ObstacleIndex& index, const PlanRequest& req, SegmentRouteInfo& info) const {
+  if (req.planner != kPortfolioPlanner) return plan_path(index, req);
+  PortfolioOutcome out = plan_portfolio(index, req);
+  PlanResult plan = out.plan;
+  info.portfolio = std::move(out);
+  return plan;
+}
+
+/// The segments routed so far but `except` (whose bundles the next plan avoids); none when
+/// planning is not harness-aware.
+std::vector<int> RouteRun::routed_now(int except) const {
+  std::vector<int> out;
+  if (!opt_.harness_aware) return out;
+  for (const auto& kv : tubes_)
+    if (kv.first != except) out.push_back(kv.first);
+  return out;
+}
+
+/// The planning obstacles of segment `s`: the parts and the bundle of every segment in
+/// `visible`, each cut back near a node the two share (there they meet legitimately: within
+/// the audit's junction reach, twice the breakout, and at least far enough that the breakout
+/// stubs leave clear of each other).
+std::unique_ptr<HarnessAwareIndex> RouteRun::obstacles_for(int s, const std::vector<int>& visible) const {
+  const Segment& sg = h_.segments[s];
+  const double required = ends_[s].radius + rep_.clearance + part_extra_;
+  std::vector<BundleTube> tubes;
+  for (int t : visible) {
+    const auto found = tubes_.find(t);
+    if (t == s || found == tubes_.end()) continue;
+    const BundleTube& tube = found->second;
+    const Segment& st = h_.segments[t];
+    std::vector<std::vector<Vec3>> runs{tube.points};
+    for (const std::string& n : {sg.from, sg.to}) {
+      if (n != st.from && n != st.to) continue;
+      const double breakout = breakout_length(topo_, n);
+      const double reach = std::max(2.0 * breakout, breakout + required + tube.radius);
+      const Vec3 at = *h_.node_position(n);
+      std::vector<std::vector<Vec3>> kept;
+      for (const auto& r : runs)
+        for (auto& piece : clip_near_node(r, at, reach)) kept.push_back(std::move(piece));
+      runs = std::move(kept);
+    }
+    for (auto& r : runs) tubes.push_back({t, std::move(r), tube.radius});
+  }
+  return std::make_unique<HarnessAwareIndex>(*plan_index_, tubes);
+}
+
+/// Keeps the bundle of planned segment `s` as an obstacle for the segments planned after it:
+/// its curve as build_curve will make it, sampled every bundle radius, the radius grown by
+/// the chord sag of that sampling at the bend radius.
+void RouteRun::add_bundle_tube(int s) {
+  const SegmentGeometry& g = geom_.at(s);
+  const double radius = ends_[s].radius, bend = ends_[s].min_bend_radius;
+  Centerline curve;
+  if (bend > 0.0) {
+    const auto obstacles = obstacles_for(s, g.visible);
+    curve = round_corners(s, g, *obstacles).curve;
+  } else {
+    curve = Centerline::interpolate(g.points, g.interp);
+  }
+  const double step = std::max(radius, 1e-6 * std::max(1.0, box_.diagonal()));
+  BundleTube tube;
+  tube.segment = s;
+  for (const auto& sp : curve.sample_by_arc_length(step)) tube.points.push_back(sp.second);
+  tube.radius = radius + step * step / (8.0 * std::max(bend, radius));
+  tubes_[s] = std::move(tube);
+}
+
+/// What blocked a plan, for its message: a part by name or the bundle of a segment.
+std::string RouteRun::blocker_name(const ObstacleIndex& index, int part) const {
+  if (part >= 0 && part < static_cast<int>(planning_parts_.size())) return "part '" + planning_parts_[part].name + "'";
+  const auto* aware = dynamic_cast<const HarnessAwareIndex*>(&index);
+  const int t = aware ? aware->bundle_segment(part) : -1;
+  if (t < 0) return "";
+  return "the bundle of segment " + h_.segments[t].from + " -> " + h_.segments[t].to + ", routed before it";
 }
 
 /// One entry per cable through segment `s`: the first segment (in routing order) that
@@ -455,13 +550,13 @@ void RouteRun::record_unrouted(int s, const PlanResult& plan, bool branch_blocke
 
 /// Plans segment `s` (unless the input already has its path or spline) and keeps its
 /// key-point polyline, or records why its cables have no route.
-void RouteRun::plan_segment(int s) {
+void RouteRun::plan_segment(int s, const std::vector<int>& visible) {
   const Segment& seg = h_.segments[s];
   SegmentRouteInfo info;
   info.segment = s;
   if (seg.bspline || !seg.path.empty()) {
     info.kept_from_input = true;
-    rep_.segments.push_back(info);
+    store_info(info);
     return;
   }
   const SegmentExits x = segment_exits(s);
@@ -469,6 +564,7 @@ void RouteRun::plan_segment(int s) {
   bool branch_blocked = false;
   const PlanResult blocked = blocked_end(x, branch_blocked);
   const Stopwatch t0;
+  const auto obstacles = obstacles_for(s, visible);
   PlanResult plan;
   if (!blocked.message.empty()) {
     plan = blocked;
@@ -476,20 +572,23 @@ void RouteRun::plan_segment(int s) {
     plan.status = PlanStatus::Solved;
     plan.key_points = {x.a_stub, x.b_stub};
   } else {
-    plan = plan_with_retry(seg, req, info);
+    plan = plan_with_retry(seg, *obstacles, req, info);
   }
   rep_.timing.plan += t0.ms();
-  if (!plan.solved() && plan.blocking_part >= 0 && plan.blocking_part < static_cast<int>(planning_parts_.size()) &&
-      plan.message.find("'" + planning_parts_[plan.blocking_part].name + "'") == std::string::npos)
-    plan.message += " (part '" + planning_parts_[plan.blocking_part].name + "')";
+  if (!plan.solved() && plan.blocking_part >= 0) {
+    const std::string who = blocker_name(*obstacles, plan.blocking_part);
+    if (!who.empty() && plan.message.find(who) == std::string::npos) plan.message += " (" + who + ")";
+    if (const int t = obstacles->bundle_segment(plan.blocking_part); t >= 0) blocked_by_[s] = t;
+  }
   info.plan = plan;
   if (!plan.solved()) {
+    branch_blocked_[s] = branch_blocked;
     record_unrouted(s, plan, branch_blocked);
-    rep_.segments.push_back(info);
+    store_info(info);
     return;
   }
   info.planned = true;
-  if (scene_.routing.supports) info.support_points = pull_to_supports(x, plan.key_points);
+  if (scene_.routing.supports) info.support_points = pull_to_supports(*obstacles, x, plan.key_points);
   SegmentGeometry g;
   g.a = x.ea.position;
   g.a_stub = x.a_stub;
@@ -499,13 +598,27 @@ void RouteRun::plan_segment(int s) {
   g.points = assemble(g, plan.key_points, eps_);
   g.interp.start_tangent = x.ea.exit;
   g.interp.end_tangent = -x.eb.exit;
+  g.visible = visible;
   geom_[s] = g;
+  add_bundle_tube(s);
+  store_info(info);
+}
+
+/// Records how segment `s` was routed: replaces its entry (a re-plan) or appends one.
+void RouteRun::store_info(const SegmentRouteInfo& info) {
+  for (auto& i : rep_.segments)
+    if (i.segment == info.segment) {
+      i = info;
+      return;
+    }
   rep_.segments.push_back(info);
 }
 
 /// Inserts key points into `key_points` (stub end to stub end) where the route runs longer
-/// than clamp_spacing out of clamp reach of structure (pull_to_structure); returns how many.
-int RouteRun::pull_to_supports(const SegmentExits& x, std::vector<Vec3>& key_points) const {
+/// than clamp_spacing out of clamp reach of structure (pull_to_structure), clear of what
+/// `index` holds (the parts and the bundles routed so far; bundles carry no clamp); returns
+/// how many.
+int RouteRun::pull_to_supports(const ObstacleIndex& index, const SegmentExits& x, std::vector<Vec3>& key_points) const {
   SupportPullSettings ps;
   ps.spacing = scene_.routing.clamp_spacing.value;
   ps.reach = x.radius + scene_.routing.clamp_reach.value;
@@ -514,16 +627,69 @@ int RouteRun::pull_to_supports(const SegmentExits& x, std::vector<Vec3>& key_poi
   ps.start_is_port = x.ea.is_port;
   ps.end_is_port = x.eb.is_port;
   for (const Part& p : planning_parts_) ps.part_supports.push_back(p.role == PartRole::Structure);
-  SupportPullResult pulled = pull_to_structure(*plan_index_, key_points, ps);
+  SupportPullResult pulled = pull_to_structure(index, key_points, ps);
   key_points = std::move(pulled.points);
   return pulled.inserted;
+}
+
+/// Re-plans routed segment `t` among the bundles of `visible` (its request as first
+/// planned); on success its key points, bundle and route info are replaced. False (nothing
+/// changed) if it finds no route.
+bool RouteRun::replan_among(int t, const std::vector<int>& visible) {
+  SegmentGeometry& g = geom_.at(t);
+  PlanRequest req = g.request;
+  SegmentRouteInfo info;
+  info.segment = t;
+  const Stopwatch t0;
+  const auto obstacles = obstacles_for(t, visible);
+  const PlanResult plan = plan_with_retry(h_.segments[t], *obstacles, req, info);
+  rep_.timing.plan += t0.ms();
+  if (!plan.solved()) return false;
+  g.request = req;
+  g.visible = visible;
+  g.points = assemble(g, plan.key_points, eps_);
+  info.plan = plan;
+  info.planned = true;
+  store_info(info);
+  add_bundle_tube(t);
+  return true;
+}
+
+/// Where the routing order was wrong for a segment: one blocked by the bundle of a segment
+/// routed before it is planned again among every other routed bundle, and the blocker is
+/// re-planned around it. Both plans are kept only if both succeed; otherwise the first plan
+/// and its diagnosis stand. The unrouted cables are then recounted in routing order.
+void RouteRun::reorder_blocked() {
+  bool changed = false;
+  for (const auto& [s, t] : std::map<int, int>(blocked_by_)) {
+    if (geom_.count(s) || !geom_.count(t)) continue;
+    const SegmentRouteInfo saved = info_of(s);
+    std::vector<int> without_t = routed_now(s);
+    without_t.erase(std::remove(without_t.begin(), without_t.end(), t), without_t.end());
+    plan_segment(s, without_t);
+    if (geom_.count(s) && replan_among(t, routed_now(t))) {
+      changed = true;
+      rep_.notes.push_back("segment " + h_.segments[s].from + " -> " + h_.segments[s].to +
+                           " was blocked by the bundle of segment " + h_.segments[t].from + " -> " +
+                           h_.segments[t].to + ": planned before it, which was re-planned around it");
+      continue;
+    }
+    geom_.erase(s);
+    tubes_.erase(s);
+    store_info(saved);
+  }
+  if (!changed) return;
+  rep_.unrouted.clear();
+  failed_segments_.clear();
+  for (const auto& info : rep_.segments)
+    if (!info.planned && !info.kept_from_input) record_unrouted(info.segment, info.plan, branch_blocked_[info.segment]);
 }
 
 /// Rounds the corners of segment `s` as far as the planning obstacles allow: tries the
 /// budgets from generous (a corner rounded to the full bend radius moves up to ~0.4 R) to
 /// tight, and keeps the first repaired curve whose samples stay clear of the (simplified)
 /// parts, else the last tried; the exact audit that follows is the judge.
-BendRepairResult RouteRun::round_corners(int s, const SegmentGeometry& g) const {
+BendRepairResult RouteRun::round_corners(int s, const SegmentGeometry& g, const ObstacleIndex& index) const {
   const double min_bend = ends_[s].min_bend_radius;
   const double radius = ends_[s].radius;
   const double need = radius + 0.5 * rep_.clearance;
@@ -540,7 +706,7 @@ BendRepairResult RouteRun::round_corners(int s, const SegmentGeometry& g) const 
     bool clear = true;
     for (const auto& [sa, p] : br.curve.sample_by_arc_length(step)) {
       (void)sa;
-      if (plan_index_->any_within(p, need) && (p - g.points.front()).norm() > need &&
+      if (index.any_within(p, need) && (p - g.points.front()).norm() > need &&
           (p - g.points.back()).norm() > need) {
         clear = false;
         break;
@@ -562,7 +728,7 @@ void RouteRun::build_curve(int s) {
   SegmentGeometry& g = geom_[s];
   std::string status = "not checked";
   if (ends_[s].min_bend_radius > 0.0) {
-    const BendRepairResult chosen = round_corners(s, g);
+    const BendRepairResult chosen = round_corners(s, g, *obstacles_for(s, g.visible));
     g.curve = chosen.curve;
     g.points = chosen.points.empty() ? g.points : chosen.points;
     status = chosen.status == BendRepairStatus::Failed ? "failed: " + chosen.reason
@@ -607,7 +773,8 @@ void RouteRun::replan_bend_failures() {
       req.time_limit = g.request.time_limit * std::pow(2.0, attempt);
       req.max_iterations = g.request.max_iterations << attempt;  // twice the budget, as the time
       const Stopwatch t0;
-      const PlanResult plan = plan_path(*plan_index_, req);
+      SegmentRouteInfo scratch;
+      const PlanResult plan = plan_one(*obstacles_for(s, g.visible), req, scratch);
       rep_.timing.plan += t0.ms();
       // Whether the re-plan is kept depends on its result: a timed-out one makes the segment
       // irreproducible either way.
@@ -625,6 +792,7 @@ void RouteRun::replan_bend_failures() {
         info_of(s).time_limited = timed;
       } else {
         info_of(s).plan = plan;
+        info_of(s).portfolio = scratch.portfolio;
         info_of(s).replans = attempt;
       }
     }
@@ -730,7 +898,7 @@ void RouteRun::note_reproducibility() {
     rep_.unreproducible.push_back("no iteration budget: the planners stop on the time limit and on time-based "
                                   "convergence, so another run may give other routes (set --iterations or "
                                   "[routing] iterations)");
-  else if (planner_is_threaded(rep_.planner))
+  else if (rep_.planner != kPortfolioPlanner && planner_is_threaded(rep_.planner))
     rep_.unreproducible.push_back("planner " + rep_.planner +
                                   " grows its roadmap in a second thread: its routes are not reproducible, "
                                   "even with an iteration budget");

@@ -9,10 +9,12 @@
 #include "core/scene.hpp"
 #include "routing/audit/audit.hpp"
 #include "routing/route/path_planner.hpp"
+#include "routing/route/planner_portfolio.hpp"
 
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,6 +46,10 @@ struct RouteOptions {
   /// always uses the scene's exact parts.
   std::shared_ptr<const std::vector<Part>> planning_parts;
   int max_repair_rounds = 4; ///< audit → densify → re-spline rounds per segment
+  /// Plan each segment among the parts and the bundles routed before it (bundle radius +
+  /// clearance; cut back near the nodes they share). false: among the parts only, as
+  /// before harness-aware planning (for comparisons).
+  bool harness_aware = true;
   /// Progress of the stages: "simplify" (parts), "index" (planning index built), "plan"
   /// (segments), "audit" (cables, each audit round); may be empty.
   ProgressFn progress;
@@ -65,6 +71,8 @@ struct SegmentRouteInfo {
   /// True if the time limit ended any plan of this segment (first plan, clearance retry or
   /// bend re-plan) before its iteration budget: this segment's route is not reproducible.
   bool time_limited = false;
+  /// With the portfolio planner: the budgets of the plan kept and what its stages did.
+  std::optional<PortfolioOutcome> portfolio;
 };
 
 /// Why a cable has no route.

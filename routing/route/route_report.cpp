@@ -88,6 +88,19 @@ json route_report_json(const RouteReport& rep) {
       o["plan_ms"] = info.plan.time_ms;
       o["iterations"] = info.plan.iterations;
       o["time_limited"] = info.time_limited;
+      if (info.portfolio) {
+        const PortfolioOutcome& pf = *info.portfolio;
+        o["portfolio"] = {{"scale", pf.budget.scale},
+                          {"feasibility_seconds", pf.budget.feasibility_seconds},
+                          {"feasibility_iterations", pf.budget.feasibility_iterations},
+                          {"feasibility_iterations_used", pf.feasibility_iterations_used},
+                          {"optimise_seconds", pf.budget.optimise_seconds},
+                          {"optimise_iterations", pf.budget.optimise_iterations},
+                          {"optimise_iterations_used", pf.optimise_iterations_used},
+                          {"corridor_found", pf.corridor_found},
+                          {"optimised", pf.optimised}};
+        if (pf.corridor_found) o["portfolio"]["corridor_cost"] = pf.feasibility_cost;
+      }
       if (info.plan.solved()) {
         o["planned_length"] = info.plan.length;
         o["planned_min_clearance"] = finite_or(info.plan.min_clearance, 0.0);

@@ -1,0 +1,166 @@
+// Harness-aware planning: the capsule obstacles of routed bundles (against a brute-force
+// oracle), their cut-back near a shared node (closed form), and a hand-made harness whose two
+// segments clash when each is planned among the parts only and do not when the second is
+// planned among the first's bundle too (the audit is the judge).
+#include "core/io/harness_xml.hpp"
+#include "index/embree_index.hpp"
+#include "index/index_test_meshes.hpp"
+#include "index/triangle_distance.hpp"
+#include "routing/route/bundle_obstacles.hpp"
+#include "routing/route/route_pipeline.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace loom {
+namespace {
+
+/// Brute force: distance from segment ab to the nearest capsule surface (∞ if none).
+double brute_capsule_distance(const std::vector<BundleTube>& tubes, const Vec3& a, const Vec3& b) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& t : tubes)
+    for (std::size_t i = 0; i + 1 < t.points.size(); ++i) {
+      const auto r = closest_segment_segment(a, b, t.points[i], t.points[i + 1]);
+      best = std::min(best, std::max(0.0, std::sqrt(r.dist2) - t.radius));
+    }
+  return best;
+}
+
+TEST(HarnessAware, CapsuleQueriesMatchBruteForce) {
+  // Parts far away from every capsule and query, so that only the capsules answer.
+  const std::vector<Part> parts{testmesh::box_part("far", Vec3(1000, 1000, 1000), Vec3(1001, 1001, 1001))};
+  const EmbreeIndex embree(parts);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-50.0, 50.0), rad(0.5, 4.0);
+  std::vector<BundleTube> tubes;
+  for (int t = 0; t < 12; ++t) {
+    BundleTube tube;
+    tube.segment = 100 + t;
+    tube.radius = rad(rng);
+    Vec3 p(u(rng), u(rng), u(rng));
+    for (int i = 0; i < 9; ++i) {
+      tube.points.push_back(p);
+      p += 0.2 * Vec3(u(rng), u(rng), u(rng));
+    }
+    tubes.push_back(tube);
+  }
+  const HarnessAwareIndex index(embree, tubes);
+  EXPECT_EQ(index.capsule_count(), 12u * 8u);
+  EXPECT_EQ(index.part_count(), 1 + 12);
+  for (int q = 0; q < 400; ++q) {
+    const Vec3 a(u(rng), u(rng), u(rng));
+    const Vec3 b = q % 2 ? a : Vec3(a + 0.3 * Vec3(u(rng), u(rng), u(rng)));
+    const double want = brute_capsule_distance(tubes, a, b);
+    const ClosestHit hit = index.segment_closest(a, b, std::numeric_limits<double>::infinity(), nullptr);
+    ASSERT_TRUE(hit.found());
+    EXPECT_NEAR(hit.distance, want, 1e-9) << "query " << q;
+    EXPECT_GE(index.bundle_segment(hit.part), 100);
+    const double r = want + (q % 3 == 0 ? -1e-6 : 1e-6);
+    EXPECT_EQ(index.segment_within(a, b, r), r >= want) << "query " << q;
+    if (q % 2) {
+      EXPECT_NEAR(index.closest(a, std::numeric_limits<double>::infinity()).distance, want, 1e-9);
+      EXPECT_EQ(index.any_within(a, r), r >= want);
+    }
+  }
+  EXPECT_EQ(index.bundle_segment(0), -1);  // a part
+  EXPECT_THROW(index.part_bounds(1 + 12), std::out_of_range);
+  EXPECT_THROW(index.segment_closest_on_part(Vec3::Zero(), Vec3::UnitX(), 1 + 12, 1.0, nullptr), std::out_of_range);
+  ASSERT_TRUE(index.part_bounds(1).has_value());  // tube 0: its points inflated by its radius
+  EXPECT_TRUE(index.part_bounds(1)->contains(tubes[0].points.front()));
+}
+
+TEST(HarnessAware, ClipNearNodeCutsTheBallOut) {
+  // The x axis from −10 to 10 through a ball of radius 3 at the origin: two runs, cut on the sphere.
+  const std::vector<Vec3> line{Vec3(-10, 0, 0), Vec3(-1, 0, 0), Vec3(10, 0, 0)};
+  const auto runs = clip_near_node(line, Vec3::Zero(), 3.0);
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_NEAR((runs[0].front() - Vec3(-10, 0, 0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((runs[0].back() - Vec3(-3, 0, 0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((runs[1].front() - Vec3(3, 0, 0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((runs[1].back() - Vec3(10, 0, 0)).norm(), 0.0, 1e-12);
+  // A leg leaving the node: only the run beyond the ball stays; one wholly inside vanishes.
+  const auto leg = clip_near_node({Vec3::Zero(), Vec3(0, 5, 0)}, Vec3::Zero(), 3.0);
+  ASSERT_EQ(leg.size(), 1u);
+  EXPECT_NEAR((leg[0].front() - Vec3(0, 3, 0)).norm(), 0.0, 1e-12);
+  EXPECT_TRUE(clip_near_node({Vec3::Zero(), Vec3(0, 2, 0)}, Vec3::Zero(), 3.0).empty());
+}
+
+std::string port_xml(const std::string& id, const Vec3& at, const Vec3& dir) {
+  auto f = [](double v) { return std::to_string(v); };
+  return "<port id=\"" + id + "\" x=\"" + f(at.x()) + "\" y=\"" + f(at.y()) + "\" z=\"" + f(at.z()) + "\" dx=\"" +
+         f(dir.x()) + "\" dy=\"" + f(dir.y()) + "\" dz=\"" + f(dir.z()) + "\"/>\n";
+}
+
+std::string cable_xml(const std::string& id, const std::string& p1, const std::string& p2) {
+  return "<cable id=\"" + id + "\"><electrical><port id=\"" + p1 + "\"/><port id=\"" + p2 +
+         "\"/></electrical><physical type=\"T\" color=\"red\" diameter=\"4\" min_bend_radius=\"10\"/></cable>\n";
+}
+
+/// Two bundles crossing in empty space: A1–A2 along x (two cables, so it is routed first),
+/// B1–B2 along y, straight lines meeting at the origin; a slab far below bounds the scene.
+/// `b1` moves the first port of B.
+Scene crossing_scene(const Vec3& b1 = Vec3(0, -100, 0)) {
+  std::string x = "<harness name=\"H\" units=\"mm\"><attributes>\n";
+  x += cable_xml("C1", "A1", "A2") + cable_xml("C2", "A1", "A2") + cable_xml("C3", "B1", "B2");
+  x += "</attributes><structure>\n";
+  x += port_xml("A1", Vec3(-100, 0, 0), Vec3::UnitX()) + port_xml("A2", Vec3(100, 0, 0), -Vec3::UnitX());
+  x += port_xml("B1", b1, Vec3::UnitY()) + port_xml("B2", Vec3(0, 100, 0), -Vec3::UnitY());
+  x += "<segment from=\"A1\" to=\"A2\"/>\n<segment from=\"B1\" to=\"B2\"/>\n</structure></harness>\n";
+  Scene sc;
+  sc.name = "crossing";
+  sc.parts.push_back(testmesh::box_part("slab", Vec3(-120, -120, -60), Vec3(120, 120, -50)));
+  sc.harness = parse_harness_xml(x, "crossing.xml");
+  sc.has_harness = true;
+  sc.routing.clearance = {2.0, "test"};
+  sc.routing.time_limit = {30.0, "test"};
+  sc.routing.iterations = {3000, "test"};
+  sc.routing.planner = "informedrrtstar";
+  sc.routing.seed = 3;
+  sc.simplify.dim_pre = {4.0, "test"};
+  return sc;
+}
+
+std::size_t cable_cable_clashes(const RouteReport& rep) {
+  std::size_t n = 0;
+  for (const auto& c : rep.audit.result.clashes) n += c.kind == ClashKind::CableCable;
+  return n;
+}
+
+TEST(HarnessAware, SecondSegmentGoesAroundTheFirst) {
+  const Scene sc = crossing_scene();
+  RouteOptions opt;
+  opt.threads = 2;
+  opt.harness_aware = false;  // among the parts only: both straight, crossing at the origin
+  const RouteReport blind = route_scene(sc, opt);
+  ASSERT_TRUE(blind.unrouted.empty());
+  EXPECT_GT(cable_cable_clashes(blind), 0u);
+  opt.harness_aware = true;
+  const RouteReport aware = route_scene(sc, opt);
+  ASSERT_TRUE(aware.unrouted.empty());
+  EXPECT_EQ(cable_cable_clashes(aware), 0u);
+  EXPECT_EQ(aware.audit.result.clashes.size(), 0u);
+  EXPECT_EQ(aware.exit_code(), 0);
+}
+
+TEST(HarnessAware, ABlockedSegmentIsPlannedFirstAndItsBlockerAroundIt) {
+  // B1 sits right beside where A's straight bundle runs, its exit through it: planned after
+  // A, B cannot leave its port. Planned before A (A then re-planned around B) both route.
+  const Scene sc = crossing_scene(Vec3(0, -3, 0));
+  RouteOptions opt;
+  opt.threads = 2;
+  const RouteReport rep = route_scene(sc, opt);
+  EXPECT_TRUE(rep.unrouted.empty()) << (rep.unrouted.empty() ? "" : rep.unrouted.front().message);
+  bool noted = false;
+  for (const auto& n : rep.notes)
+    noted = noted || n.find("segment B1 -> B2 was blocked by the bundle of segment A1 -> A2") != std::string::npos;
+  EXPECT_TRUE(noted);
+  EXPECT_EQ(cable_cable_clashes(rep), 0u);
+}
+
+}  // namespace
+}  // namespace loom
