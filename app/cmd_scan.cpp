@@ -12,7 +12,7 @@
 #include "core/io/harness_xml.hpp"
 #include "core/io/mesh_write.hpp"
 #include "routing/curve/cable_geometry.hpp"
-#include "routing/scan/point_cloud_io.hpp"
+#include "core/io/point_cloud_io.hpp"
 #include "core/io/json_text.hpp"
 #include "routing/scan/scan_centerline.hpp"
 #include "routing/curve/sweep.hpp"

@@ -3,6 +3,7 @@
 
 #include "core/mesh.hpp"
 
+#include <cmath>
 #include <string>
 
 namespace loom {
@@ -26,6 +27,14 @@ struct Part {
   std::string source_file;  ///< file it came from
   std::string source_name;  ///< product / solid name inside that file (STEP), if any
   int source_faces = 0;     ///< B-rep faces it was tessellated from (STEP/IGES), else 0
+  /// Scanned parts (OctoMap tree or point cloud): voxel edge after the transform, scene
+  /// units; the mesh is the union of occupied voxels. 0 for meshed parts.
+  double voxel_edge = 0.0;
+  bool unknown_occupied = false;  ///< scanned parts: unobserved voxels within the map's bounds count as occupied
 };
+
+/// Certified bound of a scanned part: half its voxel diagonal (scene units), 0 for meshes.
+/// The voxel union lies within it of the occupied voxel centres.
+inline double voxel_accuracy(const Part& p) { return 0.5 * std::sqrt(3.0) * p.voxel_edge; }
 
 }  // namespace loom

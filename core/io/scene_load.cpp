@@ -10,6 +10,7 @@
 #include "core/io/mesh_read.hpp"
 #include "core/io/tessellation_cache.hpp"
 #include "core/io/toml_checks.hpp"
+#include "core/io/voxel_part.hpp"
 
 #include <toml++/toml.h>
 
@@ -128,6 +129,34 @@ Eigen::Affine3d part_transform(const TomlReader& r, const toml::table* t, const 
   m.linear() = R * scale;
   m.translation() = tr;
   return m;
+}
+
+/// Scanned-part settings of a [[part]] (resolution, origin, unknown), or none for a mesh or
+/// CAD part. A .bt, .ot, .pcd or .xyz file is scanned, and so is a .ply given a resolution.
+std::optional<VoxelPartOptions> scan_options(const TomlReader& r, const toml::table& t, const std::filesystem::path& f,
+                                             const std::string& where) {
+  const auto res = r.number(t, where, "resolution");
+  std::string ext = f.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const bool tree = is_octree_file(f);
+  if (!tree && !is_point_cloud_only_file(f) && !(res && ext == ".ply")) {
+    for (const char* k : {"resolution", "origin", "unknown"})
+      if (t.get(k))
+        r.fail(t.get(k), where + "." + k, "applies to scanned parts only (.bt .ot .pcd .xyz, or .ply with a resolution)");
+    return std::nullopt;
+  }
+  VoxelPartOptions o;
+  if (tree && res) r.fail(t.get("resolution"), where + ".resolution", "an OctoMap tree has its own resolution");
+  if (tree && t.get("origin")) r.fail(t.get("origin"), where + ".origin", "applies to point clouds only");
+  if (!tree && !res) r.fail(&t, where, "a point cloud part needs a 'resolution' (voxel edge, file units)");
+  if (res && !(*res > 0.0)) r.fail(t.get("resolution"), where + ".resolution", "must be positive, got " + full_precision(*res));
+  o.resolution = res.value_or(0.0);
+  if (const toml::node* n = t.get("origin")) o.origin = r.vec3(n, where + ".origin");
+  if (auto u = r.string(t, where, "unknown")) {
+    if (*u == "occupied") o.unknown_occupied = true;
+    else if (*u != "free") r.fail(t.get("unknown"), where + ".unknown", "must be 'free' or 'occupied', got '" + *u + "'");
+  }
+  return o;
 }
 
 std::filesystem::path resolve(const std::filesystem::path& base, const std::string& rel) {
@@ -421,7 +450,8 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
       const toml::table* pt = node.as_table();
       const std::string where = "part[" + std::to_string(idx) + "]";
       if (!pt) r.fail(&node, where, "expected a table");
-      r.only_keys(*pt, where, {"name", "file", "transform", "role", "clearance", "compound"});
+      r.only_keys(*pt, where, {"name", "file", "transform", "role", "clearance", "compound", "resolution",
+                                  "origin", "unknown"});
       auto file_rel = r.string(*pt, where, "file");
       if (!file_rel) r.fail(&node, where, "missing 'file'");
       const std::optional<std::string> given_name = r.string(*pt, where, "name");
@@ -448,10 +478,12 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
       if (pt->get("transform") && !pt->get("transform")->as_table())
         r.fail(pt->get("transform"), pwhere + ".transform", "expected an inline table { translate, rotate_deg, scale }");
       const std::filesystem::path fpath = resolve(base, *file_rel);
-      if (!is_cad_file(fpath) && !is_mesh_file(fpath))
+      const std::optional<VoxelPartOptions> scan = scan_options(r, *pt, fpath, pwhere);
+      if (!scan && !is_cad_file(fpath) && !is_mesh_file(fpath))
         r.fail(pt->get("file"), pwhere + ".file",
                "unknown file extension '" + fpath.extension().string() +
-                   "' (meshes: .stl .obj .ply .off .gltf .glb .dae; CAD: .step .stp .iges .igs)");
+                   "' (meshes: .stl .obj .ply .off .gltf .glb .dae; CAD: .step .stp .iges .igs; scans: .bt .ot .pcd "
+                   ".xyz, .ply with a resolution)");
       if (!opt.load_parts) {
         std::error_code ec;
         if (!std::filesystem::exists(fpath, ec))
@@ -466,6 +498,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
         continue;
       }
       std::vector<NamedMesh> pieces;
+      double voxel_edge = 0.0;  // scanned parts, scene units
       try {
         if (is_cad_file(fpath)) {
           TessellationParams tp;
@@ -473,6 +506,15 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
           tp.angular_deflection_deg = scene.tessellation.angular_deflection_deg.value;
           tp.unit_in_mm = unit_in_mm(scene.units);
           pieces = opt.use_cache ? read_cad_file_cached(fpath, tp, !compound) : read_cad_file(fpath, tp, !compound);
+        } else if (scan) {
+          VoxelPart vp = read_voxel_part(fpath, *scan);
+          voxel_edge = vp.resolution * xf.linear().col(0).norm();
+          if (report)
+            report->notes.push_back("part '" + pname + "' is scanned: " + std::to_string(vp.occupied_voxels) +
+                                    " occupied voxels of " + full_precision(voxel_edge) + " (" +
+                                    std::to_string(vp.unknown_filled) + " of them unknown), accuracy " +
+                                    full_precision(0.5 * std::sqrt(3.0) * voxel_edge));
+          pieces.push_back({pname, std::move(vp.mesh), 0});
         } else {
           pieces.push_back({pname, read_mesh_file(fpath), 0});
         }
@@ -497,6 +539,8 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
         p.source_file = fpath.string();
         p.source_name = piece.name;
         p.source_faces = piece.brep_faces;
+        p.voxel_edge = voxel_edge;
+        p.unknown_occupied = scan && scan->unknown_occupied;
         const MeshTopology topo = analyse_topology(p.mesh);
         p.closed = topo.closed;
         orient_outward(p.mesh, topo);

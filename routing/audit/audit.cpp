@@ -282,6 +282,7 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
     rep.part_names.push_back(p.name);
     rep.part_keep_out.push_back(p.role == PartRole::KeepOut);
   }
+  rep.scanned_parts = scanned_part_bounds(scene.parts);
   std::vector<CableInput> inputs;
   if (scene.has_harness) inputs = audit_cable_inputs(scene.harness, rep.cables);
   else rep.notes.push_back("the scene has no harness: nothing to audit");

@@ -8,6 +8,7 @@
 #include "routing/audit/clash_check.hpp"
 #include "routing/audit/segregation.hpp"
 #include "routing/audit/supports.hpp"
+#include "routing/audit/voxel_findings.hpp"
 
 #include <filesystem>
 #include <optional>
@@ -47,6 +48,7 @@ struct AuditReport {
   std::string index_accuracy;    ///< the index's own description of its accuracy
   std::vector<std::string> part_names;
   std::vector<bool> part_keep_out;
+  std::vector<ScannedPartBound> scanned_parts;  ///< parts made of voxels, with their bound
   std::vector<AuditCable> cables;       ///< every harness cable, in harness order
   std::vector<std::string> check_ids;   ///< ids of the checked (routed) cables, by check index
   ClashResult result;                   ///< indices refer to check_ids / part_names

@@ -65,6 +65,15 @@ json audit_report_json(const AuditReport& rep) {
   }
   j["index"] = rep.index_name;
   j["index_accuracy"] = rep.index_accuracy;
+  if (!rep.scanned_parts.empty()) {
+    json scanned = json::array();
+    for (const ScannedPartBound& b : rep.scanned_parts)
+      scanned.push_back({{"part", rep.part_names.at(static_cast<std::size_t>(b.part))},
+                         {"voxel", b.voxel_edge},
+                         {"accuracy", b.accuracy},
+                         {"unknown", b.unknown_occupied ? "occupied" : "free"}});
+    j["scanned_parts"] = scanned;
+  }
 
   json clashes = json::array();
   for (const ClashEntry& e : r.clashes) {
@@ -79,6 +88,9 @@ json audit_report_json(const AuditReport& rep) {
       c["other"] = rep.check_ids.at(static_cast<std::size_t>(e.other));
     }
     put(c, "clearance", e.clearance, "unbounded");
+    if (e.kind == ClashKind::CableStructure)
+      if (const ScannedPartBound* b = find_scanned_part(rep.scanned_parts, e.part))
+        c["voxel"] = voxel_finding_name(e.clearance, 0.0, b->accuracy);
     c["point"] = vec_json(e.point);
     c["s"] = e.s;
     if (e.kind != ClashKind::CableStructure) c["s_other"] = e.s_other;
@@ -100,6 +112,8 @@ json audit_report_json(const AuditReport& rep) {
       o["part"] = rep.part_names.at(static_cast<std::size_t>(v.part));
       o["clearance"] = v.value;
       o["required"] = v.limit;
+      if (const ScannedPartBound* b = find_scanned_part(rep.scanned_parts, v.part))
+        o["voxel"] = voxel_finding_name(v.value, v.limit, b->accuracy);
     }
     o["s"] = v.s;
     o["point"] = vec_json(v.point);

@@ -63,7 +63,7 @@ TEST(Cli, BadSceneIsExitTwoWithLine) {
 }
 
 TEST(Cli, InfoOnTheBundledExamples) {
-  for (const char* ex : {"wing-section", "real-meshes"}) {
+  for (const char* ex : {"wing-section", "real-meshes", "building-scan"}) {
     const std::string scene = kExamples + "/" + ex + "/scene.toml";
     auto r = loom("info " + scene);
     EXPECT_EQ(r.status, 0) << ex << "\n" << r.out;

@@ -140,8 +140,8 @@ TEST_F(SceneDir, MissingPartFileNamesFileAndEntry) {
 }
 
 TEST_F(SceneDir, UnknownExtension) {
-  write("part.xyz", "1 2 3\n");
-  expect_bad("[scene]\nname='t'\n[[part]]\nname='p'\nfile='part.xyz'\n", {"scene.toml:5", "unknown file extension '.xyz'"});
+  write("part.abc", "1 2 3\n");
+  expect_bad("[scene]\nname='t'\n[[part]]\nname='p'\nfile='part.abc'\n", {"scene.toml:5", "unknown file extension '.abc'"});
 }
 
 TEST_F(SceneDir, UnitMismatch) {

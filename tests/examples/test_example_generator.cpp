@@ -291,6 +291,28 @@ TEST(RealMeshesExample, LoadsWithPortsAndBranchPointClearOfEveryPart) {
     if (br.position) check_clear(br.id, *br.position);
 }
 
+TEST(BuildingScanExample, LoadsWithPortsInObservedFreeSpace) {
+  const fs::path toml = fs::path(LOOM_SOURCE_DIR) / "examples" / "building-scan" / "scene.toml";
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data("octomap/geb079.bt"));
+  const loom::Scene s = loom::load_scene(toml);
+  ASSERT_EQ(s.parts.size(), 1u);
+  const loom::Part& floor = s.parts[0];
+  EXPECT_DOUBLE_EQ(floor.voxel_edge, 80.0);  // 8 cm voxels scaled to millimetres
+  EXPECT_TRUE(floor.unknown_occupied);
+  ASSERT_EQ(s.harness.ports.size(), 2u);
+  const loom::HarnessTopology topo(s.harness);
+  for (const auto& port : s.harness.ports) {
+    double radius = 0.0;
+    for (int si : topo.incident_segments(port.id)) radius = std::max(radius, 0.5 * topo.segment_diameter(si));
+    // Clear of the voxels by the bundle radius + clearance + one voxel (the exit's first step).
+    EXPECT_GE(surface_distance(floor.mesh, port.position), radius + s.routing.clearance.value + 80.0) << port.id;
+    EXPECT_GT(ray_hit(floor.mesh, port.position, port.direction), 300.0) << port.id << " faces a wall";
+  }
+  // The rooms lie on either side of the corridor (y from -1.0 to 0.9 m).
+  EXPECT_LT(std::min(s.harness.ports[0].position.y(), s.harness.ports[1].position.y()), -1400.0);
+  EXPECT_GT(std::max(s.harness.ports[0].position.y(), s.harness.ports[1].position.y()), 1300.0);
+}
+
 RC_GTEST_PROP(ExampleNumberText, ShortestTextReadsBackExactly, (double v)) {
   RC_PRE(std::isfinite(v));
   const std::string t = loom::examples::num(v);

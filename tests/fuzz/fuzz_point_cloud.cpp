@@ -5,7 +5,7 @@
 // finite, and every declared point either kept or counted as dropped.
 #include "fuzz_support.hpp"
 
-#include "routing/scan/point_cloud_io.hpp"
+#include "core/io/point_cloud_io.hpp"
 
 #include <cstddef>
 #include <cstdint>

@@ -27,7 +27,7 @@
 #include "core/io/scene_load.hpp"
 #include "core/io/tessellation_cache.hpp"
 #include "routing/curve/cable_geometry.hpp"
-#include "routing/scan/point_cloud_io.hpp"
+#include "core/io/point_cloud_io.hpp"
 #include "common/run_loom.hpp"
 #include "common/test_files.hpp"
 #include "common/shared_data.hpp"

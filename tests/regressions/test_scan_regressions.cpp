@@ -1,7 +1,7 @@
 // Scan regressions: one test per bug of `loom scan` on adversarial clouds
 // (routing/scan/scan_centerline), inputs generated from fixed seeds (tests/routing/scan/scan_oracle.hpp).
 // Each test fails on a centerline extraction with that bug.
-#include "routing/scan/point_cloud_io.hpp"
+#include "core/io/point_cloud_io.hpp"
 #include "routing/scan/scan_centerline.hpp"
 #include "routing/scan/scan_oracle.hpp"
 

@@ -1,6 +1,6 @@
 // Point cloud reading: PLY ascii/binary LE/BE, XYZ, PCD ascii/binary/compressed,
 // the real PCL sample clouds, malformed files with located errors.
-#include "routing/scan/point_cloud_io.hpp"
+#include "core/io/point_cloud_io.hpp"
 
 #include "core/error.hpp"
 

@@ -1,4 +1,4 @@
-#include "routing/scan/point_cloud_io.hpp"
+#include "core/io/point_cloud_io.hpp"
 
 #include "core/error.hpp"
 #include "core/io/atomic_file.hpp"
