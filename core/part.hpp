@@ -2,6 +2,9 @@
 /// A part of the scene: named, meshed geometry in world coordinates.
 
 #include "core/mesh.hpp"
+#include "core/motion.hpp"
+
+#include <optional>
 
 #include <string>
 
@@ -26,6 +29,8 @@ struct Part {
   std::string source_file;  ///< file it came from
   std::string source_name;  ///< product / solid name inside that file (STEP), if any
   int source_faces = 0;     ///< B-rep faces it was tessellated from (STEP/IGES), else 0
+  /// How the part moves (its mesh is the rest pose); nullopt for a fixed part.
+  std::optional<Motion> motion;
 };
 
 }  // namespace loom
