@@ -54,6 +54,24 @@ struct SweptCylinder {
   }
 };
 
+/// False when no point of curve c comes within `cutoff` of the cylinder: each knot span lies
+/// within its hull deviation of the chord joining its ends (convex hull property), and a
+/// chord's distance is at least its midpoint's less half its length. Saves flattening the
+/// cables that pass nowhere near a moving part (most of them).
+bool may_come_within(const Centerline& c, const SweptCylinder& cyl, double cutoff) {
+  const std::vector<double>& k = c.knots();
+  double a = c.u_min();
+  for (std::size_t i = 0; i < k.size() && a < c.u_max(); ++i) {
+    const double b = std::min(k[i], c.u_max());
+    if (!(b > a)) continue;
+    const Vec3 pa = c.position(a), pb = c.position(b);
+    const double lower = cyl.distance(0.5 * (pa + pb)) - 0.5 * (pb - pa).norm() - c.hull_bounds(a, b).deviation;
+    if (lower <= cutoff) return true;
+    a = b;
+  }
+  return false;
+}
+
 /// Distance from point p to box b (0 inside).
 double box_distance(const AABB& b, const Vec3& p) {
   return (b.min - p).cwiseMax(p - b.max).cwiseMax(Vec3::Zero()).norm();
@@ -163,7 +181,11 @@ MotionAudit check_motion_clearance(const std::vector<CableInput>& cables, const 
     throw std::invalid_argument("motion audit: tolerance " + full_precision(tolerance) +
                                 " is not above twice the FCL index's rounding");
   std::vector<double> speed(moving.size());
-  for (std::size_t k = 0; k < moving.size(); ++k) speed[k] = rest[k].motion->max_point_speed(rest[k].mesh);
+  std::vector<SweptCylinder> swept;
+  for (std::size_t k = 0; k < moving.size(); ++k) {
+    speed[k] = rest[k].motion->max_point_speed(rest[k].mesh);
+    swept.emplace_back(rest[k].mesh, *rest[k].motion);
+  }
 
   struct PerCable {
     std::vector<MotionClash> clashes;
@@ -173,10 +195,12 @@ MotionAudit check_motion_clearance(const std::vector<CableInput>& cables, const 
   std::vector<PerCable> per(cables.size());
   audit::parallel_indices(cables.size(), threads, [&](std::size_t c) {
     const CableInput& in = cables[c];
-    Chords ch;
-    flatten(in.curve, in.curve.u_min(), in.curve.u_max(), out.chord_error, audit::kMaxChordRadii * in.radius,
-            audit::kShortSpanRadii * in.radius, ch);
+    Chords ch;  // flattened on first need
     for (std::size_t k = 0; k < moving.size(); ++k) {
+      if (!may_come_within(in.curve, swept[k], in.radius)) continue;
+      if (ch.p.empty())
+        flatten(in.curve, in.curve.u_min(), in.curve.u_max(), out.chord_error, audit::kMaxChordRadii * in.radius,
+                audit::kShortSpanRadii * in.radius, ch);
       const Part& p = parts[static_cast<std::size_t>(moving[k])];
       const bool attached = std::any_of(in.attachments.begin(), in.attachments.end(),
                                         [&](const PartAttachment& a) { return a.part == moving[k]; });

@@ -261,6 +261,18 @@ TEST(MotionAudit, CableOutsideTheSweepIsClean) {
   EXPECT_GT(rep.motion.poses, 0) << "the cable is within the door's swept cylinder: it must be checked";
 }
 
+TEST(MotionAudit, CableOutsideTheSweptCylinderCostsNoPose) {
+  const Part door = door_part();
+  // 250 mm from the hinge: beyond the door's reach (200.01) by more than the radius.
+  const AuditReport rep = audit({door}, one_cable(vertical_at(250.0, 10.0)));
+  EXPECT_TRUE(rep.motion.clashes.empty());
+  EXPECT_EQ(rep.motion.poses, 0);
+  // 203 mm: within the cylinder by a hair, so checked, and clear.
+  const AuditReport near = audit({door}, one_cable(vertical_at(std::hypot(200.0, 2.0) + kRadius - 0.5, 70.0)));
+  EXPECT_TRUE(near.motion.clashes.empty());
+  EXPECT_GT(near.motion.poses, 0);
+}
+
 TEST(MotionAudit, InterpenetratingMovingPartsAreWarnedByName) {
   Part a = door_part();
   Part b = door_part();
