@@ -87,6 +87,9 @@ struct BadMotion {
   const char* says;
 };
 
+/// Test names show the expected message, not the bytes of the struct.
+void PrintTo(const BadMotion& b, std::ostream* os) { *os << b.says; }
+
 class MotionSceneRefuses : public ::testing::TestWithParam<BadMotion> {};
 
 TEST_P(MotionSceneRefuses, NamingTheFileAndThePart) {
@@ -120,7 +123,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadMotion{"", "motion = \"nope\"", "no [[motion]] named 'nope'"},
         BadMotion{"[[motion]]\nname = \"flap\"\nrotate = { axis_point = [0, 0, 0], axis = [0, 0, 1], from_deg = -400, "
                   "to_deg = 0 }\n",
-                  "motion = \"flap\"", "motion 'flap'"}));
+                  "motion = \"flap\"", "motion 'flap'"}),
+    [](const ::testing::TestParamInfo<BadMotion>& i) { return "case" + std::to_string(i.index); });
 
 }  // namespace
 }  // namespace loom
