@@ -2,6 +2,7 @@
 // [--tolerance T] [--per-cable] [--threads N] [--out DIR] [--render-size WxH] [--json] [--quiet]`: clash,
 // bend and clearance audit of a harness in its scene; writes DIR/report.json (DESIGN §4),
 // DIR/view.html and DIR/render.png. Progress bars on stderr when it is a terminal.
+#include "app/motion_summary.hpp"
 #include "app/support_summary.hpp"
 #include "app/commands.hpp"
 #include "app/option_checks.hpp"
@@ -86,9 +87,10 @@ void print_summary(const AuditReport& rep, const std::filesystem::path& report_p
                   rep.part_names[static_cast<std::size_t>(v.part)].c_str(), v.value, v.limit, u, v.s);
   }
   const std::size_t more = print_support_findings(rep, kListedClashes);
+  const std::size_t moving = print_motion_clashes(rep, kListedClashes);
   for (const auto& note : rep.notes) std::printf("  note: %s\n", note.c_str());
   std::printf("%zu clashes, %zu violations; load %.0f ms, index %.1f ms, check %.1f ms, %lld distance queries\n",
-              r.clashes.size(), r.violations.size() + more, rep.load_ms, rep.index_ms, rep.check_ms,
+              r.clashes.size() + moving, r.violations.size() + more, rep.load_ms, rep.index_ms, rep.check_ms,
               static_cast<long long>(r.counters.distance_queries));
   std::printf("report: %s\n", report_path.string().c_str());
 }

@@ -1,6 +1,7 @@
 // `loom route SCENE ...`: plan, spline, audit and repair every cable; write routed.xml,
 // report.json, cables.ply, view.html and render.png (--render-size WxH). Progress bars on
 // stderr when it is a terminal.
+#include "app/motion_summary.hpp"
 #include "app/support_summary.hpp"
 #include "app/commands.hpp"
 #include "app/option_checks.hpp"
@@ -64,13 +65,14 @@ void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
               rep.timing.load, rep.timing.simplify, rep.timing.index, rep.timing.plan, rep.timing.spline,
               rep.timing.audit, rep.timing.repair, rep.timing.total + rep.timing.load);
   std::printf("  audit (%s, exact triangles): %zu clashes, %zu violations\n", clash_method_name(a.method),
-              a.result.clashes.size(), a.result.violations.size() + a.supports.spans.size() + a.segregation.size());
+              a.result.clashes.size() + a.motion.clashes.size(), a.result.violations.size() + a.supports.spans.size() + a.segregation.size());
   if (rep.share_within_reach >= 0.0)
     std::printf("  supports: %zu clamps placed, %.1f%% of the cable length within reach of structure, "
                 "%zu unsupported spans\n",
                 rep.clamps_placed, 100.0 * rep.share_within_reach, a.supports.spans.size());
   print_support_findings(a, 10);
   print_portfolio_budgets(rep);
+  print_motion_clashes(a, 10);
   for (const auto& u : rep.unrouted)
     std::printf("  NOT ROUTED %s (segment %s): %s — %s\n", u.cable.c_str(), u.segment.c_str(), u.reason.c_str(),
                 u.message.c_str());

@@ -2,8 +2,10 @@
 /// A part of the scene: named, meshed geometry in world coordinates.
 
 #include "core/mesh.hpp"
+#include "core/motion.hpp"
 
 #include <cmath>
+#include <optional>
 #include <string>
 
 namespace loom {
@@ -31,6 +33,8 @@ struct Part {
   /// units; the mesh is the union of occupied voxels. 0 for meshed parts.
   double voxel_edge = 0.0;
   bool unknown_occupied = false;  ///< scanned parts: unobserved voxels within the map's bounds count as occupied
+  /// How the part moves (its mesh is the rest pose); nullopt for a fixed part.
+  std::optional<Motion> motion;
 };
 
 /// Certified bound of a scanned part: half its voxel diagonal (scene units), 0 for meshes.

@@ -8,6 +8,7 @@
 #include "core/io/kbl_read.hpp"
 #include "core/io/kbl_vec.hpp"
 #include "core/io/mesh_read.hpp"
+#include "core/io/motion_toml.hpp"
 #include "core/io/tessellation_cache.hpp"
 #include "core/io/toml_checks.hpp"
 #include "core/io/voxel_part.hpp"
@@ -324,7 +325,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
                      std::string("malformed TOML: ") + std::string(e.description()));
   }
   TomlReader r(file);
-  r.only_keys(doc, "", {"scene", "part", "harness", "routing", "simplify", "tessellation"});
+  r.only_keys(doc, "", {"scene", "part", "motion", "harness", "routing", "simplify", "tessellation"});
   const std::filesystem::path base = toml_path.parent_path();
   Scene scene;
   scene.source_file = file;
@@ -439,6 +440,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
   }
 
   // [[part]]
+  const std::map<std::string, Motion> motions = read_named_motions(doc, file);
   std::set<std::string> names;
   if (const toml::node* pn = doc.get("part")) {
     const toml::array* parts = pn->as_array();
@@ -451,7 +453,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
       const std::string where = "part[" + std::to_string(idx) + "]";
       if (!pt) r.fail(&node, where, "expected a table");
       r.only_keys(*pt, where, {"name", "file", "transform", "role", "clearance", "compound", "resolution",
-                                  "origin", "unknown"});
+                                  "origin", "unknown", "motion"});
       auto file_rel = r.string(*pt, where, "file");
       if (!file_rel) r.fail(&node, where, "missing 'file'");
       const std::optional<std::string> given_name = r.string(*pt, where, "name");
@@ -473,6 +475,8 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
         if (!b) r.fail(cn, pwhere + ".compound", "expected true or false");
         compound = b->get();
       }
+      std::optional<Motion> motion;
+      if (const toml::node* mn = pt->get("motion")) motion = read_part_motion(*mn, motions, file, pwhere);
       const Eigen::Affine3d xf = part_transform(r, pt->get("transform") ? pt->get("transform")->as_table() : nullptr,
                                                 pwhere + ".transform");
       if (pt->get("transform") && !pt->get("transform")->as_table())
@@ -493,6 +497,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
         p.role = role;
         p.clearance = extra;
         p.source_file = fpath.string();
+        p.motion = motion;
         if (!names.insert(p.name).second) r.fail(&node, pwhere, "duplicate part name");
         scene.parts.push_back(std::move(p));
         continue;
@@ -541,6 +546,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
         p.source_faces = piece.brep_faces;
         p.voxel_edge = voxel_edge;
         p.unknown_occupied = scan && scan->unknown_occupied;
+        p.motion = motion;
         const MeshTopology topo = analyse_topology(p.mesh);
         p.closed = topo.closed;
         orient_outward(p.mesh, topo);

@@ -328,8 +328,17 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
       };
       return scene.routing.separation_between(cls(a), cls(b));
     });
+  // Moving parts are certified at the audit's tolerance; the discrete method has none of
+  // its own, so they take the derived default.
+  const double motion_tol = rep.result.tolerance > 0.0 ? rep.result.tolerance : default_clash_tolerance(inputs);
+  rep.motion = naming_cable_errors(scene.harness, [&] {
+    return check_motion_clearance(inputs, scene.parts, motion_tol, req.threads);
+  });
   rep.check_ms = t1.ms();
   rep.notes.insert(rep.notes.end(), rep.result.notes.begin(), rep.result.notes.end());
+  for (const std::string& pair : moving_parts_interpenetrating(scene.parts))
+    rep.notes.push_back("warning: moving parts " + pair + " interpenetrate in their rest poses");
+  rep.notes.insert(rep.notes.end(), rep.motion.notes.begin(), rep.motion.notes.end());
   return rep;
 }
 

@@ -6,6 +6,7 @@
 #include "core/progress.hpp"
 #include "core/scene.hpp"
 #include "routing/audit/clash_check.hpp"
+#include "routing/audit/motion_clearance.hpp"
 #include "routing/audit/segregation.hpp"
 #include "routing/audit/supports.hpp"
 #include "routing/audit/voxel_findings.hpp"
@@ -63,13 +64,15 @@ struct AuditReport {
   bool supports_checked = false;
   /// Cables of separated classes too close or sharing a bundle (indices refer to check_ids).
   std::vector<SegregationFinding> segregation;
+  /// Cables closer to a moving part than their radius at some pose of its motion (cable-motion).
+  MotionAudit motion;
   /// Each harness segment as FROM/TO (the spelling of <clamp segment>), by segment index.
   std::vector<std::string> segment_names;
 
   /// True when any clash or violation was found.
   bool found_problems() const {
     return !result.clashes.empty() || !result.violations.empty() || !supports.spans.empty() ||
-           !segregation.empty();
+           !segregation.empty() || !motion.clashes.empty();
   }
   /// True when some harness cable could not be checked (a segment of its chain has no
   /// curve yet, e.g. an unplaced branch point): see `cables[i].reason`.

@@ -98,7 +98,26 @@ json audit_report_json(const AuditReport& rep) {
     c["s_end"] = e.s_end;
     clashes.push_back(c);
   }
+  for (const MotionClash& m : rep.motion.clashes) {
+    json c;
+    c["kind"] = "cable-motion";
+    c["cable"] = rep.check_ids.at(static_cast<std::size_t>(m.cable));
+    c["part"] = rep.part_names.at(static_cast<std::size_t>(m.part));
+    c["clearance"] = m.clearance;
+    c["pose"] = m.pose;
+    c["pose_unit"] = m.motion == MotionKind::Rotate ? "deg" : rep.units;
+    c["motion"] = motion_kind_name(m.motion);
+    c["inside"] = m.inside;
+    c["point"] = vec_json(m.point);
+    c["s"] = m.s;
+    clashes.push_back(c);
+  }
   j["clashes"] = clashes;
+  if (rep.motion.pose_tolerance > 0.0)
+    j["motion"] = {{"pose_tolerance", rep.motion.pose_tolerance},
+                   {"chord_error", rep.motion.chord_error},
+                   {"poses", rep.motion.poses},
+                   {"distance_queries", rep.motion.distance_queries}};
 
   json violations = json::array();
   for (const Violation& v : r.violations) {

@@ -10,6 +10,7 @@
 #include "routing/audit/clash_check.hpp"
 #include "routing/audit/supports.hpp"
 #include "routing/route/clamp_placement.hpp"
+#include "routing/route/motion_envelope.hpp"
 #include "routing/curve/bend_repair.hpp"
 #include "routing/route/branch_layout.hpp"
 #include "routing/route/bundle_obstacles.hpp"
@@ -264,6 +265,11 @@ void RouteRun::prepare_obstacles() {
   } else {
     planning_parts_ = scene_.parts;
   }
+  // Moving parts: their swept envelope is an obstacle too; then the planning parts are no
+  // longer the exact ones the audit needs.
+  const double gap = swept_envelope_gap(rep_.clearance, h_.smallest_diameter());
+  if (append_swept_envelopes(scene_.parts, gap, unit_name(scene_.units), planning_parts_, rep_.notes) > 0)
+    plan_on_other_parts_ = true;
   rep_.timing.simplify = t0.ms();
   t0.restart();
   ProgressCounter indexed(opt_.progress, "index", 1, "indices");
@@ -310,6 +316,7 @@ EndFrame RouteRun::end_frame(int seg, bool from_end) const {
 /// Plans each segment in the patent's order (bundles by cable count, largest first).
 void RouteRun::plan_segments() {
   box_ = scene_.bounds();
+  extend_by_swept_envelopes(scene_.parts, swept_envelope_gap(rep_.clearance, h_.smallest_diameter()), box_);
   eps_ = 1e-9 * std::max(1.0, box_.diagonal());
   const auto& order = topo_.routing_order();
   seed_ompl_once(rep_.seed);
@@ -836,6 +843,7 @@ std::set<int> RouteRun::segments_to_repair() const {
   }
   for (const auto& v : rep_.audit.result.violations)
     if (v.kind == ViolationKind::Clearance) mark(v.cable, v.s);
+  for (const auto& m : rep_.audit.motion.clashes) mark(m.cable, m.s);
   return bad;
 }
 

@@ -1,4 +1,5 @@
 #include "routing/view/view_html.hpp"
+#include "routing/view/motion_view.hpp"
 
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
@@ -193,18 +194,27 @@ std::string view_data_json(const Scene& scene, const Harness& harness, const nlo
   // Parts, decimated to the budget in proportion to their size.
   st.part_triangles = scene.triangle_count();
   s += ",\"budget\":" + std::to_string(opt.triangle_budget) + ",\"parts\":[";
-  for (std::size_t i = 0; i < scene.parts.size(); ++i) {
-    const Part& p = scene.parts[i];
-    std::size_t share = p.mesh.triangles.size();
-    if (st.part_triangles > opt.triangle_budget)
+  // Moving parts are drawn at rest (as parts), then at their extreme and clash poses.
+  std::vector<PosedPartView> views;
+  for (const Part& p : scene.parts) views.push_back({p.name, role_name(p.role), Mesh{}});
+  std::vector<PosedPartView> posed = motion_view_meshes(scene, report);
+  std::size_t total = st.part_triangles;  // the budget is shared out over the posed copies too
+  for (auto& v : posed) total += v.mesh.triangles.size();
+  for (std::size_t i = 0; i < views.size() + posed.size(); ++i) {
+    const bool rest = i < views.size();
+    const PosedPartView& pv = rest ? views[i] : posed[i - views.size()];
+    const Mesh& pm = rest ? scene.parts[i].mesh : pv.mesh;
+    std::size_t share = pm.triangles.size();
+    if (total > opt.triangle_budget)
       share = static_cast<std::size_t>(static_cast<double>(opt.triangle_budget) *
-                                       static_cast<double>(p.mesh.triangles.size()) /
-                                       static_cast<double>(st.part_triangles));
-    const Mesh m = decimate_vertex_clustering(p.mesh, share);
+                                       static_cast<double>(pm.triangles.size()) / static_cast<double>(total));
+    const Mesh m = decimate_vertex_clustering(pm, share);
     st.shown_triangles += m.triangles.size();
+    if (!rest)
+      for (const Vec3& v : pm.vertices) box.extend(v);
     if (i) s += ',';
-    s += "{\"name\":" + js(p.name) + ",\"role\":" + js(role_name(p.role)) +
-         ",\"triangles\":" + std::to_string(p.mesh.triangles.size()) + ",\"v\":";
+    s += "{\"name\":" + js(pv.name) + ",\"role\":" + js(pv.role) +
+         ",\"triangles\":" + std::to_string(pm.triangles.size()) + ",\"v\":";
     append_points(s, m.vertices, q);
     s += ",\"t\":[";
     for (std::size_t t = 0; t < m.triangles.size(); ++t)
@@ -456,9 +466,11 @@ function initThree() {
     g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
     g.setIndex(p.t);
     g.computeVertexNormals();
-    var keep = p.role === 'keep_out';
-    var m = new THREE.MeshPhongMaterial({ color: keep ? 0xd07070 : 0xa3adb8, flatShading: true, side: THREE.DoubleSide,
-      transparent: keep, opacity: keep ? 0.35 : 1.0, shininess: 10 });
+    var keep = p.role === 'keep_out', swept = p.role === 'swept', hit = p.role === 'clash-pose';
+    var see = keep || swept || hit;
+    var m = new THREE.MeshPhongMaterial({ color: hit ? 0xe02020 : swept ? 0x6090e0 : keep ? 0xd07070 : 0xa3adb8,
+      flatShading: true, side: THREE.DoubleSide, transparent: see, opacity: swept ? 0.25 : see ? 0.35 : 1.0,
+      shininess: 10, depthWrite: !see });
     var mesh = new THREE.Mesh(g, m);
     scene.add(mesh);
     partMeshes.push(mesh);
