@@ -14,6 +14,7 @@
 #include "routing/curve/bend_repair.hpp"
 #include "routing/route/branch_layout.hpp"
 #include "routing/route/bundle_obstacles.hpp"
+#include "routing/route/class_separation.hpp"
 #include "routing/route/port_check.hpp"
 #include "routing/route/support_pull.hpp"
 #include "routing/curve/cable_geometry.hpp"
@@ -168,7 +169,7 @@ class RouteRun {
   bool replan_among(int t, const std::vector<int>& visible);
   PlanResult plan_one(const ObstacleIndex& index, const PlanRequest& req, SegmentRouteInfo& info) const;
   void add_bundle_tube(int s);
-  std::string blocker_name(const ObstacleIndex& index, int part) const;
+  std::string blocker_name(const ObstacleIndex& index, int part, int s) const;
   int pull_to_supports(const ObstacleIndex& index, const SegmentExits& x, std::vector<Vec3>& key_points) const;
   void record_unrouted(int s, const PlanResult& plan, bool branch_blocked);
   void build_splines();
@@ -190,6 +191,7 @@ class RouteRun {
   RouteReport rep_;
   Harness& h_;
   const HarnessTopology topo_;  // ids and structure never change below, only geometry
+  const std::vector<std::set<std::string>> classes_;  ///< cable classes of each segment
   double time_limit_ = 0.0;
   double part_extra_ = 0.0;    ///< largest per-part extra clearance
   bool plan_on_other_parts_ = false;
@@ -212,7 +214,7 @@ class RouteRun {
 };
 
 RouteRun::RouteRun(const Scene& scene, const RouteOptions& opt)
-    : scene_(scene), opt_(opt), h_(rep_.routed = scene.harness), topo_(h_) {
+    : scene_(scene), opt_(opt), h_(rep_.routed = scene.harness), topo_(h_), classes_(segment_classes(topo_)) {
   rep_.planner = opt.planner.empty() ? scene.routing.planner : opt.planner;
   rep_.seed = opt.seed >= 0 ? static_cast<unsigned>(opt.seed) : scene.routing.seed;
   time_limit_ = opt.time_limit >= 0 ? opt.time_limit : scene.routing.time_limit.value;
@@ -227,6 +229,7 @@ RouteRun::RouteRun(const Scene& scene, const RouteOptions& opt)
     if (!p.placed)
       throw InputError({h_.source_file, p.line, "port " + p.id},
                        "has no 3D position (topology only): place it in the scene's [harness.place] table");
+  for (std::string& n : separation_conflicts(topo_, scene.routing, classes_)) rep_.notes.push_back(std::move(n));
 }
 
 RouteReport RouteRun::run() {
@@ -487,7 +490,8 @@ std::vector<int> RouteRun::routed_now(int except) const {
 /// The planning obstacles of segment `s`: the parts and the bundle of every segment in
 /// `visible`, each cut back near a node the two share (there they meet legitimately: within
 /// the audit's junction reach, twice the breakout, and at least far enough that the breakout
-/// stubs leave clear of each other).
+/// stubs leave clear of each other). Bundles of classes kept apart from the segment's are grown
+/// by the separation (class_gap).
 std::unique_ptr<HarnessAwareIndex> RouteRun::obstacles_for(int s, const std::vector<int>& visible) const {
   const Segment& sg = h_.segments[s];
   const double required = ends_[s].radius + rep_.clearance + part_extra_;
@@ -497,18 +501,21 @@ std::unique_ptr<HarnessAwareIndex> RouteRun::obstacles_for(int s, const std::vec
     if (t == s || found == tubes_.end()) continue;
     const BundleTube& tube = found->second;
     const Segment& st = h_.segments[t];
+    // A bundle of another class grows by the classes' separation: the planner then keeps the
+    // routing clearance beyond it, the margin for the curve's deviation from the key points.
+    const double radius = tube.radius + class_gap(scene_.routing, classes_[s], classes_[t]);
     std::vector<std::vector<Vec3>> runs{tube.points};
     for (const std::string& n : {sg.from, sg.to}) {
       if (n != st.from && n != st.to) continue;
       const double breakout = breakout_length(topo_, n);
-      const double reach = std::max(2.0 * breakout, breakout + required + tube.radius);
+      const double reach = std::max(2.0 * breakout, breakout + required + radius);
       const Vec3 at = *h_.node_position(n);
       std::vector<std::vector<Vec3>> kept;
       for (const auto& r : runs)
         for (auto& piece : clip_near_node(r, at, reach)) kept.push_back(std::move(piece));
       runs = std::move(kept);
     }
-    for (auto& r : runs) tubes.push_back({t, std::move(r), tube.radius});
+    for (auto& r : runs) tubes.push_back({t, std::move(r), radius});
   }
   return std::make_unique<HarnessAwareIndex>(*plan_index_, tubes);
 }
@@ -534,13 +541,16 @@ void RouteRun::add_bundle_tube(int s) {
   tubes_[s] = std::move(tube);
 }
 
-/// What blocked a plan, for its message: a part by name or the bundle of a segment.
-std::string RouteRun::blocker_name(const ObstacleIndex& index, int part) const {
+/// What blocked the plan of segment `s`, for its message: a part by name or the bundle of a
+/// segment (with the separation of their classes where it grew that bundle).
+std::string RouteRun::blocker_name(const ObstacleIndex& index, int part, int s) const {
   if (part >= 0 && part < static_cast<int>(planning_parts_.size())) return "part '" + planning_parts_[part].name + "'";
   const auto* aware = dynamic_cast<const HarnessAwareIndex*>(&index);
   const int t = aware ? aware->bundle_segment(part) : -1;
   if (t < 0) return "";
-  return "the bundle of segment " + h_.segments[t].from + " -> " + h_.segments[t].to + ", routed before it";
+  const double gap = class_gap(scene_.routing, classes_[s], classes_[t]);
+  return "the bundle of segment " + h_.segments[t].from + " -> " + h_.segments[t].to + ", routed before it" +
+         (gap > 0.0 ? ", kept " + full_precision(gap) + " away by the separation of their classes" : "");
 }
 
 /// One entry per cable through segment `s`: the first segment (in routing order) that
@@ -583,7 +593,7 @@ void RouteRun::plan_segment(int s, const std::vector<int>& visible) {
   }
   rep_.timing.plan += t0.ms();
   if (!plan.solved() && plan.blocking_part >= 0) {
-    const std::string who = blocker_name(*obstacles, plan.blocking_part);
+    const std::string who = blocker_name(*obstacles, plan.blocking_part, s);
     if (!who.empty() && plan.message.find(who) == std::string::npos) plan.message += " (" + who + ")";
     if (const int t = obstacles->bundle_segment(plan.blocking_part); t >= 0) blocked_by_[s] = t;
   }

@@ -89,7 +89,9 @@ TEST(VoxelAudit, AgreesWithTheScannedPointsWithinTheBound) {
       const Outcome o = audit_case(seed, gap);
       SCOPED_TRACE("gap " + std::to_string(gap) + " oracle " + std::to_string(o.oracle));
       // Nothing missed: closer than required to a scanned point means a finding.
-      if (o.oracle < kRequired - tol) EXPECT_GT(o.findings, 0);
+      if (o.oracle < kRequired - tol) {
+        EXPECT_GT(o.findings, 0);
+      }
       if (o.findings == 0) {
         EXPECT_GE(o.oracle, kRequired - tol);
         ++clear;
@@ -99,7 +101,9 @@ TEST(VoxelAudit, AgreesWithTheScannedPointsWithinTheBound) {
       EXPECT_LE(o.least, o.oracle + tol);
       EXPECT_GE(o.least, o.oracle - bound - tol);
       // Beyond the bound is a real violation of the scanned structure.
-      if (o.beyond > 0) EXPECT_LT(o.oracle, kRequired + tol);
+      if (o.beyond > 0) {
+        EXPECT_LT(o.oracle, kRequired + tol);
+      }
       (o.beyond > 0 ? beyond : within) += 1;
     }
   std::printf("beyond-bound %d, within-bound %d, clear %d cases\n", beyond, within, clear);

@@ -1,11 +1,13 @@
 // Harness-aware planning: the capsule obstacles of routed bundles (against a brute-force
 // oracle), their cut-back near a shared node (closed form), and a hand-made harness whose two
 // segments clash when each is planned among the parts only and do not when the second is
-// planned among the first's bundle too (the audit is the judge).
+// planned among the first's bundle too (the audit is the judge); the same crossing with the
+// two bundles in separated classes, planned apart by the separation.
 #include "core/io/harness_xml.hpp"
 #include "index/embree_index.hpp"
 #include "index/index_test_meshes.hpp"
 #include "index/triangle_distance.hpp"
+#include "routing/audit/audit.hpp"
 #include "routing/route/bundle_obstacles.hpp"
 #include "routing/route/route_pipeline.hpp"
 
@@ -96,17 +98,19 @@ std::string port_xml(const std::string& id, const Vec3& at, const Vec3& dir) {
          f(dir.x()) + "\" dy=\"" + f(dir.y()) + "\" dz=\"" + f(dir.z()) + "\"/>\n";
 }
 
-std::string cable_xml(const std::string& id, const std::string& p1, const std::string& p2) {
+/// A 4 mm cable between two ports; `cls` (if not empty) is its class.
+std::string cable_xml(const std::string& id, const std::string& p1, const std::string& p2, const std::string& cls = "") {
   return "<cable id=\"" + id + "\"><electrical><port id=\"" + p1 + "\"/><port id=\"" + p2 +
-         "\"/></electrical><physical type=\"T\" color=\"red\" diameter=\"4\" min_bend_radius=\"10\"/></cable>\n";
+         "\"/></electrical><physical type=\"T\" color=\"red\" diameter=\"4\" min_bend_radius=\"10\"" +
+         (cls.empty() ? std::string() : " class=\"" + cls + "\"") + "/></cable>\n";
 }
 
 /// Two bundles crossing in empty space: A1–A2 along x (two cables, so it is routed first),
 /// B1–B2 along y, straight lines meeting at the origin; a slab far below bounds the scene.
-/// `b1` moves the first port of B.
-Scene crossing_scene(const Vec3& b1 = Vec3(0, -100, 0)) {
+/// `b1` moves the first port of B; `a_class` and `b_class` are the classes of A's and B's cables.
+Scene crossing_scene(const Vec3& b1 = Vec3(0, -100, 0), const std::string& a_class = "", const std::string& b_class = "") {
   std::string x = "<harness name=\"H\" units=\"mm\"><attributes>\n";
-  x += cable_xml("C1", "A1", "A2") + cable_xml("C2", "A1", "A2") + cable_xml("C3", "B1", "B2");
+  x += cable_xml("C1", "A1", "A2", a_class) + cable_xml("C2", "A1", "A2", a_class) + cable_xml("C3", "B1", "B2", b_class);
   x += "</attributes><structure>\n";
   x += port_xml("A1", Vec3(-100, 0, 0), Vec3::UnitX()) + port_xml("A2", Vec3(100, 0, 0), -Vec3::UnitX());
   x += port_xml("B1", b1, Vec3::UnitY()) + port_xml("B2", Vec3(0, 100, 0), -Vec3::UnitY());
@@ -160,6 +164,31 @@ TEST(HarnessAware, ABlockedSegmentIsPlannedFirstAndItsBlockerAroundIt) {
     noted = noted || n.find("segment B1 -> B2 was blocked by the bundle of segment A1 -> A2") != std::string::npos;
   EXPECT_TRUE(noted);
   EXPECT_EQ(cable_cable_clashes(rep), 0u);
+}
+
+TEST(HarnessAware, SeparatedClassesArePlannedApart) {
+  // A (power) and B (signal) cross: among A's bundle B keeps the routing clearance only,
+  // closer than a 30 mm separation; with the separation in the scene B is planned around A's
+  // bundle grown by it, and the segregation audit of the route finds nothing.
+  constexpr double kSeparation = 30.0;
+  Scene sc = crossing_scene(Vec3(0, -100, 0), "power", "signal");
+  RouteOptions opt;
+  opt.threads = 2;
+  const RouteReport near = route_scene(sc, opt);
+  ASSERT_TRUE(near.unrouted.empty());
+  Scene judged = sc;
+  judged.harness = near.routed;
+  judged.routing.separation[{"power", "signal"}] = kSeparation;
+  AuditOptions ao;
+  ao.check.threads = 2;
+  EXPECT_FALSE(run_audit(judged, ao).segregation.empty());
+
+  sc.routing.separation[{"power", "signal"}] = kSeparation;
+  const RouteReport apart = route_scene(sc, opt);
+  ASSERT_TRUE(apart.unrouted.empty()) << apart.unrouted.front().message;
+  EXPECT_TRUE(apart.audit.segregation.empty())
+      << "closest " << apart.audit.segregation.front().distance << " at " << full_precision(apart.audit.segregation.front().point);
+  EXPECT_TRUE(apart.audit.result.clashes.empty());
 }
 
 }  // namespace
