@@ -66,6 +66,10 @@ void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
               rep.timing.audit, rep.timing.repair, rep.timing.total + rep.timing.load);
   std::printf("  audit (%s, exact triangles): %zu clashes, %zu violations\n", clash_method_name(a.method),
               a.result.clashes.size() + a.motion.clashes.size(), a.result.violations.size() + a.supports.spans.size() + a.segregation.size());
+  if (rep.voxel_resolution > 0.0)
+    std::printf("  voxel layer: %.4g %s voxels; %llu planning queries decided by the map, %llu by Embree\n",
+                rep.voxel_resolution, a.units.c_str(), static_cast<unsigned long long>(rep.voxel_decided),
+                static_cast<unsigned long long>(rep.voxel_exact));
   if (rep.share_within_reach >= 0.0)
     std::printf("  supports: %zu clamps placed, %.1f%% of the cable length within reach of structure, "
                 "%zu unsupported spans\n",
@@ -127,6 +131,7 @@ int run_route(const std::string& scene_path, const RouteCommandOptions& o) {
   ro.iterations = o.iterations;
   ro.threads = o.threads;
   ro.simplify = o.simplify;
+  ro.voxel_layer = o.voxel_layer;
   ro.progress = bar.fn();
   RouteReport rep = route_scene(scene, ro);
   rep.timing.load = lr.load_ms;
@@ -162,6 +167,9 @@ void add_route_command(CLI::App& app, int& exit_code) {
       ->check(whole_number(1, kMaxThreads));
   cmd->add_option("--render-size", o->render_size, "Size of render.png, WIDTHxHEIGHT")->capture_default_str();
   cmd->add_flag("--simplify", o->simplify, "Plan among α-simplified parts instead of the exact ones (α-SIM, DESIGN §6)");
+  cmd->add_flag("--voxel-layer", o->voxel_layer,
+                "Answer the planning queries a voxel distance map proves from it, the rest with Embree (same routes "
+                "validity; pays where planning, not the map's build, dominates)");
   cmd->add_flag("--json", o->json, "Print the report as JSON");
   cmd->add_flag("--quiet", o->quiet, "Print nothing (exit status only)");
   cmd->callback([scene, o, &exit_code]() { exit_code = run_route(*scene, *o); });

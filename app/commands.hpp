@@ -36,6 +36,7 @@ struct RouteCommandOptions {
   long long iterations = -1; ///< planner iterations per segment; < 0: the scene's
   int threads = 0;
   bool simplify = false;     ///< plan among α-simplified parts
+  bool voxel_layer = false;  ///< a voxel distance map in front of Embree while planning
   bool json = false;
   bool quiet = false;
 };

@@ -81,6 +81,12 @@ class ObstacleIndex {
     (void)part;
     return std::nullopt;
   }
+  /// A certified lower bound on the distance from p to the nearest part surface, at a cost far
+  /// below closest() (≤ 0 where the index cannot tell). The default knows nothing: 0.
+  virtual double distance_lower_bound(const Vec3& p) const {
+    (void)p;
+    return 0.0;
+  }
   /// True if p is strictly inside a closed part (open parts have no inside); the part id
   /// is written to *part when given. Correct for points near edges and vertices.
   virtual bool inside(const Vec3& p, int* part = nullptr) const = 0;

@@ -25,6 +25,12 @@ namespace {
 constexpr long kKeyHalf = 32768;
 /// Squared-distance marker for "no seed" in the EDT (voxel units²).
 constexpr double kEdtFar = 1e30;
+/// Cell flags: free, a surface passes through it, interior of a closed part, or free as far
+/// as the interior fill knows but in a row it could not decide (every line offset touched an
+/// edge): refine() then asks the exact index whether the centre lies inside.
+constexpr std::uint8_t kFree = 0, kSurface = 1, kInterior = 2, kUndecided = 3;
+/// Occupied cells: the ones in the OcTree and the seeds of the distance transform.
+bool occupied(std::uint8_t flag) { return flag == kSurface || flag == kInterior; }
 /// Default max_distance in voxels when VoxelOptions::max_distance ≤ 0.
 constexpr double kDefaultMaxDistanceVoxels = 8.0;
 /// Offsets (in voxels) of the scan lines used for the interior fill; all below
@@ -155,12 +161,15 @@ VoxelMap::VoxelMap(const std::vector<Part>& parts, const VoxelOptions& opt, std:
   voxelise(parts);
   fill_tree();
   stats_.voxelise_seconds = t0.seconds();
+  edt_only_ = !opt.exact_refine;
   const Stopwatch t1;
   run_edt();
   stats_.edt_seconds = t1.seconds();
-  const Stopwatch t2;
-  refine();
-  stats_.refine_seconds = t2.seconds();
+  if (!edt_only_) {
+    const Stopwatch t2;
+    refine();
+    stats_.refine_seconds = t2.seconds();
+  }
 }
 
 void VoxelMap::voxelise(const std::vector<Part>& parts) {
@@ -181,9 +190,9 @@ void VoxelMap::voxelise(const std::vector<Part>& parts) {
         for (long j = lo[1]; j <= hi[1]; ++j)
           for (long i = lo[0]; i <= hi[0]; ++i) {
             const long id = (k * n_[1] + j) * n_[0] + i;
-            if (flags_[id] == 1) continue;
+            if (flags_[id] == kSurface) continue;
             if (closest_point_on_triangle(cell_centre(i, j, k), c[0], c[1], c[2]).dist2 <= h2) {
-              flags_[id] = 1;
+              flags_[id] = kSurface;
               part_[id] = static_cast<std::int32_t>(pi);
               ++stats_.surface_voxels;
             }
@@ -252,15 +261,21 @@ void VoxelMap::voxelise(const std::vector<Part>& parts) {
           ok = true;
           break;
         }
-        if (!ok) continue;  // every offset touched an edge: leave the row to the surface voxels
+        if (!ok) {  // every offset touched an edge: refine() decides the row's free cells
+          for (long i = lo[0]; i <= hi[0]; ++i) {
+            std::uint8_t& f = flags_[(k * n_[1] + j) * n_[0] + i];
+            if (f == kFree) f = kUndecided;
+          }
+          continue;
+        }
         std::sort(xs.begin(), xs.end());
         for (std::size_t s = 0; s + 1 < xs.size(); s += 2) {
           const long i0 = std::max(lo[0], static_cast<long>(std::ceil(xs[s] / res_ - 0.5)) - base_[0]);
           const long i1 = std::min(hi[0], static_cast<long>(std::floor(xs[s + 1] / res_ - 0.5)) - base_[0]);
           for (long i = i0; i <= i1; ++i) {
             const long id = (k * n_[1] + j) * n_[0] + i;
-            if (flags_[id] != 0) continue;
-            flags_[id] = 2;
+            if (flags_[id] != kFree) continue;
+            flags_[id] = kInterior;
             part_[id] = static_cast<std::int32_t>(pi);
             ++stats_.interior_voxels;
           }
@@ -274,7 +289,7 @@ void VoxelMap::fill_tree() {
   for (long k = 0; k < n_[2]; ++k)
     for (long j = 0; j < n_[1]; ++j)
       for (long i = 0; i < n_[0]; ++i) {
-        if (flags_[(k * n_[1] + j) * n_[0] + i] == 0) continue;
+        if (!occupied(flags_[(k * n_[1] + j) * n_[0] + i])) continue;
         const octomap::OcTreeKey key(static_cast<octomap::key_type>(base_[0] + i + kKeyHalf),
                                      static_cast<octomap::key_type>(base_[1] + j + kKeyHalf),
                                      static_cast<octomap::key_type>(base_[2] + k + kKeyHalf));
@@ -288,7 +303,7 @@ void VoxelMap::run_edt() {
   // Squared distances in voxel units, seeded at occupied cells, in three separable passes.
   const std::size_t cells = dist_.size();
   std::vector<double> g(cells);
-  for (std::size_t c = 0; c < cells; ++c) g[c] = flags_[c] ? 0.0 : kEdtFar;
+  for (std::size_t c = 0; c < cells; ++c) g[c] = occupied(flags_[c]) || (edt_only_ && flags_[c] == kUndecided) ? 0.0 : kEdtFar;
   for (int axis = 0; axis < 3; ++axis) {
     const long n = n_[axis];
     const long stride = axis == 0 ? 1 : axis == 1 ? n_[0] : n_[0] * n_[1];
@@ -328,26 +343,32 @@ void VoxelMap::refine() {
     std::size_t local = 0;
     for (std::size_t c = b; c < e; ++c) {
       const float edt = dist_[c];
-      if (flags_[c] == 2) {
+      if (flags_[c] == kInterior) {
         dist_[c] = 0.0f;
-        continue;
-      }
-      if (!(edt <= band)) {
-        dist_[c] = std::numeric_limits<float>::infinity();
         continue;
       }
       const long i = static_cast<long>(c % static_cast<std::size_t>(n_[0]));
       const long j = static_cast<long>((c / static_cast<std::size_t>(n_[0])) % static_cast<std::size_t>(n_[1]));
       const long k = static_cast<long>(c / static_cast<std::size_t>(n_[0] * n_[1]));
       const Vec3 p = cell_centre(i, j, k);
+      // A cell the interior fill could not decide may lie deep inside a part, beyond the band.
+      int inside_part = -1;
+      if (flags_[c] == kUndecided && exact_->inside(p, &inside_part)) {
+        dist_[c] = 0.0f;
+        part_[c] = inside_part;
+        continue;
+      }
+      if (!(edt <= band)) {
+        dist_[c] = std::numeric_limits<float>::infinity();
+        continue;
+      }
       const ClosestHit h = exact_->closest(p, static_cast<double>(edt) + 2.0 * half_diag_);
       ++local;
       if (!h.found()) {
         dist_[c] = std::numeric_limits<float>::infinity();
         continue;
       }
-      int inside_part = -1;
-      if (flags_[c] == 1 && exact_->inside(p, &inside_part)) {
+      if (flags_[c] == kSurface && exact_->inside(p, &inside_part)) {
         dist_[c] = 0.0f;
         part_[c] = inside_part;
         continue;
@@ -391,8 +412,8 @@ std::unique_ptr<VoxelMap> VoxelMap::load_bt(const std::string& path, const Voxel
         for (long d = 0; d < steps; ++d) {
           const Vec3 p = c - Vec3::Constant(hs) + (Vec3(a, b, d) + Vec3::Constant(0.5)) * vm->res_;
           const long id = vm->cell_of(p);
-          if (id >= 0 && vm->flags_[id] == 0) {
-            vm->flags_[id] = 1;
+          if (id >= 0 && vm->flags_[id] == kFree) {
+            vm->flags_[id] = kSurface;
             vm->part_[id] = 0;
             ++vm->stats_.surface_voxels;
           }
@@ -428,7 +449,11 @@ IndexAccuracy VoxelMap::accuracy() const {
   // Nearest-centre lookup of a 1-Lipschitz function: ≤ half a diagonal; float storage adds
   // a relative 2^-24 of max_distance.
   const double storage = max_distance_ * 6e-8;
-  if (from_file_) {
+  if (edt_only_) {
+    a.abs_error = 2.0 * half_diag_ + storage;
+    a.description = "voxel map " + full_precision(res_) + ", EDT of occupied voxels: <= voxel diagonal " +
+                    full_precision(a.abs_error) + " scene units";
+  } else if (from_file_) {
     a.abs_error = 2.0 * half_diag_ + storage;
     a.description = "voxel map loaded from .bt, EDT of occupied voxel centres: <= voxel diagonal " +
                     full_precision(a.abs_error) + " scene units up to " + full_precision(max_distance_);
@@ -486,8 +511,8 @@ ClosestHit VoxelMap::segment_closest_on_part(const Vec3& a, const Vec3& b, int p
 
 bool VoxelMap::inside(const Vec3& p, int* part) const {
   const long c = cell_of(p);
-  if (c < 0 || flags_[c] == 0) return false;
-  if (flags_[c] == 2) {
+  if (c < 0 || flags_[c] == kFree) return false;
+  if (flags_[c] == kInterior) {
     if (part) *part = part_[c];
     return true;
   }

@@ -39,6 +39,11 @@ struct VoxelOptions {
   double max_distance = 0.0;  ///< distances are known up to this (scene units); ≤ 0: 8 voxels
   std::size_t max_cells = std::size_t(64) << 20;  ///< budget for the dense distance grid (cells)
   int threads = 0;            ///< TBB workers for the build (≤ 0: all cores)
+  /// Exact distances at the voxel centres within max_distance (error ≤ half a voxel
+  /// diagonal). false: the distance transform of the occupied voxels alone, with no exact
+  /// query in the build (error ≤ a voxel diagonal; cells whose side of a closed part the
+  /// interior fill could not decide count as occupied).
+  bool exact_refine = true;
 };
 
 /// Timings and sizes of a voxel map build (seconds, counts).
@@ -126,6 +131,7 @@ class VoxelMap : public ObstacleIndex {
   double max_distance_ = 0.0;
   double half_diag_ = 0.0;
   bool from_file_ = false;
+  bool edt_only_ = false;  ///< built without exact_refine
   int part_count_ = 0;
   int threads_ = 0;
   std::size_t max_cells_ = 0;
@@ -133,7 +139,7 @@ class VoxelMap : public ObstacleIndex {
   long n_[3] = {0, 0, 0};
   std::vector<float> dist_;          ///< per cell: distance (scene units), +inf beyond max_distance
   std::vector<std::int32_t> part_;   ///< per cell: nearest part (-1 unknown)
-  std::vector<std::uint8_t> flags_;  ///< per cell: 0 free, 1 surface, 2 interior of a closed part
+  std::vector<std::uint8_t> flags_;  ///< per cell: 0 free, 1 surface, 2 interior of a closed part, 3 undecided by the fill
   std::unique_ptr<octomap::OcTree> tree_;
   std::shared_ptr<const ObstacleIndex> exact_;
   VoxelBuildStats stats_;

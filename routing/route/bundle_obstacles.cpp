@@ -198,6 +198,13 @@ bool HarnessAwareIndex::any_within(const Vec3& p, double r) const {
   return parts_.any_within(p, r) || nearest_capsule(p, p, r, -1, nullptr).found();
 }
 
+double HarnessAwareIndex::distance_lower_bound(const Vec3& p) const {
+  const double parts = parts_.distance_lower_bound(p);
+  if (!(parts > 0.0)) return parts;
+  const ClosestHit cap = nearest_capsule(p, p, parts, -1, nullptr);
+  return cap.found() ? cap.distance : parts;
+}
+
 bool HarnessAwareIndex::segment_within(const Vec3& a, const Vec3& b, double r) const {
   return parts_.segment_within(a, b, r) || nearest_capsule(a, b, r, -1, nullptr).found();
 }

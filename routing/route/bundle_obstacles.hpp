@@ -54,6 +54,8 @@ class HarnessAwareIndex : public ObstacleIndex {
   bool inside(const Vec3& p, int* part) const override { return parts_.inside(p, part); }
   void inside_parts(const Vec3& p, std::vector<int>& out) const override { parts_.inside_parts(p, out); }
   RayHit ray(const Vec3& o, const Vec3& d, double t_max) const override { return parts_.ray(o, d, t_max); }
+  /// The parts' lower bound, or the exact distance to a bundle surface closer than it.
+  double distance_lower_bound(const Vec3& p) const override;
   bool any_within(const Vec3& p, double r) const override;
   bool segment_within(const Vec3& a, const Vec3& b, double r) const override;
   ClosestHit segment_closest(const Vec3& a, const Vec3& b, double max_radius, double* segment_param) const override;

@@ -282,6 +282,32 @@ class TubeObjective : public ob::OptimizationObjective {
     const double horizon = required_ + band_ + kSkipSteps * step_;
     constant_for = horizon;
     double r = w_len_;
+    // Beyond the band every ramp is 0: an index that proves it cheaply (the voxel layer's
+    // lower bound) saves the closest-point queries, and the bound says how far the rate
+    // stays so.
+    const bool ramps = w_clear_ > 0.0 || !avoid_.empty() || !near_.empty();
+    const double far = ramps ? index_.distance_lower_bound(p) : 0.0;
+    if (far >= required_ + band_) {
+      if (!near_.empty()) r += w_pref_;
+      constant_for = std::min(constant_for, flat_for(far));
+    } else {
+      r += near_rate(p, horizon, constant_for);
+    }
+    if (w_sup_ > 0.0) {
+      // σ is constant (0) within reach − step and (1) beyond reach + band: 1-Lipschitz
+      // distance gives how far it stays so.
+      const double d = support_distance(p);
+      r += w_sup_ * std::clamp((d - sup_reach_) / sup_band_, 0.0, 1.0);
+      const double inside = sup_reach_ - d, outside = d - sup_reach_ - sup_band_;
+      constant_for = std::min(constant_for, std::max({0.0, inside, outside}));
+    }
+    return r;
+  }
+
+  /// The clearance and preference terms of rate() from exact queries (horizon: their search
+  /// radius); lowers constant_for to how far they provably stay.
+  double near_rate(const Vec3& p, double horizon, double& constant_for) const {
+    double r = 0.0;
     if (w_clear_ > 0.0) {
       const ClosestHit hit = index_.closest(p, horizon);
       const double d = hit.found() ? hit.distance : horizon;
@@ -303,14 +329,6 @@ class TubeObjective : public ob::OptimizationObjective {
       }
       r += w_pref_ * (1.0 - ramp(d));
       constant_for = std::min(constant_for, flat_for(d));
-    }
-    if (w_sup_ > 0.0) {
-      // σ is constant (0) within reach − step and (1) beyond reach + band: 1-Lipschitz
-      // distance gives how far it stays so.
-      const double d = support_distance(p);
-      r += w_sup_ * std::clamp((d - sup_reach_) / sup_band_, 0.0, 1.0);
-      const double inside = sup_reach_ - d, outside = d - sup_reach_ - sup_band_;
-      constant_for = std::min(constant_for, std::max({0.0, inside, outside}));
     }
     return r;
   }

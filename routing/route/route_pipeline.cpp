@@ -15,6 +15,8 @@
 #include "routing/route/branch_layout.hpp"
 #include "routing/route/bundle_obstacles.hpp"
 #include "routing/route/class_separation.hpp"
+#include "index/voxel_first_index.hpp"
+#include "index/voxel_map.hpp"
 #include "routing/route/port_check.hpp"
 #include "routing/route/support_pull.hpp"
 #include "routing/curve/cable_geometry.hpp"
@@ -39,6 +41,29 @@ constexpr double kStubShare = 0.5;
 /// Re-plans of a segment whose bend repair failed: each with a fresh seed and twice the
 /// previous budget; the first whose curve meets the bend radius is kept.
 constexpr int kBendReplans = 2;
+
+/// Grid budget of the voxel layer (cells; ~9 bytes each: distance, nearest part, flags).
+constexpr std::size_t kVoxelLayerCells = std::size_t(16) << 20;
+
+/// Box of every part's triangles.
+AABB box_of(const std::vector<Part>& parts) {
+  AABB box;
+  for (const Part& p : parts) box.extend(p.mesh.bounds());
+  return box;
+}
+
+/// The voxel layer's edge: `finest` (the diagonal the thinnest tube needs), coarsened in
+/// steps of 10% until the grid over `box` plus its margin (max_distance and a voxel) holds at
+/// most `budget` cells: a coarser map still decides the queries far from every part.
+double voxel_layer_resolution(const AABB& box, double finest, double max_distance, std::size_t budget) {
+  double h = finest;
+  for (int step = 0; step < 200 && !box.empty(); ++step, h *= 1.1) {
+    double cells = 1.0;
+    for (int a = 0; a < 3; ++a) cells *= (box.max[a] - box.min[a] + 2.0 * (max_distance + h)) / h + 3.0;
+    if (cells <= static_cast<double>(budget)) break;
+  }
+  return h;
+}
 
 /// Slack of the port-exit checks, as a share of the tube radius (the audit's default
 /// tolerance, r/100): the exit is checked not to enter the part its port sits on from this far
@@ -153,6 +178,8 @@ class RouteRun {
 
  private:
   void prepare_obstacles();
+  void prepare_voxel_layer();
+  const ObstacleIndex& planning_index() const;
   void layout_branches();
   EndFrame end_frame(int seg, bool from_end) const;
   void plan_segments();
@@ -197,6 +224,8 @@ class RouteRun {
   bool plan_on_other_parts_ = false;
   std::vector<Part> planning_parts_;
   std::unique_ptr<EmbreeIndex> plan_index_;
+  std::unique_ptr<VoxelMap> voxel_map_;          ///< distance map of the planning parts (voxel layer)
+  std::unique_ptr<VoxelFirstIndex> voxel_first_; ///< plan_index_ behind the map's lower bound
   std::vector<AABB> part_boxes_;  ///< box of each planning part
   std::vector<SegmentEnds> ends_;
   std::map<std::pair<int, bool>, Vec3> exit_dir_;
@@ -238,6 +267,9 @@ RouteReport RouteRun::run() {
   plan_segments();
   build_splines();
   replan_bend_failures();
+  const VoxelFirstCounts n = voxel_first_->counts();
+  rep_.voxel_decided = n.decided;
+  rep_.voxel_exact = n.exact;
   audit_and_repair();
   note_nominal_lengths();
   note_reproducibility();
@@ -282,8 +314,48 @@ void RouteRun::prepare_obstacles() {
     const auto kept = plan_index_->part_bounds(static_cast<int>(q));
     part_boxes_.push_back(kept ? *kept : planning_parts_[q].mesh.bounds());
   }
+  prepare_voxel_layer();
   rep_.timing.index = t0.ms();
 }
+
+/// The voxel layer: a distance map of the planning parts at the resolution the thinnest
+/// tube needs (half its required distance as the map's error bound), known up to the
+/// required distance plus twice that bound, so that a point farther than that from every
+/// part is decided without Embree. A scene too large for the map's grid budget plans on
+/// Embree alone, and the notes say so.
+void RouteRun::prepare_voxel_layer() {
+  const double required = 0.5 * h_.smallest_diameter() + rep_.clearance + part_extra_;
+  if (opt_.voxel_layer && !planning_parts_.empty() && required > 0.0) {
+    VoxelOptions vo;
+    vo.max_distance = 4.0 * required;  // beyond the clearance band (2 required) and the bound
+    vo.resolution = voxel_layer_resolution(box_of(planning_parts_), required / std::sqrt(3.0), vo.max_distance,
+                                           kVoxelLayerCells);
+    vo.exact_refine = false;                    // no exact query in the build
+    vo.max_cells = kVoxelLayerCells;
+    vo.threads = opt_.threads;
+    const Stopwatch t0;
+    try {
+      voxel_map_ = std::make_unique<VoxelMap>(
+          planning_parts_, vo, std::shared_ptr<const ObstacleIndex>(plan_index_.get(), [](const ObstacleIndex*) {}));
+      rep_.voxel_resolution = vo.resolution;
+      rep_.voxel_bytes = voxel_map_->memory_bytes();
+      rep_.notes.push_back("voxel layer: " + full_precision(vo.resolution) + " voxels, distances within " +
+                           full_precision(voxel_map_->accuracy().abs_error) + ", " +
+                           std::to_string(voxel_map_->memory_bytes() >> 20) + " MiB, built in " +
+                           std::to_string(static_cast<long>(t0.ms())) + " ms (voxels and OcTree " +
+                           std::to_string(static_cast<long>(1e3 * voxel_map_->stats().voxelise_seconds)) +
+                           " ms, distance transform " +
+                           std::to_string(static_cast<long>(1e3 * voxel_map_->stats().edt_seconds)) + " ms)");
+    } catch (const InputError& e) {
+      rep_.notes.push_back(std::string("no voxel layer (Embree answers every planning query): ") + e.what());
+    }
+  }
+  voxel_first_ = std::make_unique<VoxelFirstIndex>(*plan_index_, voxel_map_.get());
+}
+
+/// The planning parts as the planner queries them: behind the voxel layer (counted, and
+/// decided by the map when there is one).
+const ObstacleIndex& RouteRun::planning_index() const { return *voxel_first_; }
 
 /// Places the branch points the file leaves open where the legs are short and can turn into
 /// their connectors within the bend radius; then the exit direction of every segment at
@@ -517,7 +589,7 @@ std::unique_ptr<HarnessAwareIndex> RouteRun::obstacles_for(int s, const std::vec
     }
     for (auto& r : runs) tubes.push_back({t, std::move(r), radius});
   }
-  return std::make_unique<HarnessAwareIndex>(*plan_index_, tubes);
+  return std::make_unique<HarnessAwareIndex>(planning_index(), tubes);
 }
 
 /// Keeps the bundle of planned segment `s` as an obstacle for the segments planned after it:

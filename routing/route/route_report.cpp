@@ -46,6 +46,8 @@ json route_report_json(const RouteReport& rep) {
   j["iterations"] = rep.iterations;  // 0: none
   j["reproducible"] = rep.unreproducible.empty();
   j["clearance"] = rep.clearance;
+  if (rep.voxel_resolution > 0.0)
+    j["voxel_layer"] = {{"resolution", rep.voxel_resolution}, {"decided", rep.voxel_decided}, {"exact", rep.voxel_exact}};
   if (rep.share_within_reach >= 0.0)
     j["supports"] = {{"clamps_placed", rep.clamps_placed}, {"share_within_reach", rep.share_within_reach}};
   // Per cable: the audit's figures plus how it was routed.

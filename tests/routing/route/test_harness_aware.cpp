@@ -2,7 +2,8 @@
 // oracle), their cut-back near a shared node (closed form), and a hand-made harness whose two
 // segments clash when each is planned among the parts only and do not when the second is
 // planned among the first's bundle too (the audit is the judge); the same crossing with the
-// two bundles in separated classes, planned apart by the separation.
+// two bundles in separated classes, planned apart by the separation; and the crossing planned
+// with the voxel layer in front of Embree (clean, the map deciding part of the queries).
 #include "core/io/harness_xml.hpp"
 #include "index/embree_index.hpp"
 #include "index/index_test_meshes.hpp"
@@ -189,6 +190,23 @@ TEST(HarnessAware, SeparatedClassesArePlannedApart) {
   EXPECT_TRUE(apart.audit.segregation.empty())
       << "closest " << apart.audit.segregation.front().distance << " at " << full_precision(apart.audit.segregation.front().point);
   EXPECT_TRUE(apart.audit.result.clashes.empty());
+}
+
+TEST(HarnessAware, VoxelLayerDecidesQueriesAndKeepsTheRouteClean) {
+  const Scene sc = crossing_scene();
+  RouteOptions opt;
+  opt.threads = 2;
+  const RouteReport plain = route_scene(sc, opt);
+  EXPECT_EQ(plain.voxel_resolution, 0.0);
+  EXPECT_EQ(plain.voxel_decided, 0u);
+  EXPECT_GT(plain.voxel_exact, 0u);
+  opt.voxel_layer = true;
+  const RouteReport layered = route_scene(sc, opt);
+  ASSERT_TRUE(layered.unrouted.empty());
+  EXPECT_GT(layered.voxel_resolution, 0.0);
+  EXPECT_GT(layered.voxel_decided, 0u);
+  EXPECT_TRUE(layered.audit.result.clashes.empty());
+  EXPECT_EQ(layered.exit_code(), plain.exit_code());
 }
 
 }  // namespace
