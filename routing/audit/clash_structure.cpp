@@ -30,7 +30,6 @@ class StructureTracer {
  public:
   StructureTracer(Context& ctx, int cable, const StructureHints* hints)
       : ctx_(ctx),
-        cable_(cable),
         in_(ctx.cables[cable]),
         r_(in_.radius),
         hints_(hints),
@@ -606,7 +605,6 @@ class StructureTracer {
   }
 
   Context& ctx_;
-  int cable_;
   const CableInput& in_;
   double r_;
   const StructureHints* hints_;  ///< stretches proven clear beforehand (may be null)
