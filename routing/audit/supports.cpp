@@ -20,14 +20,16 @@ constexpr int kGoldenSteps = 60;
 
 }  // namespace
 
+bool holds_clamps(const Part& p) { return p.role == PartRole::Structure && !p.motion; }
+
 ClosestHit nearest_structure(const ObstacleIndex& index, const std::vector<Part>& parts, const Vec3& p,
                              double max_radius) {
   const ClosestHit any = index.closest(p, max_radius);
-  if (!any.found() || parts[static_cast<std::size_t>(any.part)].role == PartRole::Structure) return any;
-  // The nearest surface is a keep-out zone, which holds nothing: ask the structure parts.
+  if (!any.found() || holds_clamps(parts[static_cast<std::size_t>(any.part)])) return any;
+  // The nearest surface holds nothing (a keep-out zone, a moving part): ask the others.
   ClosestHit best;
   for (std::size_t q = 0; q < parts.size(); ++q) {
-    if (parts[q].role != PartRole::Structure) continue;
+    if (!holds_clamps(parts[q])) continue;
     if (const auto box = index.part_bounds(static_cast<int>(q)); box && !box->inflated(best.found() ? best.distance : max_radius).contains(p))
       continue;
     const ClosestHit h = index.closest_on_part(p, static_cast<int>(q), best.found() ? best.distance : max_radius);

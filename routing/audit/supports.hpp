@@ -16,8 +16,13 @@
 
 namespace loom {
 
-/// Nearest point of a structure part (role structure; keep-out zones are skipped) within
-/// `max_radius` of p, exact to the index's accuracy; found() == false if none.
+/// True if a clamp may be fixed to the part: structure that does not move. Keep-out zones
+/// and moving parts (a clamp there would ride the mechanism and drop or chafe the bundle)
+/// hold nothing.
+bool holds_clamps(const Part& p);
+
+/// Nearest point of a part that holds clamps (holds_clamps) within `max_radius` of p, exact
+/// to the index's accuracy; found() == false if none.
 ClosestHit nearest_structure(const ObstacleIndex& index, const std::vector<Part>& parts, const Vec3& p,
                              double max_radius);
 

@@ -180,6 +180,7 @@ class RouteRun {
   void prepare_obstacles();
   void prepare_voxel_layer();
   const ObstacleIndex& planning_index() const;
+  bool holds_clamp(std::size_t planning_part) const;
   void layout_branches();
   EndFrame end_frame(int seg, bool from_end) const;
   void plan_segments();
@@ -223,6 +224,7 @@ class RouteRun {
   double part_extra_ = 0.0;    ///< largest per-part extra clearance
   bool plan_on_other_parts_ = false;
   std::vector<Part> planning_parts_;
+  std::size_t envelope_parts_from_ = 0;  ///< planning parts from here on are posed copies of moving parts
   std::unique_ptr<EmbreeIndex> plan_index_;
   std::unique_ptr<VoxelMap> voxel_map_;          ///< distance map of the planning parts (voxel layer)
   std::unique_ptr<VoxelFirstIndex> voxel_first_; ///< plan_index_ behind the map's lower bound
@@ -302,6 +304,7 @@ void RouteRun::prepare_obstacles() {
   }
   // Moving parts: their swept envelope is an obstacle too; then the planning parts are no
   // longer the exact ones the audit needs.
+  envelope_parts_from_ = planning_parts_.size();
   const double gap = swept_envelope_gap(rep_.clearance, h_.smallest_diameter());
   if (append_swept_envelopes(scene_.parts, gap, unit_name(scene_.units), planning_parts_, rep_.notes) > 0)
     plan_on_other_parts_ = true;
@@ -351,6 +354,12 @@ void RouteRun::prepare_voxel_layer() {
     }
   }
   voxel_first_ = std::make_unique<VoxelFirstIndex>(*plan_index_, voxel_map_.get());
+}
+
+/// Whether a planning part may hold a clamp: structure that does not move, and not a posed
+/// copy of a moving part (its swept envelope).
+bool RouteRun::holds_clamp(std::size_t planning_part) const {
+  return planning_part < envelope_parts_from_ && holds_clamps(planning_parts_[planning_part]);
 }
 
 /// The planning parts as the planner queries them: behind the voxel layer (counted, and
@@ -475,7 +484,7 @@ PlanRequest RouteRun::plan_request(int s, const SegmentExits& x) const {
     // Prefer ways a clamp can hold: within clamp_reach of the bundle surface from structure.
     req.objective.support_weight = scene_.routing.support_weight.value;
     req.objective.support_reach = x.radius + scene_.routing.clamp_reach.value;
-    for (const Part& p : planning_parts_) req.objective.part_supports.push_back(p.role == PartRole::Structure);
+    for (std::size_t q = 0; q < planning_parts_.size(); ++q) req.objective.part_supports.push_back(holds_clamp(q));
   }
   req.start = {a_stub, (b_stub - a_stub).norm() > 0 ? Vec3((b_stub - a_stub).normalized()) : Vec3::UnitX()};
   req.goal = {b_stub, (a_stub - b_stub).norm() > 0 ? Vec3((a_stub - b_stub).normalized()) : Vec3::UnitX()};
@@ -715,7 +724,7 @@ int RouteRun::pull_to_supports(const ObstacleIndex& index, const SegmentExits& x
   if (!(ps.reach > ps.required)) return 0;  // no stand-off between clearance and reach to aim at
   ps.start_is_port = x.ea.is_port;
   ps.end_is_port = x.eb.is_port;
-  for (const Part& p : planning_parts_) ps.part_supports.push_back(p.role == PartRole::Structure);
+  for (std::size_t q = 0; q < planning_parts_.size(); ++q) ps.part_supports.push_back(holds_clamp(q));
   SupportPullResult pulled = pull_to_structure(index, key_points, ps);
   key_points = std::move(pulled.points);
   return pulled.inserted;

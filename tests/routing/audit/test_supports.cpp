@@ -3,7 +3,7 @@
 // reach 25 + radius 2; the plate edge is ≥ 201 mm away), so the one unsupported span runs
 // from the last clamp on the first plate to the first clamp on the second. Without any
 // structure every cable is one span from port to port; without clamp_spacing in the scene
-// no span is checked (clamps are still listed).
+// no span is checked (clamps are still listed); keep-out zones and moving parts hold nothing.
 #include "routing/audit/audit.hpp"
 #include "routing/audit/report_json.hpp"
 #include "common/support_fixtures.hpp"
@@ -93,6 +93,24 @@ TEST(Supports, ClampsCloseTheGapWhenWithinReach) {
   // 1 mm farther, beyond the reach: the span is back.
   parts.back() = box_part("plate-3", {900, -100, -10}, {1300, 100, kHeight - 2 - 26});
   EXPECT_EQ(audit(straight(kEvery200), parts, true).supports.spans.size(), 1u);
+}
+
+TEST(Supports, AMovingPartHoldsNoClamp) {
+  // The third plate within reach as above, but it slides along x (a door, a seat rail):
+  // a clamp there would ride it, so the gap stays one span and its clamps hold nothing.
+  std::vector<Part> parts = two_plates();
+  parts.push_back(box_part("plate-3", {900, -100, -10}, {1300, 100, kHeight - 2 - 24}));
+  Motion slide;
+  slide.kind = MotionKind::Translate;
+  slide.axis = Vec3::UnitY();
+  slide.from = 0.0;
+  slide.to = 50.0;
+  parts.back().motion = slide;
+  const AuditReport rep = audit(straight(kEvery200), parts, true);
+  EXPECT_EQ(rep.supports.spans.size(), 1u);
+  EXPECT_EQ(rep.supports.clamps[4].part, -1);
+  EXPECT_FALSE(holds_clamps(parts.back()));
+  EXPECT_TRUE(holds_clamps(parts.front()));
 }
 
 TEST(Supports, WithoutStructureEveryCableIsOneSpan) {
