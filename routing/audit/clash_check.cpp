@@ -51,6 +51,12 @@ constexpr double kChordShareOfTolerance = 0.5;
   throw CableLimitError(thinnest->id, "cable '" + thinnest->id + "' is the thinnest: " + text);
 }
 
+/// A node's breakout is its largest bend radius, so a right-angle turn through it sits
+/// exactly at the limit (reach / tan 45°); its tangents come from evaluating the curves,
+/// within rounding of the directions the layout gave them, so a node turn within this
+/// relative slack of the limit is not tighter than it.
+constexpr double kNodeTurnRelSlack = 1e-9;
+
 /// The smallest bend radius of cable c (per bend piece where it has them, and at the nodes
 /// it passes) into `sum`, and a bend-radius violation into `out` for every stretch bending
 /// tighter than the cable's minimum (Centerline::bend_stretches_below), at its tightest
@@ -100,7 +106,7 @@ void check_bend(const Context& ctx, std::size_t c, CableCheckSummary& sum, std::
   if (in.bend_pieces.empty()) add(in.curve, 0.0, 0);
   for (std::size_t k = 0; k < in.bend_pieces.size(); ++k) add(in.bend_pieces[k].second, in.bend_pieces[k].first, k);
   for (const NodeTurn& t : in.node_turns) {
-    if (!(t.radius < in.min_bend_radius)) continue;
+    if (!(t.radius < in.min_bend_radius * (1.0 - kNodeTurnRelSlack))) continue;
     Violation v;
     v.kind = ViolationKind::BendRadius;
     v.cable = static_cast<int>(c);

@@ -153,6 +153,20 @@ TEST_P(NodeDegree, AFoldBackThroughTheNodeIsABendNotASelfClash) {
   }
 }
 
+// Two legs 1e-12 rad less than a right angle apart (the cable turns by that much more): the turn is taken up within the
+// breakout, which equals the bend radius, at exactly the limit — not a violation. 0.01° more
+// is one.
+TEST(NodeDegreeRightAngle, ATurnAtTheLimitWithinRoundingIsNotAViolation) {
+  const Vec3 x = Vec3::UnitX();
+  for (const double extra : {1e-12, 0.01 * M_PI / 180.0}) {
+    const Vec3 y = Eigen::AngleAxisd(0.5 * M_PI - extra, Vec3::UnitZ()) * x;  // the cable turns by 90° + extra
+    const Harness h = star({x, y, -x, -y}, {{0, 1}});
+    const AuditReport rep = audit(h, ClashMethod::Certified);
+    EXPECT_TRUE(rep.result.clashes.empty());
+    EXPECT_EQ(rep.result.violations.size(), extra < 1e-9 ? 0u : 1u) << "extra turn " << extra;
+  }
+}
+
 // Two cables through the node on legs of their own, one leg bent to cross the other's 150 mm
 // from the hub, far outside its breakout: that contact is a cable–cable clash.
 TEST_P(NodeDegree, AContactAwayFromTheNodeIsStillAClash) {
