@@ -63,7 +63,7 @@ TEST(Cli, BadSceneIsExitTwoWithLine) {
 }
 
 TEST(Cli, InfoOnTheBundledExamples) {
-  for (const char* ex : {"wing-section", "real-meshes", "building-scan"}) {
+  for (const char* ex : {"wing-section", "wing-classes", "real-meshes", "building-scan"}) {
     const std::string scene = kExamples + "/" + ex + "/scene.toml";
     auto r = loom("info " + scene);
     EXPECT_EQ(r.status, 0) << ex << "\n" << r.out;
@@ -171,6 +171,18 @@ TEST(CliDemo, RoutesAndAuditsTheWingSection) {
   EXPECT_NE(r.out.find("24/24 cables routed"), std::string::npos) << r.out;
   EXPECT_TRUE(std::filesystem::exists(out / "routed.xml"));
   EXPECT_TRUE(std::filesystem::exists(out / "report.json"));
+}
+
+TEST(CliRoute, TheWingInThreeClassesRoutesCleanAndSegregated) {
+  // Power, data and signal on their own connectors and segments, kept 20/20/10 mm apart:
+  // every rule holds — no clash, bend, unsupported span or segregation finding (exit 0).
+  const auto out = fresh_dir("wing_classes");
+  auto r = loom("route " + kExamples + "/wing-classes/scene.toml --out " + out.string());
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("24/24 cables routed"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("0 clashes, 0 violations"), std::string::npos) << r.out;
+  const std::string report = slurp(out / "report.json");
+  EXPECT_EQ(report.find("\"segregation\""), std::string::npos) << "a segregation finding";
 }
 
 // --- progress bars and --render-size ----------------------------------------
