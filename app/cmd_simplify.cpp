@@ -10,6 +10,7 @@
 #include "core/io/mesh_write.hpp"
 #include "core/io/scene_load.hpp"
 #include "app/progress_bar.hpp"
+#include "index/embree_index.hpp"
 #include "index/simplify/alpha_sim.hpp"
 #include "core/io/json_text.hpp"
 
@@ -37,6 +38,29 @@ struct SimplifyCommandOptions {
 };
 
 double finite_or_zero(double v) { return std::isfinite(v) ? v : 0.0; }
+
+/// A split part's tree for simplify.json, depth first.
+nlohmann::json pieces_json(const std::vector<AlphaSimPiece>& pieces) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const AlphaSimPiece& p : pieces)
+    out.push_back({{"id", p.id},
+                   {"cut", p.cut},
+                   {"box_min", {p.box.min.x(), p.box.min.y(), p.box.min.z()}},
+                   {"box_max", {p.box.max.x(), p.box.max.y(), p.box.max.z()}},
+                   {"leaf", p.leaf},
+                   {"status", alpha_sim_status_name(p.status)},
+                   {"reason", p.reason},
+                   {"triangles_before", p.triangles_before},
+                   {"triangles_after", p.triangles_after},
+                   {"containment", finite_or_zero(p.containment)},
+                   {"lost_space_radius", finite_or_zero(p.lost_space_radius)}});
+  return out;
+}
+
+/// Bytes of an Embree index over `parts` (the BVH and the triangles it holds).
+std::size_t index_bytes(const std::vector<Part>& parts) {
+  return parts.empty() ? 0 : EmbreeIndex(parts).memory_bytes();
+}
 
 /// The targets this run did not stage (no STEP for a part whose original is kept, no STL for
 /// an empty part) that an earlier run left in the output directory. They are removed once
@@ -74,6 +98,8 @@ int run_simplify(const SimplifyCommandOptions& o) {
   AlphaSimOptions opt;
   opt.dim_pre = dim_pre;
   opt.scene_size = scene.bounds().diagonal();
+  opt.extra_planes = scene.simplify.planes;
+  opt.split_blocked = scene.simplify.split;
   if (o.step) opt.step_dir = outputs.staging();
   opt.progress = bar.fn();
   const double tolerance = opt.containment_tolerance_factor * opt.scene_size;
@@ -133,7 +159,8 @@ int run_simplify(const SimplifyCommandOptions& o) {
                      {"booleans_by", r.booleans_by},
                      {"booleans_note", r.booleans_note},
                      {"projections", projections}});
-    // Only a simplified part has a STEP solid; a part kept as it was has none.
+    if (!r.pieces.empty()) parts.back()["pieces"] = pieces_json(r.pieces);
+    // Only a simplified part (not split) has a STEP solid; a part kept as it was has none.
     if (o.step) parts.back()["step_file"] = step_written ? stem + ".step" : "";
     if (!o.quiet) {
       // Below the containment tolerance a distance is rounding (a part kept as it was).
@@ -146,11 +173,15 @@ int run_simplify(const SimplifyCommandOptions& o) {
                    alpha_sim_status_name(r.status), r.reason.empty() ? "" : ": ", r.reason.c_str());
     }
   }
-  std::size_t before = 0, after = 0;
+  std::size_t before = 0, after = 0, split = 0, blocked = 0;
   for (const auto& r : results) {
     before += r.triangles_before;
     after += r.triangles_after;
+    split += !r.pieces.empty() && r.fallback != AlphaSimFallback::Original;
+    blocked += r.status == AlphaSimStatus::Blocked;
   }
+  // What planning on the simplified parts saves in memory: both indices as `route` builds them.
+  const std::size_t bytes_exact = index_bytes(scene.parts), bytes_simplified = index_bytes(simple);
   json j = {{"scene", scene.name},
             {"units", unit_name(scene.units)},
             {"dim_pre", dim_pre},
@@ -160,6 +191,10 @@ int run_simplify(const SimplifyCommandOptions& o) {
             {"tolerance", tolerance},
             {"triangles_before", before},
             {"triangles_after", after},
+            {"parts_split", split},
+            {"parts_blocked", blocked},
+            {"index_bytes_exact", bytes_exact},
+            {"index_bytes_simplified", bytes_simplified},
             {"parts", parts}};
   targets.erase(targets.begin());  // simplify.json (the first target) is written below
   const std::vector<std::filesystem::path> stale = stale_targets(targets, outputs.staging());
@@ -173,10 +208,11 @@ int run_simplify(const SimplifyCommandOptions& o) {
     if (ec) throw std::runtime_error(t.string() + ": cannot remove the earlier run's file: " + ec.message());
   }
   if (!o.quiet)
-    std::fprintf(stderr, "loom simplify: %zu -> %zu triangles (%.1f%%) in %.2f s; wrote %s\n", before, after,
-                 before > 0 ? 100.0 * after / before : 0.0,
-                 t_start.seconds(),
-                 (out_dir / "simplify.json").string().c_str());
+    std::fprintf(stderr,
+                 "loom simplify: %zu -> %zu triangles (%.1f%%) in %.2f s; %zu parts split, %zu blocked; "
+                 "index %.1f -> %.1f MB; wrote %s\n",
+                 before, after, before > 0 ? 100.0 * after / before : 0.0, t_start.seconds(), split, blocked,
+                 bytes_exact / 1e6, bytes_simplified / 1e6, (out_dir / "simplify.json").string().c_str());
   return 0;
 }
 

@@ -25,6 +25,8 @@ struct Setting {
 /// milliseconds here): a larger budget could only be ended by the time limit, which is what
 /// the budget is there to avoid.
 constexpr long long kMaxPlanIterations = 100'000'000;
+/// Most [simplify] planes beyond the three axis planes (each adds a projection's work).
+constexpr std::size_t kMaxSimplifyPlanes = 16;
 
 /// [routing] of the scene file.
 /// The OMPL geometric planners that a scene's routing.planner may name, sorted. The scene
@@ -67,6 +69,11 @@ struct RoutingSettings {
 /// [simplify] of the scene file (α-SIM level of detail).
 struct SimplifySettings {
   Setting dim_pre;  ///< features smaller than this vanish; default smallest cable diameter
+  /// `planes`: normals of projection planes beyond XY, XZ and YZ (need not be unit; none by
+  /// default). Parts turned off the axes simplify better seen along their own axes.
+  std::vector<Vec3> planes;
+  /// `split`: a part whose projections hide a feature is split into pieces (default true).
+  bool split = true;
 };
 
 /// [tessellation]: how finely STEP/IGES B-reps are meshed.

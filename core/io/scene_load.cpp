@@ -416,10 +416,29 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
   scene.simplify.dim_pre = {dmin > 0 ? dmin : 1.0 * mm,
                             dmin > 0 ? "default: smallest cable diameter" : "default: 1 mm (no cables)"};
   if (const toml::table* st = r.section(doc, "simplify")) {
-    r.only_keys(*st, "simplify", {"dim_pre"});
+    r.only_keys(*st, "simplify", {"dim_pre", "planes", "split"});
     if (auto v = r.number(*st, "simplify", "dim_pre")) {
       if (!(*v > 0)) r.fail(st->get("dim_pre"), "simplify.dim_pre", "must be positive");
       scene.simplify.dim_pre = {*v, "scene file"};
+    }
+    if (const toml::node* n = st->get("planes")) {
+      const toml::array* a = n->as_array();
+      if (!a) r.fail(n, "simplify.planes", "expected an array of normals, e.g. [[1, 1, 0]]");
+      if (a->size() > kMaxSimplifyPlanes)
+        r.fail(n, "simplify.planes", "at most " + std::to_string(kMaxSimplifyPlanes) + " planes, got " + std::to_string(a->size()));
+      for (std::size_t i = 0; i < a->size(); ++i) {
+        const std::string key = "simplify.planes[" + std::to_string(i) + "]";
+        const Vec3 normal = r.vec3(a->get(i), key);
+        // A normal whose length underflows gives no direction.
+        if (!(normal.norm() > 0.0))
+          r.fail(a->get(i), key, "must be a non-zero normal");
+        scene.simplify.planes.push_back(normal);
+      }
+    }
+    if (const toml::node* n = st->get("split")) {
+      const auto b = n->as_boolean();
+      if (!b) r.fail(n, "simplify.split", "expected true or false");
+      scene.simplify.split = b->get();
     }
   }
   // [tessellation]

@@ -6,6 +6,7 @@
 #include "core/error.hpp"
 #include "index/embree_index.hpp"
 #include "index/simplify/extrusion.hpp"
+#include "index/simplify/lost_space.hpp"
 
 // CGAL before OpenCASCADE, whose macro Handle breaks CGAL's headers.
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -964,19 +965,24 @@ double float_rounding_reserve(const AABB& box, const AlphaSimOptions& opt, doubl
   return std::min(reserve, kMaxFloatRoundingShare * tol);
 }
 
+/// The mesh as a list of one part (for an EmbreeIndex).
+std::vector<Part> one_part(Mesh m, bool closed) {
+  std::vector<Part> parts(1);
+  parts[0].name = "alpha-sim";
+  parts[0].mesh = std::move(m);
+  parts[0].closed = closed;
+  return parts;
+}
+
 /// One closed or open mesh as a one-part EmbreeIndex: exact (double) distances and
 /// ray-parity inside tests (DESIGN §9: Embree for BVH queries). `watertight`: checked to
 /// have no boundary and no misoriented edge, so one ray that grazes nothing decides an
 /// inside test exactly (inside_rays = 1); the default majority of three guards real
 /// meshes with holes, at three times the rays.
 EmbreeIndex mesh_index(Mesh m, bool closed, bool watertight = false) {
-  std::vector<Part> parts(1);
-  parts[0].name = "alpha-sim";
-  parts[0].mesh = std::move(m);
-  parts[0].closed = closed;
   EmbreeOptions eo;
   if (watertight) eo.inside_rays = 1;
-  return EmbreeIndex(parts, eo);
+  return EmbreeIndex(one_part(std::move(m), closed), eo);
 }
 
 /// Number of `samples` inside or within tol of the closed mesh indexed by q (parallel).
@@ -1407,6 +1413,12 @@ struct PartSimplification {
   /// Containment of the original in the mesh and the implicit solid, Hausdorff distance,
   /// lost space.
   bool measure();
+  /// The lost-space probe on the implicit solid (before any mesh is built: a blocked part
+  /// keeps its original, so its Booleans would be wasted).
+  bool probe_lost_space_first();
+  /// The original part as a one-part index (built once, for the probe and the Hausdorff
+  /// distance).
+  const EmbreeIndex& original_index();
   /// The STEP file, when asked for.
   void write_step();
 
@@ -1427,6 +1439,7 @@ struct PartSimplification {
   std::shared_ptr<AlphaSimSolid> solid;
   std::vector<std::vector<PolygonWithHoles2>> polys;
   TopoDS_Shape result;  ///< OpenCASCADE's solid, when it ran the Booleans
+  std::unique_ptr<EmbreeIndex> original;  ///< see original_index()
 };
 
 PartSimplification::PartSimplification(const Part& part_in, const AlphaSimOptions& opt_in, const std::string& stem)
@@ -1460,7 +1473,7 @@ AlphaSimPart PartSimplification::run() {
   if (check_input() && build_shapes()) {
     outline_polygons();
     r.shapes_ms = t0.ms();
-    if (opt.build_mesh && build_mesh() && measure()) write_step();
+    if (opt.build_mesh && probe_lost_space_first() && build_mesh() && measure()) write_step();
   }
   r.time_ms = t0.ms();
   return std::move(out);
@@ -1774,59 +1787,40 @@ bool PartSimplification::measure() {
       return false;
     }
     // One-sided Hausdorff distance: output surface → original surface.
-    const EmbreeIndex original = mesh_index(part.mesh, r.closed_before);
     r.hausdorff = 0.0;
     if (opt.hausdorff) {
       const auto surf = dense_surface_samples(out.mesh, r.l_max, 1.0, 200000, opt.seed + 1);
-      for (const ClosestHit& h : original.closest_batch(surf, std::numeric_limits<double>::infinity()))
+      for (const ClosestHit& h : original_index().closest_batch(surf, std::numeric_limits<double>::infinity()))
         r.hausdorff = std::max(r.hausdorff, h.distance);
-    }
-
-    // Lost space (blocked projections): largest ball inside the simplified solid and
-    // outside the original, probed on a grid.
-    if (opt.detect_lost_space && r.closed_before) {
-      const double r_lost = opt.lost_space_factor * opt.dim_pre;
-      const Vec3 ext = box.size();
-      const double vol = std::max(ext.x(), 1e-12) * std::max(ext.y(), 1e-12) * std::max(ext.z(), 1e-12);
-      double h = std::max(r_lost / 2.0, std::cbrt(vol / static_cast<double>(opt.lost_space_max_samples)));
-      r.lost_space_resolution = h;
-      const int nx = std::max(1, static_cast<int>(std::floor(ext.x() / h))),
-                ny = std::max(1, static_cast<int>(std::floor(ext.y() / h))),
-                nz = std::max(1, static_cast<int>(std::floor(ext.z() / h)));
-      const std::size_t total = static_cast<std::size_t>(nx) * ny * nz;
-      r.lost_space_radius = tbb::parallel_reduce(
-          tbb::blocked_range<std::size_t>(0, total, 256), 0.0,
-          [&](const auto& rg, double acc) {
-            for (std::size_t i = rg.begin(); i != rg.end(); ++i) {
-              const std::size_t ix = i % nx, iy = (i / nx) % ny, iz = i / (static_cast<std::size_t>(nx) * ny);
-              const Vec3 p = box.min + Vec3((ix + 0.5) * ext.x() / nx, (iy + 0.5) * ext.y() / ny,
-                                            (iz + 0.5) * ext.z() / nz);
-              // Outside the solid (or on it) the depth is ≤ 0 ≤ acc: skip the distances.
-              if (!solid->contains(p)) continue;
-              const double depth = -solid->distance_bound(p);  // exact inside the intersection
-              if (depth <= acc) continue;
-              const double d = original.closest(p).distance;
-              const double ball = std::min(depth, d);
-              if (ball <= acc) continue;
-              if (!original.inside(p)) acc = ball;
-            }
-            return acc;
-          },
-          [](double a, double b) { return std::max(a, b); });
-      if (r.lost_space_radius >= r_lost) {
-        const double lost = r.lost_space_radius;
-        keep_original(out, part, AlphaSimStatus::Blocked,
-                      "a ball of radius " + full_precision(lost) + " ≥ " + full_precision(r_lost) +
-                          " outside the original fits inside the simplified part: a feature is hidden in every "
-                          "projection (split the part); original kept");
-        r.lost_space_radius = lost;
-        return false;
-      }
     }
   }
 
-  r.measure_ms = t_measure.ms();
+  r.measure_ms += t_measure.ms();
   return true;
+}
+
+const EmbreeIndex& PartSimplification::original_index() {
+  if (!original) original = std::make_unique<EmbreeIndex>(one_part(part.mesh, r.closed_before));
+  return *original;
+}
+
+bool PartSimplification::probe_lost_space_first() {
+  // Lost space (blocked projections): largest ball inside the simplified solid and
+  // outside the original, probed on a grid. Only a closed original has an outside.
+  if (!(opt.measure && opt.detect_lost_space && r.closed_before)) return true;
+  const Stopwatch t_probe;
+  const double r_lost = opt.lost_space_factor * opt.dim_pre;
+  const LostSpace lost = probe_lost_space({solid.get()}, original_index(), box, r_lost / 2.0, opt.lost_space_max_samples);
+  r.lost_space_radius = lost.radius;
+  r.lost_space_center = lost.center;
+  r.lost_space_resolution = lost.resolution;
+  r.measure_ms += t_probe.ms();
+  if (r.lost_space_radius < r_lost) return true;
+  keep_original(out, part, AlphaSimStatus::Blocked,
+                "a ball of radius " + full_precision(lost.radius) + " ≥ " + full_precision(r_lost) +
+                    " outside the original fits inside the simplified part: a feature is hidden in every "
+                    "projection; original kept");
+  return false;
 }
 
 void PartSimplification::write_step() {
@@ -1917,7 +1911,7 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
     const std::size_t i = unique[u];
     AlphaSimPart sp;
     try {
-      sp = simplify_part(parts[i], o, stems[i]);
+      sp = simplify_part_split(parts[i], o, stems[i]);
     } catch (...) {
       failed[i] = std::current_exception();
       return;
@@ -1949,7 +1943,7 @@ std::vector<Part> simplify_parts(const std::vector<Part>& parts, const AlphaSimO
         weld_identical_vertices(p.mesh);
         const MeshTopology topo = analyse_topology(p.mesh);
         if (res[j].float_rounding + rounding + copy_tol > budget || topo.boundary_edges > 0 || topo.misoriented_edges > 0) {
-          store(i, simplify_part(parts[i], o, stems[i]));
+          store(i, simplify_part_split(parts[i], o, stems[i]));
           continue;
         }
       }

@@ -52,6 +52,13 @@ struct AlphaSimOptions {
   bool detect_lost_space = true;
   double lost_space_factor = 2.0;
   std::size_t lost_space_max_samples = 1u << 18;  ///< grid points probed at most
+  /// A closed part whose lost-space probe finds a hidden feature is split rather than kept
+  /// whole (simplify_part_split): cut by axis-aligned planes around the lost ball, each
+  /// piece simplified on its own and probed against the whole part, recursively while a
+  /// piece is blocked. No piece is cut thinner than dim_pre. false keeps such a part as it is.
+  bool split_blocked = true;
+  int split_max_depth = 6;            ///< cut levels at most
+  std::size_t split_max_pieces = 64;  ///< pieces of one part at most
   /// Dense containment samples of the original surface: about this many per L_max² of area
   /// (at least the vertices, edge midpoints, centroids and two random points per triangle).
   double containment_density = 4.0;
@@ -141,6 +148,20 @@ struct ProjectionReport {
   std::size_t holes = 0;
 };
 
+/// One node of a split part's tree: a piece cut from the part and what happened to it.
+struct AlphaSimPiece {
+  std::string id;   ///< path in the tree: "1" (second child of the part), "1.0", ...
+  std::string cut;  ///< the slab of its last cut, e.g. "-28 <= x <= 28" (scene units)
+  AABB box;         ///< bounds of the piece's (cut) triangles, world frame
+  /// false: the piece was cut again (its children follow it): blocked, or failed and halved
+  bool leaf = true;
+  AlphaSimStatus status = AlphaSimStatus::Ok;  ///< Blocked or Failed for a piece cut again
+  std::string reason;
+  std::size_t triangles_before = 0, triangles_after = 0;
+  double containment = 1.0;        ///< as AlphaSimResult::containment, for the piece
+  double lost_space_radius = 0.0;  ///< against the whole part
+};
+
 /// Per-part result (DESIGN §4 simplify.json fields + diagnostics).
 struct AlphaSimResult {
   std::string name;
@@ -161,6 +182,7 @@ struct AlphaSimResult {
   /// Largest move of an output vertex rounded to float32 (float32_vertices; scene units).
   double float_rounding = 0.0;
   double lost_space_radius = 0.0;     ///< largest probed ball radius filled by the simplification
+  Vec3 lost_space_center = Vec3::Zero();  ///< centre of that ball (world frame; when the radius is > 0)
   double lost_space_resolution = 0.0; ///< grid spacing of that probe
   double time_ms = 0.0;
   double shapes_ms = 0.0;   ///< sampling + α-shapes + repair + implicit verification
@@ -180,6 +202,9 @@ struct AlphaSimResult {
   /// simplify_parts: the earlier part this one is a moved copy of (its result was moved,
   /// not recomputed; time_ms is the copy's); empty otherwise.
   std::string copy_of;
+  /// A split part's tree, depth first (empty when the part was not split). When every leaf
+  /// was simplified the part's mesh is the union of theirs; else the original is kept.
+  std::vector<AlphaSimPiece> pieces;
 };
 
 /// One extrusion: a 2D region in a plane frame swept over a depth range.
@@ -212,7 +237,9 @@ class AlphaSimSolid {
 /// A simplified part: the mesh for viewing and indices, the implicit solid, the report.
 struct AlphaSimPart {
   Mesh mesh;                                   ///< world frame; the original mesh on fallback Original
-  std::shared_ptr<const AlphaSimSolid> solid;  ///< null when the original is kept
+  std::shared_ptr<const AlphaSimSolid> solid;  ///< null when the original is kept or the part was split
+  /// A split part's leaves' solids (the simplified part is their union), in tree order.
+  std::vector<std::shared_ptr<const AlphaSimSolid>> piece_solids;
   AlphaSimResult result;
 };
 
@@ -221,8 +248,15 @@ struct AlphaSimPart {
 /// name made a file name by output_file_stems).
 AlphaSimPart simplify_part(const Part& part, const AlphaSimOptions& opt, const std::string& step_stem = {});
 
-/// Simplifies every part in parallel (TBB) and returns them with the simplified meshes
-/// (names, roles, clearances kept), ready for any ObstacleIndex. opt.scene_size ≤ 0 is
+/// Simplifies one part like simplify_part and, when a hidden feature blocks it and
+/// opt.split_blocked is set, splits it (part_split.cpp): the result's mesh is then the union
+/// of closed pieces that overlap only within the prisms' margin, result.pieces the tree.
+/// No STEP file is written for a split part (its pieces are separate solids).
+AlphaSimPart simplify_part_split(const Part& part, const AlphaSimOptions& opt, const std::string& step_stem = {});
+
+/// Simplifies every part in parallel (TBB), blocked parts split (simplify_part_split), and
+/// returns them with the simplified meshes (names, roles, clearances kept), ready for any
+/// ObstacleIndex. opt.scene_size ≤ 0 is
 /// replaced by the diagonal of all parts. Results in part order if `results` is given.
 /// A part that is a moved copy of an earlier one (same triangles; vertices = R·v + t within
 /// 1e-2 of the tolerance, R a rotation mapping the axes onto themselves, e.g. a part turned

@@ -290,15 +290,22 @@ void RouteRun::prepare_obstacles() {
   } else if (opt_.simplify && !scene_.parts.empty()) {
     AlphaSimOptions ao;
     ao.dim_pre = scene_.simplify.dim_pre.value;
+    ao.extra_planes = scene_.simplify.planes;
+    ao.split_blocked = scene_.simplify.split;
     ao.detect_lost_space = true;
     ao.hausdorff = false;  // not reported by routing; the containment check and lost-space probe stay
     ao.progress = opt_.progress;
     std::vector<AlphaSimResult> results;
     planning_parts_ = simplify_parts(scene_.parts, ao, &results);
-    std::size_t before = 0, after = 0;
-    for (const auto& r : results) before += r.triangles_before, after += r.triangles_after;
+    std::size_t before = 0, after = 0, split = 0, kept = 0;
+    for (const auto& r : results) {
+      before += r.triangles_before, after += r.triangles_after;
+      split += !r.pieces.empty() && r.fallback != AlphaSimFallback::Original;
+      kept += r.fallback == AlphaSimFallback::Original;
+    }
     rep_.notes.push_back("planning on α-simplified parts (dim_pre " + full_precision(ao.dim_pre) + "): " +
-                         std::to_string(before) + " -> " + std::to_string(after) + " triangles");
+                         std::to_string(before) + " -> " + std::to_string(after) + " triangles, " +
+                         std::to_string(split) + " parts split, " + std::to_string(kept) + " kept as they are");
   } else {
     planning_parts_ = scene_.parts;
   }

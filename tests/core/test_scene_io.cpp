@@ -113,9 +113,14 @@ time_limit = 2
 seed = 7
 [simplify]
 dim_pre = 4.0
+planes = [[1, 1, 0], [0, -2, 1.5]]
+split = false
 [tessellation]
 linear_deflection = 0.5
 )"));
+  ASSERT_EQ(s.simplify.planes.size(), 2u);
+  EXPECT_EQ(s.simplify.planes[1], Vec3(0, -2, 1.5));
+  EXPECT_FALSE(s.simplify.split);
   EXPECT_DOUBLE_EQ(s.routing.clearance.value, 3.5);
   EXPECT_EQ(s.routing.clearance.source, "scene file");
   EXPECT_EQ(s.routing.planner, "rrtstar");
@@ -162,6 +167,11 @@ TEST_F(SceneDir, BadNumbers) {
   expect_bad("[scene]\nname='t'\n[routing]\nclearance=-1\n", {"scene.toml:4", "routing.clearance", "must not be negative"});
   expect_bad("[scene]\nname='t'\n[routing]\nclearance=nan\n", {"routing.clearance", "finite"});
   expect_bad("[scene]\nname='t'\n[simplify]\ndim_pre=0\n", {"simplify.dim_pre", "positive"});
+  expect_bad("[scene]\nname='t'\n[simplify]\nplanes=[[0,0,0]]\n", {"scene.toml:4", "simplify.planes[0]", "non-zero"});
+  expect_bad("[scene]\nname='t'\n[simplify]\nplanes=[1,0,0]\n", {"simplify.planes[0]", "array of 3"});
+  expect_bad("[scene]\nname='t'\n[simplify]\nplanes=[[1,0,0],[1e-200,0,0]]\n", {"simplify.planes[1]", "non-zero"});
+  expect_bad("[scene]\nname='t'\n[simplify]\nplanes=1\n", {"simplify.planes", "array of normals"});
+  expect_bad("[scene]\nname='t'\n[simplify]\nsplit='yes'\n", {"scene.toml:4", "simplify.split", "true or false"});
   expect_bad("[scene]\nname='t'\n[[part]]\nfile='cube.stl'\ntransform={scale=0}\n", {"scale", "positive"});
   expect_bad("[scene]\nname='t'\n[[part]]\nfile='cube.stl'\ntransform={translate=[1,2]}\n", {"array of 3"});
 }
