@@ -146,6 +146,19 @@ def harness_audit_rows():
     ]
 
 
+def fcl_peer_rows():
+    name = "fcl_peer.csv"
+    two = pick(rows(name), name, threads="2")
+    ms, fcl, speedup = num(two, "loom_check_ms", name), num(two, "fcl_check_ms", name), num(two, "speedup", name)
+    same = two["identical"] == "1"
+    return [
+        ("certified audit against a staged FCL 0.7 pipeline, same scene and work, 2 threads", f"`{name}`",
+         f"{sig(ms)} ms vs {sig(fcl)} ms: {times(speedup)}, findings {'identical' if same else 'DIFFERENT'}; "
+         f"index build {sig(num(two, 'loom_build_ms', name))} ms vs {sig(num(two, 'fcl_build_ms', name))} ms",
+         "≥ 2×, identical", status(speedup >= 2 and same)),
+    ]
+
+
 def index_rows():
     build = [r for r in rows("index_build.csv") if r["scene"] == "generated"]
     rates = [num(r, "mtris_per_s", "index_build.csv") for r in build]
@@ -217,6 +230,25 @@ def alpha_sim_rows():
          f"{times(num(wing, 'clearance_box_speedup', 'alpha_sim_parts.csv'))} / "
          f"{times(num(wing, 'clearance_near_speedup', 'alpha_sim_parts.csv'))}; "
          f"{sig(min(speedups), 2)}–{times(max(speedups))}; {times(planner)}", "≥ 5×", status(min(speedups) >= 5)),
+    ] + alpha_sim_split_rows()
+
+
+def alpha_sim_split_rows():
+    name = "alpha_sim_split.csv"
+    every = rows(name)
+    wing = pick(every, name, case="wing-section-2mm")
+    before, split = num(wing, "triangles_before", name), num(wing, "kept_split", name)
+    whole = num(wing, "kept_unsplit", name)
+    large = sum(int(num(r, "blocked_large_split", name)) for r in every)
+    contained = min(num(r, "containment_split", name) for r in every)
+    slower = num(wing, "seconds_split", name) / num(wing, "seconds_unsplit", name)
+    return [
+        ("α-SIM with blocked parts split, wing section at dim_pre 2 mm", f"`{name}`",
+         f"{sig(100 * split / before, 2)}% kept ({sig(100 * whole / before, 2)}% unsplit), "
+         f"{int(num(wing, 'blocked_unsplit', name))} blocked parts → {int(num(wing, 'blocked_split', name))}; "
+         f"containment {sig(contained)}", "≤ 10%", status(split / before <= 0.10 and contained >= 1)),
+        ("same, on every bench scene: blocked parts over 20·dim_pre; time split / unsplit (wing 2 mm)", f"`{name}`",
+         f"{large}; {times(slower)}", "0; ≤ 2×", status(large == 0 and slower <= 2)),
     ]
 
 
@@ -271,7 +303,7 @@ def scan_rows():
 
 def table():
     lines = ["| measure | bench/results | measured | target | status |", "|---|---|---|---|---|"]
-    for group in (audit_rows, harness_audit_rows, index_rows, centerline_rows, alpha_sim_rows, planning_rows, scan_rows):
+    for group in (audit_rows, harness_audit_rows, fcl_peer_rows, index_rows, centerline_rows, alpha_sim_rows, planning_rows, scan_rows):
         for row in group():
             lines.append("| " + " | ".join(row) + " |")
     return "\n".join(lines) + "\n"
