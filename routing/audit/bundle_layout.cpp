@@ -209,16 +209,20 @@ Layout make_layout(const std::vector<CableInput>& cables, double meet, int threa
       lay.pieces[static_cast<std::size_t>(found)].uses.push_back(
           {static_cast<int>(c), rp.s0, rp.length, reversed, rp.curve});
     }
-  for (std::size_t k = 0; k < lay.pieces.size(); ++k) {
+  // Each piece on its own (in parallel): its uses by radius, junctions, bundle segment.
+  parallel_indices(lay.pieces.size(), threads, [&](std::size_t k) {
     Piece& p = lay.pieces[k];
     std::stable_sort(p.uses.begin(), p.uses.end(), [&](const PieceUse& a, const PieceUse& b) {
       return cables[static_cast<std::size_t>(a.cable)].radius > cables[static_cast<std::size_t>(b.cable)].radius;
     });
     p.r_max = cables[static_cast<std::size_t>(p.uses.front().cable)].radius;
     p.r_min = cables[static_cast<std::size_t>(p.uses.back().cable)].radius;
-    if (p.uses.size() > 1) lay.shared = true;
     common_junctions(p, nodes_of);
     p.bundle_segment = bundle_segment_of(p, cables, meet);
+  });
+  for (std::size_t k = 0; k < lay.pieces.size(); ++k) {
+    const Piece& p = lay.pieces[k];
+    if (p.uses.size() > 1) lay.shared = true;
     for (std::size_t u = 0; u < p.uses.size(); ++u)
       lay.of_cable[static_cast<std::size_t>(p.uses[u].cable)].emplace_back(static_cast<int>(k), static_cast<int>(u));
   }

@@ -148,8 +148,39 @@ double default_clash_tolerance(const std::vector<CableInput>& cables, std::strin
   return kDefaultToleranceOfRadius * rmin;
 }
 
-ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vector<Part>& parts,
-                          const ObstacleIndex* index, const ClashRequest& request) {
+namespace {
+
+/// Throws CableLimitError for the first cable (in cable order) whose certified check would
+/// need more than kMaxCertifiedChords chords, saying which bound asked for them.
+void refuse_unbounded_chords(const std::vector<CableInput>& cables, const Context& ctx) {
+  // Chords each cable will need, in parallel (a pass over every curve); refused in cable order.
+  std::vector<double> chords(cables.size());
+  parallel_indices(cables.size(), ctx.req.threads, [&](std::size_t i) {
+    const CableInput& c = cables[i];
+    chords[i] = planned_chords(c.curve, ctx.chord_error, kMaxChordRadii * c.radius, kShortSpanRadii * c.radius);
+  });
+  for (std::size_t i = 0; i < cables.size(); ++i) {
+    const CableInput& c = cables[i];
+    const double hmax = kMaxChordRadii * c.radius;
+    const double n = chords[i];
+    if (n <= kMaxCertifiedChords) continue;
+    // Say which bound asked for the chords: the longest chord (a route thousands of
+    // kilometres long is a units or key-point mistake) or the chord error (a wiggle).
+    const double by_length = c.curve.length() / hmax;
+    const std::string reason =
+        by_length >= 0.5 * n
+            ? "it is " + full_precision(c.curve.length()) + " long, " + full_precision(std::ceil(by_length)) +
+                  " chords of at most 2r = " + full_precision(hmax) + "; check its key points and units"
+            : "its curvature reaches the scale of the tolerance; smooth the route or raise --tolerance";
+    throw CableLimitError(c.id, "cable '" + c.id + "' would need " + full_precision(n) +
+                                    " chords to stay within " + full_precision(ctx.chord_error) +
+                                    " of its curve (more than " + full_precision(kMaxCertifiedChords) + "): " + reason);
+  }
+}
+
+/// check_clashes, inside the audit's arena.
+ClashResult check_clashes_in_arena(const std::vector<CableInput>& cables, const std::vector<Part>& parts,
+                                   const ObstacleIndex* index, const ClashRequest& request) {
   for (const auto& c : cables) {
     if (c.curve.empty()) throw std::invalid_argument("check_clashes: cable '" + c.id + "' has no centerline");
     if (!(c.radius > 0.0) || !std::isfinite(c.radius))
@@ -186,23 +217,7 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
   if (request.method == ClashMethod::Certified && !(ctx.abs_err < 0.5 * ctx.tol))
     refuse_tolerance(cables, ctx, res.tolerance_source);
   ctx.chord_error = kChordShareOfTolerance * (ctx.tol - ctx.abs_err);
-  if (request.method == ClashMethod::Certified)
-    for (const auto& c : cables) {
-      const double hmax = kMaxChordRadii * c.radius;
-      const double n = planned_chords(c.curve, ctx.chord_error, hmax, kShortSpanRadii * c.radius);
-      if (n <= kMaxCertifiedChords) continue;
-      // Say which bound asked for the chords: the longest chord (a route thousands of
-      // kilometres long is a units or key-point mistake) or the chord error (a wiggle).
-      const double by_length = c.curve.length() / hmax;
-      const std::string reason =
-          by_length >= 0.5 * n
-              ? "it is " + full_precision(c.curve.length()) + " long, " + full_precision(std::ceil(by_length)) +
-                    " chords of at most 2r = " + full_precision(hmax) + "; check its key points and units"
-              : "its curvature reaches the scale of the tolerance; smooth the route or raise --tolerance";
-      throw CableLimitError(c.id, "cable '" + c.id + "' would need " + full_precision(n) +
-                                      " chords to stay within " + full_precision(ctx.chord_error) +
-                                      " of its curve (more than " + full_precision(kMaxCertifiedChords) + "): " + reason);
-    }
+  if (request.method == ClashMethod::Certified) refuse_unbounded_chords(cables, ctx);
   res.cables.resize(cables.size());
   std::vector<std::vector<ClashEntry>> per_clash(cables.size());
   std::vector<std::vector<Violation>> per_viol(cables.size());
@@ -217,8 +232,7 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
       std::vector<AABB> boxes(parts.size());
       for (std::size_t q = 0; q < parts.size(); ++q) boxes[q] = ctx.info[q].box;
       // In the audit's arena: Embree's builder runs on TBB and must not exceed `threads`.
-      tbb::task_arena arena(request.threads > 0 ? request.threads : tbb::task_arena::automatic);
-      arena.execute([&] { ctx.part_tree = std::make_unique<BoxTree>(std::move(boxes)); });
+      ctx.part_tree = std::make_unique<BoxTree>(std::move(boxes));
     }
     // The bundle level where cables share pieces: each shared piece checked once for all.
     if (!request.per_cable) {
@@ -291,6 +305,15 @@ ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vect
   res.counters = ctx.counters.snapshot();
   checked.finish();
   return res;
+}
+
+}  // namespace
+
+ClashResult check_clashes(const std::vector<CableInput>& cables, const std::vector<Part>& parts,
+                          const ObstacleIndex* index, const ClashRequest& request) {
+  // Every pass runs in one arena of the requested concurrency (parallel_indices joins it).
+  tbb::task_arena arena(request.threads > 0 ? request.threads : tbb::task_arena::automatic);
+  return arena.execute([&] { return check_clashes_in_arena(cables, parts, index, request); });
 }
 
 }  // namespace loom

@@ -70,16 +70,24 @@ struct AtomicCounters {
   }
 };
 
-/// Runs body(i), i in [0, n), on `threads` workers (≤ 0: all cores), grain 1.
+/// Runs body(i), i in [0, n), on `threads` workers (≤ 0: all cores), grain 1. Called from
+/// inside an arena of that concurrency (check_clashes runs in one), it runs there: a new
+/// arena per pass makes the workers join again each time, which on a harness checked in
+/// milliseconds costs more than a pass's work.
 template <class Body>
 void parallel_indices(std::size_t n, int threads, const Body& body) {
   if (n == 0) return;
-  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
-  arena.execute([&] {
+  auto loop = [&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
     });
-  });
+  };
+  if (threads > 0 && tbb::this_task_arena::max_concurrency() == threads) {
+    loop();
+    return;
+  }
+  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+  arena.execute(loop);
 }
 
 /// The checked scene and the audit's derived tolerances, shared by every pass and thread.
