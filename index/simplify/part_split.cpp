@@ -281,7 +281,7 @@ AlphaSimPart PartSplitter::assemble(const std::string& failure) {
   r.fallback = hull ? AlphaSimFallback::ConvexHull : AlphaSimFallback::None;
   r.booleans_by = occt ? "opencascade" : cgal ? "cgal" : "none";
   r.closed_after = true;  // each piece is closed
-  r.reason = "split into " + std::to_string(leaves_.size()) + " pieces: whole, it hid a ball of radius " +
+  r.reason = "split into " + std::to_string(leaves_.size()) + " pieces: the whole part hid a ball of radius " +
              full_precision(whole_lost_.radius) + " at " + full_precision(whole_lost_.center) + " in every projection";
   out.mesh = std::move(mesh);
   out.solid.reset();
@@ -310,11 +310,13 @@ AlphaSimPart PartSplitter::run() {
     std::vector<const AlphaSimSolid*> solids;
     for (const auto& leaf : leaves_) solids.push_back(leaf.solid.get());
     const LostSpace lost = probe_lost_space(solids, original_, box, r_lost_ / 2.0, opt_.lost_space_max_samples);
-    if (lost.radius >= r_lost_)
+    if (lost.radius >= r_lost_) {
       failure = "their union hides a ball of radius " + full_precision(lost.radius) + " at " +
                 full_precision(lost.center) + " across a cut";
-    else
-      whole_.result.lost_space_radius = lost.radius, whole_.result.lost_space_center = lost.center;
+    } else {
+      whole_.result.lost_space_radius = lost.radius;
+      whole_.result.lost_space_center = lost.center;
+    }
   }
   AlphaSimPart out = assemble(failure);
   out.result.time_ms = whole_ms + t0.ms();
