@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <string>
 
@@ -66,6 +67,15 @@ struct AABB {
 
 /// True if every component is finite (no NaN, no inf).
 inline bool is_finite(const Vec3& v) { return v.allFinite(); }
+
+/// The unit vector along d (finite, not zero): d itself when its length is 1 within
+/// rounding, so that a direction written at full precision reads back bit for bit (one
+/// normalised again moves in its last bits); else d scaled by its largest component first
+/// (the squared length of (1e-200, 0, 0) underflows) and normalised.
+inline Vec3 stable_unit_direction(const Vec3& d) {
+  if (std::abs(d.norm() - 1.0) <= 8.0 * std::numeric_limits<double>::epsilon()) return d;
+  return (d / d.cwiseAbs().maxCoeff()).normalized();
+}
 
 /// Squared distance from p to the closed segment ab (scene units²; a point if a == b).
 inline double point_segment_dist2(const Vec3& p, const Vec3& a, const Vec3& b) {

@@ -445,11 +445,8 @@ class Reader {
         p.line = line(c);
         p.position = point(c);
         Vec3 d{number(c, "dx"), number(c, "dy"), number(c, "dz")};
-        // Scaled by its largest component first: (1e-200, 0, 0) is a direction, though its
-        // squared length underflows to zero.
-        const double largest = d.cwiseAbs().maxCoeff();
-        if (!(largest > 0.0)) fail(c, "exit direction (dx, dy, dz) has zero length");
-        p.direction = (d / largest).normalized();
+        if (!(d.cwiseAbs().maxCoeff() > 0.0)) fail(c, "exit direction (dx, dy, dz) has zero length");
+        p.direction = stable_unit_direction(d);
         h.ports.push_back(std::move(p));
       } else if (n == "branch") {
         only_attributes(c, {"id", "x", "y", "z"});

@@ -143,9 +143,8 @@ class KblReader {
     if (parts.empty()) return std::nullopt;
     if (parts.size() != 3) fail(parts.front(), std::string("<") + name + "> needs 3 values, found " + std::to_string(parts.size()));
     const Vec3 v(number(parts[0]), number(parts[1]), number(parts[2]));
-    const double largest = v.cwiseAbs().maxCoeff();
-    if (!(largest > 0.0)) return std::nullopt;
-    return Vec3((v / largest).normalized());
+    if (!(v.cwiseAbs().maxCoeff() > 0.0)) return std::nullopt;
+    return stable_unit_direction(v);
   }
 
   /// A Cartesian_point as a 3D position; 2D points (a formboard drawing) are refused.

@@ -111,9 +111,12 @@ std::size_t find_end_header(const std::string& head) {
   constexpr std::size_t kLen = 10;  // "end_header"
   for (std::size_t line = 0; line < head.size();) {
     std::size_t at = head.find_first_not_of(" \t", line);
-    if (at != std::string::npos && head.compare(at, kLen, "end_header") == 0 &&
-        (at + kLen == head.size() || std::strchr(" \t\r\n", head[at + kLen]) != nullptr))
-      return at;
+    // Not strchr(" \t\r\n", c): it finds a NUL byte too (the literal's terminator), and
+    // "end_header\0" then passed for the end while Assimp read the data from elsewhere.
+    const auto blank_or_end = [&](std::size_t i) {
+      return i == head.size() || head[i] == ' ' || head[i] == '\t' || head[i] == '\r' || head[i] == '\n';
+    };
+    if (at != std::string::npos && head.compare(at, kLen, "end_header") == 0 && blank_or_end(at + kLen)) return at;
     const std::size_t nl = head.find('\n', line);
     if (nl == std::string::npos) break;
     line = nl + 1;
@@ -441,10 +444,26 @@ void check_ply(const std::filesystem::path& path) {
 
 // --- OFF ---------------------------------------------------------------------------------
 
+/// `text` with every line ending made "\n": Assimp's OFF reader ends a line at a lone "\r"
+/// too, so a comment "#...\r2222222224 6" hides from a reader that ends lines at "\n" alone
+/// the counts Assimp then allocates by. A "\r\n" stays one line ending (line numbers hold).
+std::string unix_lines(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] != '\r') {
+      out.push_back(text[i]);
+    } else if (i + 1 >= text.size() || text[i + 1] != '\n') {
+      out.push_back('\n');
+    }
+  }
+  return out;
+}
+
 /// The OFF header's vertex and face counts, whole numbers, against the file size: each vertex
 /// and face takes at least one line.
 void check_off(const std::filesystem::path& path) {
-  const std::string head = file_bytes(path, 1 << 16);
+  const std::string head = unix_lines(file_bytes(path, 1 << 16));
   std::istringstream is(head);
   std::vector<std::string> tokens;
   std::vector<int> lines;
@@ -485,7 +504,7 @@ void check_off(const std::filesystem::path& path) {
   // Face indices: Assimp's OFF reader replaces one beyond the vertices by the last vertex
   // (logging an error nobody sees), a silently different triangle. Lines after the header's:
   // nv vertex lines, then faces "k i1 .. ik [colour]"; blank and '#' lines skipped.
-  std::istringstream all(file_bytes(path));
+  std::istringstream all(unix_lines(file_bytes(path)));
   int no = 0;
   std::uint64_t seen_v = 0, seen_f = 0;
   for (std::string line; seen_f < nf && std::getline(all, line);) {

@@ -211,7 +211,7 @@ class Dae {
     nodes_.push_back(n);
   }
 
-  /// A <p> or <vcount> list: unsigned decimal integers. Why: Assimp's reader does not move
+  /// A <p> or <vcount> list: unsigned decimal integers, at least one. Why: Assimp's reader does not move
   /// past a token it cannot read as one and appended indices until memory ran out.
   void check_indices(const pugi::xml_node& n) {
     const char* s = n.child_value();
@@ -228,6 +228,9 @@ class Dae {
       }
       ++values;
     }
+    // An empty list (<p/>, <p> </p>) in a primitive made Assimp 5.2's COLLADA reader
+    // dereference null (SIGSEGV).
+    if (values == 0) fail(n, "holds no values (an empty index list)");
     if (std::string(n.name()) == "p") p_values_[n.parent()] += static_cast<double>(values);
   }
 

@@ -219,7 +219,7 @@ void place_ports(const TomlReader& r, const toml::node& pn, Harness& h, std::vec
         }
     }
     p.position = at;
-    p.direction = dir.normalized();
+    p.direction = stable_unit_direction(dir);
     p.placed = true;
   }
 }

@@ -303,6 +303,55 @@ TEST(CliSimplify, WritesEachPartAndTheReport) {
     EXPECT_TRUE(e.path().extension() == ".json" || e.path().extension() == ".stl") << e.path();  // no temp files
 }
 
+/// Writes DIR/scene.toml with one part, DIR/hollow.obj: a cube [0, 40]³ around a sealed
+/// cubic cavity [4, 36]³ (the inner shell wound inwards), and `simplify_keys` under [simplify].
+std::filesystem::path hollow_box_scene(const std::filesystem::path& dir, const std::string& simplify_keys) {
+  std::filesystem::create_directories(dir);
+  std::ofstream obj(dir / "hollow.obj");
+  for (const double s : {0.0, 4.0})
+    for (int k = 0; k < 8; ++k)
+      obj << "v " << (k & 1 ? 40 - s : s) << ' ' << (k & 2 ? 40 - s : s) << ' ' << (k & 4 ? 40 - s : s) << '\n';
+  const int quads[6][4] = {{1, 3, 4, 2}, {5, 6, 8, 7}, {1, 2, 6, 5}, {3, 7, 8, 4}, {1, 5, 7, 3}, {2, 4, 8, 6}};
+  for (const int base : {0, 8})
+    for (const auto& q : quads) {
+      if (base == 0) obj << "f " << q[0] << ' ' << q[1] << ' ' << q[2] << ' ' << q[3] << '\n';
+      else obj << "f " << q[3] + base << ' ' << q[2] + base << ' ' << q[1] + base << ' ' << q[0] + base << '\n';
+    }
+  std::ofstream toml(dir / "scene.toml");
+  toml << "[scene]\nname = \"hollow\"\nunits = \"mm\"\n[[part]]\nname = \"hollow\"\nfile = \"hollow.obj\"\n"
+       << "[simplify]\ndim_pre = 2.0\n" << simplify_keys;
+  return dir / "scene.toml";
+}
+
+TEST(CliSimplify, ABlockedPartIsSplitAndTheTreeReported) {
+  const auto dir = fresh_dir("simplify_split");
+  const auto out = dir / "out";
+  const auto r = loom("simplify " + hollow_box_scene(dir, "").string() + " --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("1 parts split, 0 blocked"), std::string::npos) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(slurp(out / "simplify.json"));
+  EXPECT_EQ(j["parts_split"], 1);
+  EXPECT_EQ(j["parts_blocked"], 0);
+  EXPECT_GT(j["index_bytes_exact"].get<double>(), 0.0);
+  EXPECT_GT(j["index_bytes_simplified"].get<double>(), 0.0);
+  const nlohmann::json& part = j["parts"][0];
+  EXPECT_NE(part["fallback"], "original") << part["reason"];  // ok, or hull_fallback where a wall piece is torn
+  EXPECT_EQ(part["reason"].get<std::string>().rfind("split into ", 0), 0u) << part["reason"];
+  ASSERT_TRUE(part.contains("pieces"));
+  EXPECT_GE(part["pieces"].size(), 2u);
+  for (const auto& p : part["pieces"]) {
+    EXPECT_FALSE(p["id"].get<std::string>().empty());
+    EXPECT_EQ(p["containment"], 1.0);
+  }
+  // Off from the scene file: the part is kept whole, blocked, with no tree.
+  const auto dir2 = fresh_dir("simplify_nosplit");
+  const auto r2 = loom("simplify " + hollow_box_scene(dir2, "split = false\n").string() + " --out " + (dir2 / "out").string());
+  ASSERT_EQ(r2.status, 0) << r2.out;
+  const nlohmann::json j2 = nlohmann::json::parse(slurp(dir2 / "out" / "simplify.json"));
+  EXPECT_EQ(j2["parts_blocked"], 1);
+  EXPECT_FALSE(j2["parts"][0].contains("pieces"));
+}
+
 TEST(CliSimplify, BadDimPreIsExitTwoAndWritesNothing) {
   const auto out = fresh_dir("simplify_bad");
   for (const char* v : {"0", "-1", "nan", "inf", "abc"}) {

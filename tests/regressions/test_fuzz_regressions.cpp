@@ -115,6 +115,18 @@ TEST(FuzzRegression, DaeAccessorHugeStrideCrashed) {
   EXPECT_NE(e.find("count 3 x stride 4 from offset 0 reaches beyond the 9 values"), std::string::npos) << e;
 }
 
+// An empty index list (<p/>, <p></p>, <p> </p>) in a primitive (libFuzzer, a long run):
+// Assimp's COLLADA reader dereferenced null (SIGSEGV in `loom info`).
+TEST(FuzzRegression, DaeEmptyIndexListCrashed) {
+  const fs::path d = scratch();
+  for (const std::string p : {"", " "}) {
+    write(d / "empty.dae", kDaeHead + dae_triangle_geometry("3", p) + kDaeSceneOfG);
+    const auto r = bounded_info_of_part(d, "empty.dae");
+    EXPECT_EQ(r.status, 2) << "'" << p << "'\n" << r.out;
+    EXPECT_NE(r.out.find("empty.dae:7: <p>: holds no values (an empty index list)"), std::string::npos) << r.out;
+  }
+}
+
 // A DAE node instancing itself (and A -> B -> A): Assimp followed instance_node without a
 // visited set until the stack overflowed (SIGSEGV).
 TEST(FuzzRegression, DaeInstanceNodeCycleCrashed) {
@@ -335,6 +347,24 @@ TEST(FuzzRegression, PlyEmptyFaceAborted) {
   EXPECT_NE(r.out.find("binary.ply:7: element face instance 0: a face of no vertices"), std::string::npos) << r.out;
 }
 
+// "end_header" followed by a NUL byte (libFuzzer, a long run): the pre-check took it for
+// the header's end (strchr finds the NUL as its string's terminator) and checked the data
+// from the next newline; Assimp read it from elsewhere, into faces that abort its
+// triangulation (ai_assert).
+TEST(FuzzRegression, PlyEndHeaderFollowedByNulAborted) {
+  const fs::path d = scratch();
+  std::string bin = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                    "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header";
+  bin += std::string(4, '\0') + "\n";
+  for (const float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) bin.append(reinterpret_cast<const char*>(&v), sizeof v);
+  bin += '\3';
+  for (const std::int32_t i : {0, 1, 2}) bin.append(reinterpret_cast<const char*>(&i), sizeof i);
+  write(d / "nul.ply", bin);
+  const auto r = bounded_info_of_part(d, "nul.ply");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("nul.ply:9: PLY header: holds a NUL byte"), std::string::npos) << r.out;
+}
+
 // OFF counts with a letter, a comma or a NUL after the digits (libFuzzer): the pre-check
 // could not parse them and left the file to Assimp, which read the leading digits and
 // allocated 10⁹ faces (16 GB) before reading one.
@@ -350,6 +380,40 @@ TEST(FuzzRegression, OffCountWithTrailingBytesAllocatedByItsDigits) {
   write(d / "v.off", "OFF 4x 1 0\n");
   const std::string e = input_error([&] { loom::read_mesh_file(d / "v.off"); });
   EXPECT_NE(e.find("v.off:1: OFF header: vertex count '4x' is not a count"), std::string::npos) << e;
+}
+
+// An OFF comment ended by a lone carriage return (libFuzzer, a long run): Assimp ends the
+// line there and read "2222222224 6" after it as the counts, allocating 26 GB; the
+// pre-check took the whole line for the comment and checked the "0 3" below instead.
+TEST(FuzzRegression, OffCommentEndedByACarriageReturnHidTheCounts) {
+  const fs::path d = scratch();
+  write(d / "cr.off", std::string("OFF\n#`\r2222222224 6\n0 3\n"));
+  const std::string e = input_error([&] { loom::read_mesh_file(d / "cr.off"); });
+  EXPECT_NE(e.find("cr.off:3: OFF header: declares 2222222224 vertices"), std::string::npos) << e;
+  // Windows line endings stay one line end each: a valid triangle reads, line numbers hold.
+  write(d / "crlf.off", "OFF\r\n3 1 0\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2\r\n");
+  EXPECT_EQ(loom::read_mesh_file(d / "crlf.off").triangle_count(), 1u);
+  write(d / "crlf-bad.off", "OFF\r\n3 1 0\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 7\r\n");
+  const std::string e2 = input_error([&] { loom::read_mesh_file(d / "crlf-bad.off"); });
+  EXPECT_NE(e2.find("crlf-bad.off:6: face 0: vertex index 7"), std::string::npos) << e2;
+}
+
+// A port direction that is not unit (dx = 5, dy = -2) read, written at full precision and
+// read again (libFuzzer, the harness XML round trip): normalised a second time it moved in
+// its last bits, so routed.xml read back was not the harness that was written.
+TEST(FuzzRegression, PortDirectionNormalisedTwiceMovedInItsLastBits) {
+  const std::string xml =
+      "<harness name='h' units='mm'><attributes><cable id='C'><electrical><port id='A'/><port id='B'/>"
+      "</electrical><physical diameter='2'/></cable></attributes><structure>"
+      "<port id='A' x='0' y='0' z='0' dx='5' dy='-2' dz='0'/><port id='B' x='100' y='0' z='0' dx='-1' dy='0' dz='0'/>"
+      "<segment from='A' to='B'/></structure></harness>";
+  const loom::Harness h = loom::parse_harness_xml(xml, "h.xml");
+  const std::string written = loom::harness_to_xml(h);
+  const loom::Harness again = loom::parse_harness_xml(written, "written.xml");
+  EXPECT_EQ(again.ports[0].direction, h.ports[0].direction) << loom::full_precision(again.ports[0].direction) << " vs "
+                                                              << loom::full_precision(h.ports[0].direction);
+  EXPECT_EQ(loom::harness_to_xml(again), written);
+  EXPECT_NEAR(h.ports[0].direction.norm(), 1.0, 1e-15);
 }
 
 // Every minimised input of tests/fuzz/findings: a mesh as the one part of a scene, a harness
