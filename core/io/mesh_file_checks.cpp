@@ -150,6 +150,13 @@ PlyProperty read_ply_property(const std::vector<std::string>& w, int line_no, co
   const std::string& type = p.list ? w[3] : w[1];
   p.bytes = ply_scalar_bytes(type);
   p.floating = type.rfind("float", 0) == 0 || type == "double";
+  // A list's length is a whole number: a float or double count was read by Assimp as a
+  // float and by this check as an integer, so the two walked different faces, and Assimp's
+  // aborted its triangulation (ai_assert).
+  if (p.list && (w[2].rfind("float", 0) == 0 || w[2] == "double"))
+    throw InputError({path.string(), line_no, "property"},
+                     "a list's count type must be an integer type (char uchar short ushort int uint, or int8 ... "
+                     "uint32), not '" + printable(w[2]) + "'");
   // Assimp reads an unknown type as a property of no bytes and goes on with the data
   // misaligned, into faces that abort its triangulation (ai_assert).
   const std::string& bad = p.list && p.count_bytes == 0 ? w[2] : type;
@@ -477,8 +484,16 @@ void check_off(const std::filesystem::path& path) {
       lines.push_back(line_no);
     }
   }
+  // Where Assimp's reader finds the counts: after the magic (ST, C, N, 4, n before "OFF"),
+  // and after a dimension when the magic has the n; without a magic it still takes a
+  // leading 4 for the homogeneous flag and reads the counts from the rest, so "4 4 6" (a
+  // tetrahedron) would be read as 4 vertices and 6 faces.
+  const auto ends_with = [&](const std::string& t, const char* tail) {
+    const std::size_t n = std::strlen(tail);
+    return t.size() >= n && t.compare(t.size() - n, n, tail) == 0;
+  };
   std::size_t at = 0;
-  if (!tokens.empty() && tokens[0].size() >= 3 && tokens[0].compare(tokens[0].size() - 3, 3, "OFF") == 0) at = 1;
+  if (!tokens.empty() && ends_with(tokens[0], "OFF")) at = ends_with(tokens[0], "nOFF") ? 2 : 1;
   // Without both counts there is nothing to check them against, but Assimp reads counts
   // from whatever follows (the digits of "4294945910 255OBFF" as 4294945910 vertices and
   // 255 faces) and allocates by them: a header without two counts is refused.
@@ -493,6 +508,10 @@ void check_off(const std::filesystem::path& path) {
     if (!parse_count(tokens[k], k == at ? nv : nf))
       throw InputError({path.string(), lines[k], "OFF header"},
                        std::string(k == at ? "vertex" : "face") + " count '" + printable(tokens[k]) + "' is not a count");
+  if (at == 0 && tokens[0][0] == '4')
+    throw InputError({path.string(), lines[0], "OFF header"},
+                     "no OFF line, and a vertex count starting with 4 (Assimp reads that 4 as the homogeneous "
+                     "flag of a 4OFF magic): start the file with an OFF line");
   std::error_code ec;
   const auto size = static_cast<std::uint64_t>(std::filesystem::file_size(path, ec));
   if (ec) return;

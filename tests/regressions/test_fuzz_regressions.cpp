@@ -525,6 +525,32 @@ TEST(FuzzRegression, OffCountsWithoutMagicAllocated) {
   expect_part_refused(d, "c.off", "OFF\n", "c.off:1: OFF header: expected [magic] vertex and face counts, found 0 token(s)");
 }
 
+// No OFF line and a first count starting with 4 (libFuzzer, a long run): Assimp's reader
+// took that 4 for the homogeneous flag of a "4OFF" magic, read the counts one token on
+// ("642949672tetrahedron" as 642949672 faces) and allocated 10 GB; the pre-check read the
+// counts from the first token. A "nOFF" magic has a dimension before the counts.
+TEST(FuzzRegression, OffWithoutMagicLeadingFourShiftedTheCounts) {
+  const fs::path d = scratch();
+  expect_part_refused(d, "four.off", "\n4 4 642949672tetrahedron\n4 4 6429496729 50 0\n",
+                      "four.off:2: OFF header: no OFF line, and a vertex count starting with 4");
+  // With the OFF line the same counts read as a tetrahedron would.
+  write(d / "tetra.off", "OFF\n4 4 6\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  EXPECT_EQ(loom::read_mesh_file(d / "tetra.off").triangle_count(), 4u);
+  // nOFF: dimension 3, then the counts.
+  expect_part_refused(d, "n.off", "nOFF\n3\n4 4000000000 0\n", "n.off:3: OFF header: declares 4 vertices and 4000000000 faces");
+}
+
+// A PLY list whose count type is float (libFuzzer, a long run): Assimp read the counts as
+// floats, the pre-check as integers, and the two walked different faces; Assimp's
+// triangulation aborted (ai_assert).
+TEST(FuzzRegression, PlyListWithAFloatCountAborted) {
+  const fs::path d = scratch();
+  const std::string head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                           "property float z\nelement face 1\nproperty list float int vertex_indices\nend_header\n";
+  expect_part_refused(d, "f.ply", head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+                      "f.ply:8: property: a list's count type must be an integer type");
+}
+
 // A face whose vertex count is beyond 64 bits (libFuzzer): the count saturated to 2^64 − 1,
 // the check's "count + 1 > words" wrapped to 0 and it read past the face's words (ASan
 // heap-buffer-overflow in the pre-check itself).
