@@ -193,6 +193,13 @@ void read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
     auto refuse = [&](const std::string& what, const std::string& why) {
       throw InputError({path.string(), line_no, what}, why);
     };
+    // Assimp separates header words by spaces and tabs only: "property\ffloat y" was a line
+    // it skipped while this check read a property, so the two laid out the data apart
+    // (and Assimp's triangulation aborted).
+    if (const std::size_t odd = line.find_first_of("\f\v"); odd != std::string::npos && !w.empty() &&
+        w[0] != "comment" && w[0] != "obj_info")
+      refuse("PLY header", "words separated by a form feed or vertical tab (byte " + std::to_string(int(line[odd])) +
+                               "): only spaces and tabs separate them");
     if (w.empty() || w[0] == "comment" || w[0] == "obj_info" || (line_no == 1 && w[0] == "ply")) continue;
     if (w[0] == "format") {
       const std::string name = w.size() >= 2 ? w[1] : std::string();

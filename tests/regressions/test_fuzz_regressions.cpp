@@ -551,6 +551,17 @@ TEST(FuzzRegression, PlyListWithAFloatCountAborted) {
                       "f.ply:8: property: a list's count type must be an integer type");
 }
 
+// "property\ffloat y" (libFuzzer, the CI-length run): Assimp separates header words by
+// spaces and tabs only and skipped the line, the pre-check read a property; the data was
+// laid out apart and Assimp's triangulation aborted.
+TEST(FuzzRegression, PlyHeaderFormFeedSeparatorAborted) {
+  const fs::path d = scratch();
+  const std::string head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty\ffloat y\n"
+                           "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  expect_part_refused(d, "ff.ply", head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+                      "ff.ply:5: PLY header: words separated by a form feed or vertical tab (byte 12)");
+}
+
 // A face whose vertex count is beyond 64 bits (libFuzzer): the count saturated to 2^64 − 1,
 // the check's "count + 1 > words" wrapped to 0 and it read past the face's words (ASan
 // heap-buffer-overflow in the pre-check itself).
