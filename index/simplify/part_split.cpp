@@ -14,7 +14,6 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <string>
 #include <vector>
 
@@ -22,7 +21,7 @@ namespace loom {
 
 namespace {
 
-/// The slab around a lost ball of radius ρ is cut ρ·√½ on either side of its centre: the
+/// The slab around a lost ball of radius ρ reaches at least ρ·√½ on either side of its centre: the
 /// cylinder of that radius through the slab lies inside the ball, so the slab's projection
 /// along the cut axis shows a hole of radius ρ·√½ ≥ 1.4·dim_pre (the ball is ≥ 2·dim_pre),
 /// wider than α, which the α-shape keeps open.
@@ -249,7 +248,6 @@ AlphaSimPart PartSplitter::assemble(const std::string& failure) {
   Mesh mesh;
   std::vector<std::shared_ptr<const AlphaSimSolid>> solids;
   bool hull = false, occt = false, cgal = false;
-  r.triangles_after = 0;
   r.faces_after = 0;
   r.volume_after = 0.0;
   r.containment = r.containment_implicit = 1.0;

@@ -540,14 +540,18 @@ TEST(FuzzRegression, OffWithoutMagicLeadingFourShiftedTheCounts) {
   expect_part_refused(d, "n.off", "nOFF\n3\n4 4000000000 0\n", "n.off:3: OFF header: declares 4 vertices and 4000000000 faces");
 }
 
+/// An ASCII PLY of one triangle whose header has `y_line` (line 5) for the y property and
+/// `list_line` (line 8) for the face list.
+std::string ascii_ply_triangle(const std::string& y_line, const std::string& list_line) {
+  return "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n" + y_line + "\nproperty float z\nelement face 1\n" +
+         list_line + "\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+}
+
 // A PLY list whose count type is float (libFuzzer, a long run): Assimp read the counts as
 // floats, the pre-check as integers, and the two walked different faces; Assimp's
 // triangulation aborted (ai_assert).
 TEST(FuzzRegression, PlyListWithAFloatCountAborted) {
-  const fs::path d = scratch();
-  const std::string head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                           "property float z\nelement face 1\nproperty list float int vertex_indices\nend_header\n";
-  expect_part_refused(d, "f.ply", head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+  expect_part_refused(scratch(), "f.ply", ascii_ply_triangle("property float y", "property list float int vertex_indices"),
                       "f.ply:8: property: a list's count type must be an integer type");
 }
 
@@ -555,10 +559,7 @@ TEST(FuzzRegression, PlyListWithAFloatCountAborted) {
 // spaces and tabs only and skipped the line, the pre-check read a property; the data was
 // laid out apart and Assimp's triangulation aborted.
 TEST(FuzzRegression, PlyHeaderFormFeedSeparatorAborted) {
-  const fs::path d = scratch();
-  const std::string head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty\ffloat y\n"
-                           "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
-  expect_part_refused(d, "ff.ply", head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+  expect_part_refused(scratch(), "ff.ply", ascii_ply_triangle("property\ffloat y", "property list uchar int vertex_indices"),
                       "ff.ply:5: PLY header: words separated by a form feed or vertical tab (byte 12)");
 }
 
