@@ -1,6 +1,8 @@
 // The audit pipeline: scene → index → checks → AuditReport (DESIGN §4).
 #include "routing/audit/audit.hpp"
 
+#include "routing/audit/audit_shard.hpp"
+
 #include "core/stopwatch.hpp"
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
@@ -118,14 +120,15 @@ double run_together_radius(const HarnessTopology& topo, SegmentCurves& curves, c
 /// The supports audit of a scene (clamps always; unsupported spans when the scene sets
 /// clamp_spacing), through the audit's index or, for the brute-force baseline, over every
 /// triangle.
-void audit_harness_supports(const Scene& scene, const ObstacleIndex* index, AuditReport& rep) {
+/// A shard (`spans` false) measures its clamps only: spans follow from the merged clamps.
+void audit_harness_supports(const Scene& scene, const ObstacleIndex* index, bool spans, AuditReport& rep) {
   const RoutingSettings& r = scene.routing;
   rep.supports_checked = r.supports;
   if (!r.supports && scene.harness.clamps.empty()) return;
   std::unique_ptr<BruteForceIndex> brute;
   if (!index) index = (brute = std::make_unique<BruteForceIndex>(scene.parts)).get();
-  rep.supports =
-      audit_supports(scene.harness, scene.parts, *index, r.clamp_spacing.value, r.clamp_reach.value, r.supports);
+  rep.supports = audit_supports(scene.harness, scene.parts, *index, r.clamp_spacing.value, r.clamp_reach.value,
+                                r.supports && spans);
   rep.notes.insert(rep.notes.end(), rep.supports.notes.begin(), rep.supports.notes.end());
 }
 
@@ -292,6 +295,11 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
 
   ClashRequest req = opt.check;
   req.routing_clearance = scene.routing.clearance.value;
+  // A shard checks the cables against its own parts; the passes that need no part run once.
+  const bool cable_passes = !opt.shard || opt.shard->cable_passes;
+  req.check_cable_cable = req.check_cable_cable && cable_passes;
+  req.check_self = req.check_self && cable_passes;
+  req.check_bend = req.check_bend && cable_passes;
   if (!req.progress) req.progress = opt.progress;
   std::unique_ptr<ObstacleIndex> owned;
   const ObstacleIndex* index = nullptr;
@@ -318,8 +326,8 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
   const Stopwatch t1;
   // A cable whose audit would pass a limit is refused at its element of the harness file.
   rep.result = naming_cable_errors(scene.harness, [&] { return check_clashes(inputs, scene.parts, index, req); });
-  if (scene.has_harness) audit_harness_supports(scene, index, rep);
-  if (scene.has_harness && !scene.routing.separation.empty())
+  if (scene.has_harness) audit_harness_supports(scene, index, !opt.shard, rep);
+  if (scene.has_harness && cable_passes && !scene.routing.separation.empty())
     rep.segregation = check_segregation(inputs, [&](int a, int b) {
       const auto& cables = scene.harness.cables;
       const auto cls = [&](int i) -> const std::string& {
@@ -339,6 +347,7 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt) {
   for (const std::string& pair : moving_parts_interpenetrating(scene.parts))
     rep.notes.push_back("warning: moving parts " + pair + " interpenetrate in their rest poses");
   rep.notes.insert(rep.notes.end(), rep.motion.notes.begin(), rep.motion.notes.end());
+  if (opt.shard) globalise_part_ids(rep, opt.shard->part_ids);
   return rep;
 }
 

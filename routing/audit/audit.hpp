@@ -18,6 +18,8 @@
 
 namespace loom {
 
+struct AuditShard;
+
 /// What `loom audit` was asked to do.
 struct AuditOptions {
   ClashRequest check;  ///< method, tolerance, spacing, threads, progress, …
@@ -29,6 +31,10 @@ struct AuditOptions {
   /// Stages "load" (audit_scene_file: part files loaded), "index" (when run_audit builds it) and,
   /// unless check.progress is set, "audit" (cables checked). May be empty.
   ProgressFn progress;
+  /// One shard of a sharded audit (audit_shard.hpp): the scene holds only the parts the
+  /// shard owns, the report's part ids are global, and unsupported spans are left to the
+  /// merge. Null: the whole audit.
+  const AuditShard* shard = nullptr;
 };
 
 /// One cable of the harness as audited.

@@ -70,8 +70,6 @@ SupportAudit audit_supports(const Harness& h, const std::vector<Part>& parts, co
   SupportAudit out;
   const HarnessTopology topo(h);
   SegmentCurves curves(topo);
-  // The arc length along its segment's curve (from → to) where each supporting clamp holds it.
-  std::vector<double> clamp_s(h.clamps.size(), 0.0);
   for (std::size_t k = 0; k < h.clamps.size(); ++k) {
     const Clamp& c = h.clamps[k];
     ClampLoad load;
@@ -102,10 +100,18 @@ SupportAudit audit_supports(const Harness& h, const std::vector<Part>& parts, co
     const Vec3 held = curve.position(curve.parameter_at_length(at.s));
     const ClosestHit hit = nearest_structure(index, parts, held, clamp_reach + 0.5 * load.bundle_diameter);
     if (hit.found()) load.part = hit.part, load.distance = hit.distance;
-    clamp_s[k] = at.s;
+    load.segment_s = at.s;
     out.clamps.push_back(load);
   }
-  if (!check_spans) return out;
+  if (check_spans) out.spans = unsupported_spans(h, out.clamps, clamp_spacing);
+  return out;
+}
+
+std::vector<UnsupportedSpan> unsupported_spans(const Harness& h, const std::vector<ClampLoad>& clamps,
+                                               double clamp_spacing) {
+  std::vector<UnsupportedSpan> out;
+  const HarnessTopology topo(h);
+  SegmentCurves curves(topo);
   for (std::size_t c = 0; c < h.cables.size(); ++c) {
     const auto& chain = topo.cable_chain(static_cast<int>(c));
     std::vector<double> supports{0.0};
@@ -118,9 +124,9 @@ SupportAudit audit_supports(const Harness& h, const std::vector<Part>& parts, co
         break;
       }
       const double len = curve->length();
-      for (std::size_t k = 0; k < out.clamps.size(); ++k)
-        if (out.clamps[k].supports() && out.clamps[k].segment == u.segment)
-          supports.push_back(s0 + (u.reversed ? len - clamp_s[k] : clamp_s[k]));
+      for (const ClampLoad& k : clamps)
+        if (k.supports() && k.segment == u.segment)
+          supports.push_back(s0 + (u.reversed ? len - k.segment_s : k.segment_s));
       s0 += len;
     }
     if (!routed) continue;
@@ -146,7 +152,7 @@ SupportAudit audit_supports(const Harness& h, const std::vector<Part>& parts, co
         }
         t += len;
       }
-      out.spans.push_back(sp);
+      out.push_back(sp);
     }
   }
   return out;

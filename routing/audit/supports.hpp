@@ -45,6 +45,7 @@ struct ClampLoad {
   double distance = 0.0;       ///< from the centreline point to that part's surface (when part ≥ 0)
   double bundle_diameter = 0.0;  ///< diameter of the bundle it holds
   bool placed = false;         ///< placed by the router (else given by the harness file)
+  double segment_s = 0.0;      ///< arc length along its segment's curve (from → to) where it holds it
   /// True when it supports the cable: it holds a segment and structure is within reach.
   bool supports() const { return segment >= 0 && part >= 0; }
 };
@@ -71,5 +72,12 @@ struct SupportAudit {
 /// unrouted segment are skipped (the audit reports them unrouted).
 SupportAudit audit_supports(const Harness& h, const std::vector<Part>& parts, const ObstacleIndex& index,
                             double clamp_spacing, double clamp_reach, bool check_spans);
+
+/// The stretches of every routed cable of `h` longer than `clamp_spacing` between two of
+/// its supports (its ports and the clamps of `clamps` that support it), by cable, then
+/// from_s: the part of audit_supports that needs no structure, for clamps measured
+/// elsewhere (a sharded audit merges each clamp's nearest part first).
+std::vector<UnsupportedSpan> unsupported_spans(const Harness& h, const std::vector<ClampLoad>& clamps,
+                                               double clamp_spacing);
 
 }  // namespace loom
