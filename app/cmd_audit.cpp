@@ -2,6 +2,7 @@
 // [--tolerance T] [--per-cable] [--threads N] [--out DIR] [--render-size WxH] [--json] [--quiet]`: clash,
 // bend and clearance audit of a harness in its scene; writes DIR/report.json (DESIGN §4),
 // DIR/view.html and DIR/render.png. Progress bars on stderr when it is a terminal.
+#include "app/audit_mpi.hpp"
 #include "app/motion_summary.hpp"
 #include "app/support_summary.hpp"
 #include "app/commands.hpp"
@@ -26,6 +27,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace loom::app {
@@ -47,6 +49,7 @@ struct AuditFlags {
   std::string render_size = default_render_size();
   bool json = false;
   bool quiet = false;
+  std::string max_memory;  ///< sharded audits: most bytes one rank may need (empty: no limit)
 };
 
 /// Most clashes listed on the terminal (the report has them all).
@@ -95,6 +98,68 @@ void print_summary(const AuditReport& rep, const std::filesystem::path& report_p
   std::printf("report: %s\n", report_path.string().c_str());
 }
 
+/// The summary (or --json report) of a finished audit, as every way of running it prints it.
+void print_outcome(const AuditFlags& f, const AuditReport& rep, const nlohmann::json& report) {
+  if (f.json)
+    std::cout << json_text(report, 2) << "\n";
+  else if (!f.quiet)
+    print_summary(rep, std::filesystem::path(f.out) / "report.json");
+}
+
+/// `mpirun -np K loom audit`: every rank runs this; rank 0 writes report.json (and
+/// routed.kbl) and prints. view.html and render.png need every part in one process and
+/// are not written; stale ones from an earlier run are removed so that none describes
+/// another report.
+int run_sharded_audit_command(const AuditFlags& f, AuditOptions opt) {
+  const double max_memory = f.max_memory.empty() ? 0.0 : byte_size_value(f.max_memory);
+  MpiSession mpi;
+  try {
+    std::optional<OutputSet> outputs;
+    const auto report_path = std::filesystem::path(f.out) / "report.json";
+    mpi.collective([&] {
+      if (mpi.root()) outputs.emplace(f.out, std::vector<std::filesystem::path>{report_path,
+                                                                                std::filesystem::path(f.out) / kRoutedKblName});
+    });
+    ProgressBar bar(stderr, f.quiet || f.json || !mpi.root());
+    opt.progress = bar.fn();
+    ShardedAudit res = sharded_audit(mpi, f.scene, opt, max_memory);
+    int code = 0;
+    nlohmann::json report;
+    mpi.collective([&] {
+      if (!mpi.root()) return;
+      res.report.notes.push_back("sharded over " + std::to_string(mpi.size()) +
+                                 " MPI rank" + std::string(mpi.size() == 1 ? "" : "s") + ": view.html and render.png are not written (run `loom render` "
+                                 "where the whole scene fits)");
+      report = audit_report_json(res.report);
+      for (const ShardSummary& r : res.ranks)
+        report["shards"].push_back({{"rank", r.rank}, {"parts", r.parts}, {"triangles", r.triangles},
+                                    {"estimated_bytes", r.estimated_bytes}, {"peak_bytes", r.peak_bytes},
+                                    {"load_ms", r.load_ms}, {"index_ms", r.index_ms}, {"check_ms", r.check_ms}});
+      write_file_atomic(outputs->staging() / "report.json", json_text(report, 2) + "\n");
+      if (res.scene.harness.kbl) write_harness_kbl(res.scene.harness, outputs->staging() / kRoutedKblName);
+      outputs->commit();
+      for (const auto& stale : view_output_files(f.out)) std::filesystem::remove(stale);
+      code = res.report.exit_code();
+    });
+    code = mpi.broadcast(code);
+    if (mpi.root()) {
+      print_outcome(f, res.report, report);
+      if (!f.json && !f.quiet)
+        for (const ShardSummary& r : res.ranks)
+          std::printf("  rank %d: %zu parts, %zu triangles (estimated %.0f MiB, peak %.0f MiB); load %.0f ms, index "
+                      "%.1f ms, check %.1f ms\n",
+                      r.rank, r.parts, r.triangles, r.estimated_bytes / 1048576.0, r.peak_bytes / 1048576.0, r.load_ms,
+                      r.index_ms, r.check_ms);
+    }
+    return code;
+  } catch (const ShardFailure& e) {
+    // Every rank stops here; rank 0 says why (main prints it, exit 2).
+    if (!mpi.root()) return 2;
+    if (e.input_error()) throw InputError({"", 0, ""}, e.what());
+    throw;
+  }
+}
+
 int run_audit_command(const AuditFlags& f) {
   // The flags first: a usage error creates no output directory.
   AuditOptions opt;
@@ -131,6 +196,9 @@ int run_audit_command(const AuditFlags& f) {
   if (!f.routes.empty()) opt.routes = f.routes;
   RenderOptions render;
   parse_render_size(f.render_size, "--render-size", render);
+  if (launched_by_mpi()) return run_sharded_audit_command(f, opt);
+  if (!f.max_memory.empty())
+    throw InputError({"", 0, "--max-memory"}, "applies to a sharded audit (mpirun -np K loom audit) only");
   auto targets = view_output_files(f.out);
   targets.push_back(std::filesystem::path(f.out) / "report.json");
   targets.push_back(std::filesystem::path(f.out) / kRoutedKblName);  // written for a KBL harness
@@ -140,7 +208,6 @@ int run_audit_command(const AuditFlags& f) {
   render.progress = bar.fn();
   Scene scene;
   const AuditReport rep = audit_scene_file(f.scene, opt, &scene);
-  const std::filesystem::path report_path = std::filesystem::path(f.out) / "report.json";
   const nlohmann::json report = audit_report_json(rep);
   naming_cable_errors(scene.harness, [&] {  // a tube refused names its cable's element
     return write_view_outputs(outputs.staging(), scene, scene.harness, report, render);  // view.html, render.png
@@ -148,10 +215,7 @@ int run_audit_command(const AuditFlags& f) {
   write_audit_report(rep, outputs.staging() / "report.json");
   if (scene.harness.kbl) write_harness_kbl(scene.harness, outputs.staging() / kRoutedKblName);
   outputs.commit();
-  if (f.json)
-    std::cout << json_text(report, 2) << "\n";
-  else if (!f.quiet)
-    print_summary(rep, report_path);
+  print_outcome(f, rep, report);
   return rep.exit_code();
 }
 
@@ -176,6 +240,9 @@ void add_audit_command(CLI::App& app, int& exit_code) {
       ->check(whole_number(1, kMaxThreads));
   cmd->add_option("--out", f->out, "Output directory for report.json")->check(non_empty_path())->capture_default_str();
   cmd->add_option("--render-size", f->render_size, "Size of render.png, WIDTHxHEIGHT")->capture_default_str();
+  cmd->add_option("--max-memory", f->max_memory,
+                  "Sharded audit (mpirun): most memory one rank may need, e.g. 24G; a plan that needs more is refused")
+      ->check(byte_size());
   cmd->add_flag("--json", f->json, "Print the report as JSON instead of the summary");
   cmd->add_flag("--quiet", f->quiet, "Print nothing (exit status and report only)");
   cmd->callback([f, m, &exit_code]() {

@@ -1,5 +1,6 @@
 #include "app/option_checks.hpp"
 
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -35,6 +36,34 @@ CLI::Validator whole_number(long long min, long long max) {
         return {};
       },
       "INT in " + range);
+}
+
+double byte_size_value(const std::string& text) {
+  const char* begin = text.c_str();
+  char* end = nullptr;
+  const double v = std::strtod(begin, &end);
+  if (end == begin || !std::isfinite(v) || !(v > 0.0)) return 0.0;
+  std::string unit(end);
+  for (char& c : unit) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  double scale = 1.0;
+  if (!unit.empty()) {
+    const std::string prefixes = "KMGT";
+    const auto k = prefixes.find(unit[0]);
+    if (k == std::string::npos) return 0.0;
+    const std::string rest = unit.substr(1);
+    if (!(rest.empty() || rest == "B" || rest == "IB")) return 0.0;
+    scale = std::pow(1024.0, static_cast<double>(k + 1));
+  }
+  const double bytes = v * scale;
+  return std::isfinite(bytes) && bytes >= 1.0 ? bytes : 0.0;
+}
+
+CLI::Validator byte_size() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        return byte_size_value(text) > 0.0 ? "" : "must be a size such as 24G, 512M or 1.5T, got " + text;
+      },
+      "SIZE");
 }
 
 CLI::Validator non_empty_path() {

@@ -17,6 +17,14 @@ CLI::Validator finite_number(double min, bool min_allowed);
 /// The message names the range and the value.
 CLI::Validator whole_number(long long min, long long max);
 
+/// Bytes in a size written as a positive finite number with an optional binary suffix
+/// K, M, G or T (KiB…TiB; "G", "GiB" and "GB" alike mean 2³⁰), e.g. "24G", "1.5T",
+/// "4096". 0 for text that is not one.
+double byte_size_value(const std::string& text);
+
+/// Accepts what byte_size_value reads; the message names the form and the value.
+CLI::Validator byte_size();
+
 /// Accepts a non-empty path. Why: an empty `--out ""` would otherwise write into the current
 /// directory, which the user did not name.
 CLI::Validator non_empty_path();

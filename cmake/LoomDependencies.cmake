@@ -44,6 +44,8 @@ loom_wrap(occt INCLUDES ${OpenCASCADE_INCLUDE_DIR}
 
 if(LOOM_BUILD_APP)
   find_package(CLI11 REQUIRED)
+  # `mpirun -np K loom audit`: the command line shards an audit over MPI ranks (Open MPI).
+  find_package(MPI REQUIRED COMPONENTS CXX)
 endif()
 if(LOOM_BUILD_TESTS)
   find_package(GTest REQUIRED)

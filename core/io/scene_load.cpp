@@ -507,6 +507,8 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
                "unknown file extension '" + fpath.extension().string() +
                    "' (meshes: .stl .obj .ply .off .gltf .glb .dae; CAD: .step .stp .iges .igs; scans: .bt .ot .pcd "
                    ".xyz, .ply with a resolution)");
+      if (!opt.entries.empty() && !(static_cast<std::size_t>(idx - 1) < opt.entries.size() && opt.entries[idx - 1]))
+        continue;  // another shard's part
       if (!opt.load_parts) {
         std::error_code ec;
         if (!std::filesystem::exists(fpath, ec))
@@ -519,6 +521,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
         p.motion = motion;
         if (!names.insert(p.name).second) r.fail(&node, pwhere, "duplicate part name");
         scene.parts.push_back(std::move(p));
+        if (report) report->part_entries.push_back(idx - 1);
         continue;
       }
       std::vector<NamedMesh> pieces;
@@ -575,6 +578,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
                                   " boundary edges): it has no inside, surface checks only");
         if (!names.insert(p.name).second) r.fail(&node, pwhere, "duplicate part name '" + p.name + "'");
         scene.parts.push_back(std::move(p));
+        if (report) report->part_entries.push_back(idx - 1);
       }
       loaded.add();
     }

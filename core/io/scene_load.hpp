@@ -15,6 +15,10 @@ namespace loom {
 struct SceneLoadOptions {
   bool load_parts = true;    ///< false: only TOML + harness (fast, for tests of settings)
   bool use_cache = true;     ///< cache CAD tessellations keyed by file hash and deflection
+  /// Which [[part]] entries to load, by their order in the file (empty: all). An entry not
+  /// selected is validated like the others but yields no part (a shard of a sharded audit
+  /// loads only its own; duplicate names across entries are then the caller's to check).
+  std::vector<bool> entries;
   /// Stage "load": part files ([[part]] entries) read and triangulated, from the calling thread.
   ProgressFn progress;
 };
@@ -23,6 +27,9 @@ struct SceneLoadOptions {
 struct SceneLoadReport {
   double load_ms = 0.0;
   std::vector<std::string> notes;  ///< e.g. "part 'skin' is open: surface checks only"
+  /// The [[part]] entry (0-based, file order) each loaded part came from: a CAD file may
+  /// yield several parts, a skipped entry (SceneLoadOptions::entries) none.
+  std::vector<int> part_entries;
 };
 
 /// Reads and validates a scene file. Relative paths in it are relative to its directory.

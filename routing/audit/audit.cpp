@@ -426,14 +426,20 @@ void apply_matching_routes(Scene& scene, const std::filesystem::path& routes) {
   if (same) scene.harness.kbl = designed->kbl;
 }
 
+Scene load_audit_scene(const std::filesystem::path& scene_file, const AuditOptions& opt, const SceneLoadOptions& load,
+                       SceneLoadReport* report) {
+  Scene scene = load_scene(scene_file, load, report);
+  if (opt.routes) apply_matching_routes(scene, *opt.routes);
+  if (scene.has_harness) check_requested_tolerance(scene.harness, opt.check);
+  return scene;
+}
+
 AuditReport audit_scene_file(const std::filesystem::path& scene_file, const AuditOptions& opt, Scene* loaded) {
   const Stopwatch t0;
   SceneLoadReport load_rep;
   SceneLoadOptions load_opt;
   load_opt.progress = opt.progress;
-  Scene scene = load_scene(scene_file, load_opt, &load_rep);
-  if (opt.routes) apply_matching_routes(scene, *opt.routes);
-  if (scene.has_harness) check_requested_tolerance(scene.harness, opt.check);
+  Scene scene = load_audit_scene(scene_file, opt, load_opt, &load_rep);
   const double load_ms = t0.ms();
   AuditReport rep = run_audit(scene, opt);
   rep.load_ms = load_ms;

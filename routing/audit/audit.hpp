@@ -3,6 +3,7 @@
 /// clash, bend and clearance checks (timed as timing_ms.check) → an AuditReport, which
 /// report_json writes as report.json.
 
+#include "core/io/scene_load.hpp"
 #include "core/progress.hpp"
 #include "core/scene.hpp"
 #include "routing/audit/clash_check.hpp"
@@ -126,6 +127,11 @@ void apply_matching_routes(Scene& scene, const std::filesystem::path& routes);
 /// inconsistent harness, and for a cable whose audit would pass a limit (check_clashes'
 /// CableLimitError), naming the harness file and the cable's line.
 AuditReport run_audit(const Scene& scene, const AuditOptions& opt);
+
+/// The scene an audit of `scene_file` checks: load_scene with `load`, then --routes
+/// (apply_matching_routes) and the check of a requested tolerance, as audit_scene_file does.
+Scene load_audit_scene(const std::filesystem::path& scene_file, const AuditOptions& opt, const SceneLoadOptions& load,
+                       SceneLoadReport* report = nullptr);
 
 /// Loads the scene file (timed as timing_ms.load), applies --routes (apply_matching_routes),
 /// and audits it. Throws InputError (exit 2)

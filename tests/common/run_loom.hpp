@@ -15,11 +15,10 @@ struct LoomRun {
   std::string out;  ///< stdout and stderr, merged
 };
 
-/// Runs `loom ARGS` through the shell (so ARGS may quote) and returns its exit status and
-/// output.
-inline LoomRun run_loom(const std::string& args) {
+/// Runs a shell command line and returns its exit status and output (stderr merged).
+inline LoomRun run_command(const std::string& command) {
   LoomRun r;
-  const std::string cmd = std::string(LOOM_EXE) + " " + args + " 2>&1";
+  const std::string cmd = command + " 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;
   std::array<char, 4096> buf{};
@@ -28,5 +27,9 @@ inline LoomRun run_loom(const std::string& args) {
   r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
   return r;
 }
+
+/// Runs `loom ARGS` through the shell (so ARGS may quote) and returns its exit status and
+/// output.
+inline LoomRun run_loom(const std::string& args) { return run_command(std::string(LOOM_EXE) + " " + args); }
 
 }  // namespace loom::testing
