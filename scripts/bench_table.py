@@ -159,6 +159,34 @@ def fcl_peer_rows():
     ]
 
 
+def audit_mpi_rows():
+    name = "audit_mpi.csv"
+    t = rows(name)
+    one = pick(t, name, scene="x10", run="single")
+    two = pick(t, name, scene="x10", run="mpi", ranks="2")
+    mpi1 = pick(t, name, scene="x10", run="mpi", ranks="1")
+    busy = lambda r: sum(num(r, c, name) for c in ("load_ms", "index_ms", "check_ms")) / 1000
+    speedup = busy(one) / busy(two)
+    mpi = [r for r in t if r["run"] == "mpi"]
+    same = all(r["same_findings"] == "yes" for r in mpi)
+    borderline = sum(int(r["borderline_in_one_only"]) for r in mpi)
+    identical = [r["ranks"] for r in mpi if r["scene"] == "x10" and r["byte_identical_findings"] == "yes"]
+    m = rows("audit_mpi_model.csv")[0]
+    return [
+        ("sharded audit (`mpirun`), 10× scene, 2 ranks × 1 thread against 1 process × 1 thread", f"`{name}`",
+         f"{times(speedup)} ({sig(busy(one))} → {sig(busy(two))} s); peak memory per rank "
+         f"{sig(num(mpi1, 'peak_rss_mib_max', name))} → {sig(num(two, 'peak_rss_mib_max', name))} MiB",
+         "≥ 1.7×", status(speedup >= 1.7)),
+        ("same, findings against one process, 1–4 ranks, both scenes", f"`{name}`",
+         f"{'the same to the tolerance' if same else 'DIFFERENT'} ({borderline} within the tolerance of their "
+         f"threshold in one only); byte-identical with {', '.join(identical) or 'no'} rank(s)",
+         "byte-identical", status(same and len(identical) == 4)),
+        ("modelled: 10⁹ triangles, 64 ranks, 10⁵ cables", "`audit_mpi_model.csv`",
+         f"{sig(float(m['total_s']))} s ({sig(float(m['check_s']))} s check on rank 0), "
+         f"{sig(float(m['peak_gib_per_rank']))} GiB per rank", "—", "—"),
+    ]
+
+
 def index_rows():
     build = [r for r in rows("index_build.csv") if r["scene"] == "generated"]
     rates = [num(r, "mtris_per_s", "index_build.csv") for r in build]
@@ -303,7 +331,7 @@ def scan_rows():
 
 def table():
     lines = ["| measure | bench/results | measured | target | status |", "|---|---|---|---|---|"]
-    for group in (audit_rows, harness_audit_rows, fcl_peer_rows, index_rows, centerline_rows, alpha_sim_rows, planning_rows, scan_rows):
+    for group in (audit_rows, harness_audit_rows, fcl_peer_rows, audit_mpi_rows, index_rows, centerline_rows, alpha_sim_rows, planning_rows, scan_rows):
         for row in group():
             lines.append("| " + " | ".join(row) + " |")
     return "\n".join(lines) + "\n"
