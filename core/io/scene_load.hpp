@@ -15,12 +15,12 @@ namespace loom {
 struct SceneLoadOptions {
   bool load_parts = true;    ///< false: only TOML + harness (fast, for tests of settings)
   bool use_cache = true;     ///< cache CAD tessellations keyed by file hash and deflection
+  /// Stage "load": part files ([[part]] entries) read and triangulated, from the calling thread.
+  ProgressFn progress;
   /// Which [[part]] entries to load, by their order in the file (empty: all). An entry not
   /// selected is validated like the others but yields no part (a shard of a sharded audit
   /// loads only its own; duplicate names across entries are then the caller's to check).
   std::vector<bool> entries;
-  /// Stage "load": part files ([[part]] entries) read and triangulated, from the calling thread.
-  ProgressFn progress;
 };
 
 /// What loading took and noticed.

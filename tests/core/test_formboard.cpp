@@ -19,6 +19,14 @@
 namespace loom {
 namespace {
 
+/// The scene file and its harness, no part file (nor the tessellation cache) read.
+SceneLoadOptions settings_only() {
+  SceneLoadOptions o;
+  o.load_parts = false;
+  o.use_cache = false;
+  return o;
+}
+
 namespace fs = std::filesystem;
 
 const std::string kData = std::string(LOOM_TEST_DATA) + "/formboard/";
@@ -228,7 +236,7 @@ const char* kPlaceAll =
 TEST(FormboardScene, PlacedPortsTakeTheTablesPositionsAndDirections) {
   TempScene s("placed", kMini, kPlaceAll);
   SceneLoadReport rep;
-  const Scene scene = load_scene(s.file, {false, false, {}}, &rep);
+  const Scene scene = load_scene(s.file, settings_only(), &rep);
   const Harness& h = scene.harness;
   const auto& x1 = h.ports[static_cast<std::size_t>(h.find_port("X1"))];
   const auto& x2 = h.ports[static_cast<std::size_t>(h.find_port("X2"))];  // placed by its Node id N3
@@ -248,7 +256,7 @@ TEST(FormboardScene, PlacedPortsTakeTheTablesPositionsAndDirections) {
 TEST(FormboardScene, MissingPlacementsAreAllNamedWithTheTable) {
   TempScene s("missing", kMini, "\n[harness.place]\nX1 = { at = [0.0, 0.0, 50.0], dir = [1.0, 0.0, 0.0] }\n");
   const std::string text = slurp(kMini);
-  const std::string e = refusal([&] { load_scene(s.file, {false, false, {}}); });
+  const std::string e = refusal([&] { load_scene(s.file, settings_only()); });
   expect_all(e, {kMini + ":" + std::to_string(line_of(text, "<Node id=\"N3\"")) + ":", "2 ports have no position",
                  "X2 (line " + std::to_string(line_of(text, "<Node id=\"N3\"")) + ")",
                  "X3 (line " + std::to_string(line_of(text, "<Node id=\"N4\"")) + ")", "[harness.place]",
@@ -256,7 +264,7 @@ TEST(FormboardScene, MissingPlacementsAreAllNamedWithTheTable) {
   EXPECT_EQ(e.find("X1 (line"), std::string::npos) << e;
   // No table at all: all three.
   TempScene none("none", kMini, "");
-  expect_all(refusal([&] { load_scene(none.file, {false, false, {}}); }), {"3 ports have no position", "X1 (line"});
+  expect_all(refusal([&] { load_scene(none.file, settings_only()); }), {"3 ports have no position", "X1 (line"});
 }
 
 TEST(FormboardScene, ABadPlacementIsNamedAtItsKey) {
@@ -273,7 +281,7 @@ TEST(FormboardScene, ABadPlacementIsNamedAtItsKey) {
     TempScene s("bad", kMini, head + toml);
     std::vector<std::string> all = needles;
     all.push_back(s.file.string() + ":9:");  // the key's line: 6 lines of [scene] and [harness] above
-    expect_all(refusal([&] { load_scene(s.file, {false, false, {}}); }), all);
+    expect_all(refusal([&] { load_scene(s.file, settings_only()); }), all);
   }
 }
 
@@ -284,7 +292,7 @@ TEST(FormboardScene, APlacementMovesA3DPortAndFreesItsSegments) {
   const std::string id = file.ports[0].id;
   TempScene s("moved", gen, "\n[harness.place]\n\"" + id + "\" = { at = [1.0, 2.0, 3.0], dir = [0.0, 1.0, 0.0] }\n");
   SceneLoadReport rep;
-  const Scene scene = load_scene(s.file, {false, false, {}}, &rep);
+  const Scene scene = load_scene(s.file, settings_only(), &rep);
   const Harness& h = scene.harness;
   EXPECT_EQ(h.ports[0].position, Vec3(1, 2, 3));
   int freed = 0, kept = 0;
