@@ -171,13 +171,14 @@ struct PartRecord {
   std::size_t triangles = 0;
   bool keep_out = false;
   bool moving = false;
+  double deflection = 0.0;  ///< CAD parts: the deflection it was meshed at (tessellation by need)
 };
 
 Bytes records_bytes(const std::vector<PartRecord>& rs, const std::vector<std::string>& notes) {
   nlohmann::json j = nlohmann::json::array();
   for (const PartRecord& r : rs)
     j.push_back({r.entry, r.within, r.loader, r.name, r.box.min.x(), r.box.min.y(), r.box.min.z(), r.box.max.x(),
-                 r.box.max.y(), r.box.max.z(), r.triangles, r.keep_out, r.moving});
+                 r.box.max.y(), r.box.max.z(), r.triangles, r.keep_out, r.moving, r.deflection});
   return nlohmann::json::to_cbor(nlohmann::json{{"parts", j}, {"notes", notes}});
 }
 
@@ -188,7 +189,7 @@ void read_records(const Bytes& b, std::vector<PartRecord>& rs, std::vector<std::
     r.entry = x.at(0), r.within = x.at(1), r.loader = x.at(2), r.name = x.at(3);
     r.box.min = Vec3(x.at(4), x.at(5), x.at(6));
     r.box.max = Vec3(x.at(7), x.at(8), x.at(9));
-    r.triangles = x.at(10), r.keep_out = x.at(11), r.moving = x.at(12);
+    r.triangles = x.at(10), r.keep_out = x.at(11), r.moving = x.at(12), r.deflection = x.at(13);
     rs.push_back(r);
   }
   for (const auto& n : j.at("notes")) notes.push_back(n);
@@ -259,6 +260,22 @@ void check_memory(const ShardPlan& plan, double max_memory, const std::filesyste
   }
 }
 
+/// What tessellation by need did on every rank, from the deflection each part was meshed
+/// at (as refine_for_audit says it in one process).
+TessellationByNeed by_need_summary(const Scene& scene, const std::vector<PartRecord>& parts) {
+  TessellationByNeed t;
+  t.used = scene.tessellation.by_need;
+  if (!t.used) return t;
+  t.fine_deflection = scene.tessellation.linear_deflection.value;
+  t.coarse_deflection = scene.tessellation.coarse_deflection.value;
+  for (std::size_t g = 0; g < parts.size(); ++g) {
+    if (!(parts[g].deflection > 0.0)) continue;  // meshes and scans
+    if (parts[g].deflection > t.fine_deflection * (1.0 + 1e-12)) ++t.coarse_parts;
+    else if (t.coarse_deflection > t.fine_deflection) t.refined.push_back(static_cast<int>(g));
+  }
+  return t;
+}
+
 }  // namespace
 
 ShardedAudit sharded_audit(const MpiSession& mpi, const std::filesystem::path& scene_file, const AuditOptions& opt,
@@ -281,15 +298,19 @@ ShardedAudit sharded_audit(const MpiSession& mpi, const std::filesystem::path& s
     SceneLoadOptions share;
     share.use_cache = true;
     for (std::size_t e = 0; e < loader.size(); ++e) share.entries.push_back(loader[e] == mpi.rank());
+    share.tessellate_by_need = true;
     SceneLoadReport rep;
     Scene s = load_scene(scene_file, share, &rep);
     load_notes = rep.notes;
+    s.harness = out.scene.harness;  // with --routes applied: tessellation by need follows the audited routes
+    s.has_harness = out.scene.has_harness;
+    refine_for_audit(s, opt);
     for (std::size_t k = 0; k < s.parts.size(); ++k) {
       const Part& p = s.parts[k];
       const int entry = rep.part_entries.at(k);
       const int within = k > 0 && rep.part_entries[k - 1] == entry ? mine.back().within + 1 : 0;
       mine.push_back({entry, within, mpi.rank(), p.name, p.mesh.bounds(), p.mesh.triangle_count(),
-                      p.role == PartRole::KeepOut, p.motion.has_value()});
+                      p.role == PartRole::KeepOut, p.motion.has_value(), p.deflection});
     }
     loaded = std::move(s.parts);
   });
@@ -379,6 +400,8 @@ ShardedAudit sharded_audit(const MpiSession& mpi, const std::filesystem::path& s
     std::vector<ShardPart> catalogue;
     for (const PartRecord& p : parts) catalogue.push_back({p.name, p.keep_out, p.triangles});
     out.report = merge_audit_shards(std::move(reports), catalogue, out.scene.harness, out.scene.routing);
+    out.report.tessellation = by_need_summary(out.scene, parts);
+    if (out.report.tessellation.used) out.report.notes.push_back(tessellation_note(out.report.tessellation));
     // The load notes first, as one process says them; each note once.
     std::vector<std::string> merged;
     std::set<std::string> seen;

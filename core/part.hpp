@@ -29,6 +29,14 @@ struct Part {
   std::string source_file;  ///< file it came from
   std::string source_name;  ///< product / solid name inside that file (STEP), if any
   int source_faces = 0;     ///< B-rep faces it was tessellated from (STEP/IGES), else 0
+  /// CAD parts: the linear deflection its mesh was tessellated at (scene units), so the
+  /// largest distance between the mesh and the B-rep surface; 0 for meshes and scans.
+  double deflection = 0.0;
+  /// CAD parts: which leaf product of its file it is (read_cad_file order; −1: the file's
+  /// compound as one part), and the scene entry's transform (file frame → world), so that
+  /// it can be tessellated again (tessellation by need).
+  int source_leaf = -1;
+  Eigen::Affine3d source_transform = Eigen::Affine3d::Identity();
   /// Scanned parts (OctoMap tree or point cloud): voxel edge after the transform, scene
   /// units; the mesh is the union of occupied voxels. 0 for meshed parts.
   double voxel_edge = 0.0;

@@ -80,7 +80,16 @@ struct SimplifySettings {
 struct TessellationSettings {
   Setting linear_deflection;  ///< max chord deviation; default smallest cable radius / 10
   Setting angular_deflection_deg;
+  /// Tessellation by need (`loom audit`): CAD parts are meshed at `coarse_deflection` first
+  /// and again at `linear_deflection` only where a cable comes within reach of them.
+  bool by_need = false;
+  Setting coarse_deflection;  ///< default kCoarseDeflectionFactor × linear_deflection
 };
+
+/// Default coarse deflection of tessellation by need, in fine deflections: coarse enough
+/// that curved housings cost a few thousand triangles, fine enough that the reach it adds
+/// to the need test (the coarse deflection) selects few parts the fine mesh would not.
+constexpr double kCoarseDeflectionFactor = 20.0;
 
 /// Everything a command needs about the problem.
 struct Scene {

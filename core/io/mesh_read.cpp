@@ -229,14 +229,16 @@ void collect_leaves(const Handle(XCAFDoc_ShapeTool)& tool, const TDF_Label& labe
 constexpr double kMinRelativeDeflection = 1e-6;
 constexpr const char* kMinRelativeDeflectionText = "1e-6";
 
-std::vector<NamedMesh> read_cad_file_occ(const std::filesystem::path& path, const TessellationParams& tp, bool split);
+std::vector<NamedMesh> read_cad_file_occ(const std::filesystem::path& path, const TessellationParams& tp, bool split,
+                                         const std::vector<int>* only_leaves);
 }  // namespace
 
-std::vector<NamedMesh> read_cad_file(const std::filesystem::path& path, const TessellationParams& tp, bool split) {
+std::vector<NamedMesh> read_cad_file(const std::filesystem::path& path, const TessellationParams& tp, bool split,
+                                     const std::vector<int>* only_leaves) {
   // OpenCASCADE reports failures of its readers and mesher by exceptions of its own: they
   // are the file's (or the deflection's) fault, so they become input errors naming both.
   try {
-    return read_cad_file_occ(path, tp, split);
+    return read_cad_file_occ(path, tp, split, only_leaves);
   } catch (const Standard_Failure& e) {
     throw InputError({path.string(), 0, ""}, std::string("OpenCASCADE failed (") + e.DynamicType()->Name() +
                                                  "): " + (e.GetMessageString() ? e.GetMessageString() : "") +
@@ -246,7 +248,8 @@ std::vector<NamedMesh> read_cad_file(const std::filesystem::path& path, const Te
 }
 
 namespace {
-std::vector<NamedMesh> read_cad_file_occ(const std::filesystem::path& path, const TessellationParams& tp, bool split) {
+std::vector<NamedMesh> read_cad_file_occ(const std::filesystem::path& path, const TessellationParams& tp, bool split,
+                                         const std::vector<int>* only_leaves) {
   require_input_file(path, "file");
   if (!is_cad_file(path))
     throw InputError({path.string(), 0, ""}, "not a STEP/IGES file: '" + path.extension().string() + "'");
@@ -319,19 +322,22 @@ std::vector<NamedMesh> read_cad_file_occ(const std::filesystem::path& path, cons
   // products whose own names end so ("bolt", "bolt", "bolt#2" must give three names).
   std::set<std::string> used;
   std::map<std::string, int> next_suffix;  // per product name: the first k not yet tried
-  for (const auto& l : leaves) {
-    BRepMesh_IncrementalMesh mesher(l.shape, lin_mm, false, ang, true);
+  for (std::size_t i = 0; i < leaves.size(); ++i) {
+    const Leaf& l = leaves[i];
     NamedMesh nm;
     const std::string base = l.name.empty() ? "solid" : l.name;
     nm.name = base;
+    nm.leaf = static_cast<int>(i);
     int& k = next_suffix.try_emplace(base, 2).first->second;
     while (!used.insert(nm.name).second) nm.name = base + "#" + std::to_string(k++);
+    if (only_leaves && !std::binary_search(only_leaves->begin(), only_leaves->end(), nm.leaf)) continue;
+    BRepMesh_IncrementalMesh mesher(l.shape, lin_mm, false, ang, true);
     nm.brep_faces = append_triangulation(l.shape, scale, nm.mesh);
     finish_mesh(nm.mesh, path, nm.name);
     if (nm.mesh.empty()) continue;  // e.g. a wire-frame or empty product: nothing to collide with
     out.push_back(std::move(nm));
   }
-  if (out.empty()) throw InputError({path.string(), 0, ""}, "tessellation produced no triangles");
+  if (out.empty() && !only_leaves) throw InputError({path.string(), 0, ""}, "tessellation produced no triangles");
   return out;
 }
 

@@ -17,6 +17,7 @@ struct NamedMesh {
   std::string name;
   Mesh mesh;
   int brep_faces = 0;  ///< B-rep faces tessellated (CAD files only)
+  int leaf = -1;       ///< CAD files read split: the leaf product's place among the file's leaves
 };
 
 /// How CAD files are tessellated.
@@ -46,8 +47,10 @@ std::string obj_text_for_assimp(std::string text);
 
 /// Reads a STEP/IGES file. With `split` true, one NamedMesh per leaf product occurrence
 /// (name = product name, "#k" appended to repeated names); otherwise one compound mesh.
+/// `only_leaves` (split only; ascending leaf indices): tessellate just those leaves, the
+/// others are skipped (names stay those of the whole file's reading).
 std::vector<NamedMesh> read_cad_file(const std::filesystem::path& path, const TessellationParams& tp,
-                                     bool split);
+                                     bool split, const std::vector<int>* only_leaves = nullptr);
 
 /// Removes OpenCASCADE's console printers from its default messenger, for the whole
 /// process: its STEP/IGES readers and writers otherwise print transfer statistics on stdout,

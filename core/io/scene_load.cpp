@@ -21,8 +21,10 @@
 #include <cstdint>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 namespace loom {
 
@@ -446,7 +448,12 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
                                           dmin > 0 ? "default: smallest cable radius / 10" : "default: 0.1 mm (no cables)"};
   scene.tessellation.angular_deflection_deg = {20.0, "default: 20 degrees"};
   if (const toml::table* tt = r.section(doc, "tessellation")) {
-    r.only_keys(*tt, "tessellation", {"linear_deflection", "angular_deflection_deg"});
+    r.only_keys(*tt, "tessellation", {"linear_deflection", "angular_deflection_deg", "by_need", "coarse_deflection"});
+    if (const toml::node* n = tt->get("by_need")) {
+      const auto b = n->as_boolean();
+      if (!b) r.fail(n, "tessellation.by_need", "expected true or false");
+      scene.tessellation.by_need = b->get();
+    }
     if (auto v = r.number(*tt, "tessellation", "linear_deflection")) {
       if (!(*v > 0)) r.fail(tt->get("linear_deflection"), "tessellation.linear_deflection", "must be positive");
       scene.tessellation.linear_deflection = {*v, "scene file"};
@@ -457,6 +464,18 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
       scene.tessellation.angular_deflection_deg = {*v, "scene file"};
     }
   }
+  scene.tessellation.coarse_deflection = {kCoarseDeflectionFactor * scene.tessellation.linear_deflection.value,
+                                          "default: 20 x linear_deflection"};
+  if (const toml::table* tt = r.section(doc, "tessellation"))
+    if (auto v = r.number(*tt, "tessellation", "coarse_deflection")) {
+      if (!(*v >= scene.tessellation.linear_deflection.value))
+        r.fail(tt->get("coarse_deflection"), "tessellation.coarse_deflection",
+               "must be at least linear_deflection (" + full_precision(scene.tessellation.linear_deflection.value) + ")");
+      scene.tessellation.coarse_deflection = {*v, "scene file"};
+    }
+  const bool coarse_first = opt.tessellate_by_need && scene.tessellation.by_need;
+  if (scene.tessellation.by_need && !opt.tessellate_by_need && opt.load_parts && report)
+    report->notes.push_back("tessellation.by_need applies to `loom audit`: CAD parts meshed at the fine deflection");
 
   // [[part]]
   const std::map<std::string, Motion> motions = read_named_motions(doc, file);
@@ -526,10 +545,12 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
       }
       std::vector<NamedMesh> pieces;
       double voxel_edge = 0.0;  // scanned parts, scene units
+      double deflection = 0.0;  // CAD parts, scene units
       try {
         if (is_cad_file(fpath)) {
           TessellationParams tp;
-          tp.linear_deflection = scene.tessellation.linear_deflection.value;
+          deflection = coarse_first ? scene.tessellation.coarse_deflection.value : scene.tessellation.linear_deflection.value;
+          tp.linear_deflection = deflection;
           tp.angular_deflection_deg = scene.tessellation.angular_deflection_deg.value;
           tp.unit_in_mm = unit_in_mm(scene.units);
           pieces = opt.use_cache ? read_cad_file_cached(fpath, tp, !compound) : read_cad_file(fpath, tp, !compound);
@@ -566,6 +587,9 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
         p.source_file = fpath.string();
         p.source_name = piece.name;
         p.source_faces = piece.brep_faces;
+        p.deflection = deflection;
+        p.source_leaf = compound ? -1 : piece.leaf;
+        p.source_transform = xf;
         p.voxel_edge = voxel_edge;
         p.unknown_occupied = scan && scan->unknown_occupied;
         p.motion = motion;
@@ -590,6 +614,47 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
     report->load_ms = t0.ms();
   }
   return scene;
+}
+
+void retessellate_parts(Scene& scene, const std::vector<int>& parts, double deflection) {
+  TessellationParams tp;
+  tp.linear_deflection = deflection;
+  tp.angular_deflection_deg = scene.tessellation.angular_deflection_deg.value;
+  tp.unit_in_mm = unit_in_mm(scene.units);
+  // One reading per file and reading mode: the leaves asked for from a split file, the
+  // whole compound otherwise.
+  std::map<std::pair<std::string, bool>, std::vector<int>> by_file;
+  for (const int k : parts) {
+    const Part& p = scene.parts.at(static_cast<std::size_t>(k));
+    if (!is_cad_file(p.source_file))
+      throw std::invalid_argument("retessellate_parts: part '" + p.name + "' is not a CAD part");
+    by_file[{p.source_file, p.source_leaf < 0}].push_back(k);
+  }
+  for (const auto& [key, ks] : by_file) {
+    const auto& [file, compound] = key;
+    std::vector<int> leaves;
+    for (const int k : ks) leaves.push_back(scene.parts[static_cast<std::size_t>(k)].source_leaf);
+    std::sort(leaves.begin(), leaves.end());
+    leaves.erase(std::unique(leaves.begin(), leaves.end()), leaves.end());
+    std::vector<NamedMesh> pieces = compound ? read_cad_file(file, tp, false) : read_cad_file(file, tp, true, &leaves);
+    for (const int k : ks) {
+      Part& p = scene.parts[static_cast<std::size_t>(k)];
+      const auto it = std::find_if(pieces.begin(), pieces.end(),
+                                   [&](const NamedMesh& nm) { return compound || nm.leaf == p.source_leaf; });
+      if (it == pieces.end())
+        throw InputError({file, 0, "part '" + p.name + "'"},
+                         "its leaf " + std::to_string(p.source_leaf) + " gave no triangles at deflection " +
+                             full_precision(deflection));
+      Mesh m = it->mesh;
+      m.transform(p.source_transform);
+      const MeshTopology topo = analyse_topology(m);
+      orient_outward(m, topo);
+      p.mesh = std::move(m);
+      p.closed = topo.closed;
+      p.source_faces = it->brep_faces;
+      p.deflection = deflection;
+    }
+  }
 }
 
 }  // namespace loom

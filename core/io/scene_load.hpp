@@ -21,6 +21,10 @@ struct SceneLoadOptions {
   /// selected is validated like the others but yields no part (a shard of a sharded audit
   /// loads only its own; duplicate names across entries are then the caller's to check).
   std::vector<bool> entries;
+  /// Honour `[tessellation] by_need`: CAD parts meshed at its coarse deflection (the caller
+  /// refines what cables come near: retessellate_parts). False: every CAD part at the fine
+  /// deflection, and a note when the scene asks for tessellation by need.
+  bool tessellate_by_need = false;
 };
 
 /// What loading took and noticed.
@@ -36,6 +40,11 @@ struct SceneLoadReport {
 /// Throws InputError (file, line, key, reason) for every malformed input.
 Scene load_scene(const std::filesystem::path& toml, const SceneLoadOptions& opt = {},
                  SceneLoadReport* report = nullptr);
+
+/// Tessellates the given CAD parts of a loaded scene (indices into scene.parts) again at
+/// `deflection` (scene units) from their files, each with its leaf and entry transform;
+/// meshes, closedness and deflection replaced. Throws InputError naming the file.
+void retessellate_parts(Scene& scene, const std::vector<int>& parts, double deflection);
 
 /// Replaces the scene's harness by a routed harness XML (`--routes`). Throws InputError
 /// naming the routes file for a unit mismatch or any harness error.

@@ -14,7 +14,8 @@ namespace loom {
 namespace {
 /// Format and naming version of an entry. 02: repeated product names get the first free "#k"
 /// (01 could give two pieces one name, which the scene then refused; such entries are misses).
-constexpr char kMagic[8] = {'L', 'O', 'O', 'M', 'T', 'C', '0', '2'};
+/// 03: each mesh keeps its leaf index (tessellation by need re-meshes one leaf).
+constexpr char kMagic[8] = {'L', 'O', 'O', 'M', 'T', 'C', '0', '3'};
 
 std::uint64_t fnv1a(const void* data, std::size_t n, std::uint64_t h = 1469598103934665603ull) {
   const auto* p = static_cast<const unsigned char*>(data);
@@ -45,11 +46,13 @@ bool load(const std::filesystem::path& f, std::vector<NamedMesh>& out) {
   for (std::uint64_t i = 0; i < n; ++i) {
     NamedMesh nm;
     std::uint64_t len, nv, nt;
-    std::int32_t faces;
+    std::int32_t faces, leaf;
     if (!get(in, len) || len > 4096) return false;
     nm.name.resize(len);
     if (!in.read(nm.name.data(), static_cast<std::streamsize>(len))) return false;
-    if (!get(in, faces) || !get(in, nv) || !get(in, nt) || nv > (1ull << 32) || nt > (1ull << 32)) return false;
+    if (!get(in, faces) || !get(in, leaf) || !get(in, nv) || !get(in, nt) || nv > (1ull << 32) ||
+        nt > (1ull << 32))
+      return false;
     // A corrupt or truncated entry must not size the arrays (2^32 vertices: 96 GB, then
     // std::bad_alloc on every run until the cache was deleted): the rest of the file bounds them.
     const auto at = in.tellg();
@@ -58,6 +61,7 @@ bool load(const std::filesystem::path& f, std::vector<NamedMesh>& out) {
     const std::uint64_t tri_bytes = sizeof(nm.mesh.triangles[0]);
     if (nv > left / sizeof(Vec3) || nt > (left - nv * sizeof(Vec3)) / tri_bytes) return false;
     nm.brep_faces = faces;
+    nm.leaf = leaf;
     nm.mesh.vertices.resize(nv);
     nm.mesh.triangles.resize(nt);
     if (!in.read(reinterpret_cast<char*>(nm.mesh.vertices.data()), static_cast<std::streamsize>(nv * sizeof(Vec3))))
@@ -83,6 +87,7 @@ void store(const std::filesystem::path& f, const std::vector<NamedMesh>& meshes)
       put<std::uint64_t>(os, nm.name.size());
       os.write(nm.name.data(), static_cast<std::streamsize>(nm.name.size()));
       put<std::int32_t>(os, nm.brep_faces);
+      put<std::int32_t>(os, nm.leaf);
       put<std::uint64_t>(os, nm.mesh.vertices.size());
       put<std::uint64_t>(os, nm.mesh.triangles.size());
       os.write(reinterpret_cast<const char*>(nm.mesh.vertices.data()),

@@ -426,6 +426,15 @@ void apply_matching_routes(Scene& scene, const std::filesystem::path& routes) {
   if (same) scene.harness.kbl = designed->kbl;
 }
 
+TessellationByNeed refine_for_audit(Scene& scene, const AuditOptions& opt) {
+  if (!scene.tessellation.by_need) return {};
+  std::vector<AuditCable> ignored;
+  const std::vector<CableInput> inputs =
+      scene.has_harness ? audit_cable_inputs(scene.harness, ignored) : std::vector<CableInput>{};
+  const double tol = opt.check.tolerance > 0.0 ? opt.check.tolerance : default_clash_tolerance(inputs);
+  return tessellate_by_need(scene, inputs, tol);
+}
+
 Scene load_audit_scene(const std::filesystem::path& scene_file, const AuditOptions& opt, const SceneLoadOptions& load,
                        SceneLoadReport* report) {
   Scene scene = load_scene(scene_file, load, report);
@@ -439,10 +448,14 @@ AuditReport audit_scene_file(const std::filesystem::path& scene_file, const Audi
   SceneLoadReport load_rep;
   SceneLoadOptions load_opt;
   load_opt.progress = opt.progress;
+  load_opt.tessellate_by_need = true;
   Scene scene = load_audit_scene(scene_file, opt, load_opt, &load_rep);
+  const TessellationByNeed tess = refine_for_audit(scene, opt);
   const double load_ms = t0.ms();
   AuditReport rep = run_audit(scene, opt);
   rep.load_ms = load_ms;
+  rep.tessellation = tess;
+  if (tess.used) rep.notes.push_back(tessellation_note(tess));
   rep.notes.insert(rep.notes.begin(), load_rep.notes.begin(), load_rep.notes.end());
   if (loaded) *loaded = std::move(scene);
   return rep;

@@ -10,6 +10,7 @@
 #include "routing/audit/motion_clearance.hpp"
 #include "routing/audit/segregation.hpp"
 #include "routing/audit/supports.hpp"
+#include "routing/audit/tessellation_need.hpp"
 #include "routing/audit/voxel_findings.hpp"
 
 #include <filesystem>
@@ -75,6 +76,9 @@ struct AuditReport {
   MotionAudit motion;
   /// Each harness segment as FROM/TO (the spelling of <clamp segment>), by segment index.
   std::vector<std::string> segment_names;
+  /// Tessellation by need (audit_scene_file, when the scene asks for it): refined parts
+  /// index part_names.
+  TessellationByNeed tessellation;
 
   /// True when any clash or violation was found.
   bool found_problems() const {
@@ -132,6 +136,12 @@ AuditReport run_audit(const Scene& scene, const AuditOptions& opt);
 /// (apply_matching_routes) and the check of a requested tolerance, as audit_scene_file does.
 Scene load_audit_scene(const std::filesystem::path& scene_file, const AuditOptions& opt, const SceneLoadOptions& load,
                        SceneLoadReport* report = nullptr);
+
+/// Tessellation by need for an audit of `scene` (loaded with tessellate_by_need): the
+/// coarse CAD parts its routed cables come within reach of are meshed at the fine
+/// deflection (tessellate_by_need, at the audit's tolerance). Nothing when the scene does
+/// not ask for it; without a harness every part stays coarse (nothing is checked).
+TessellationByNeed refine_for_audit(Scene& scene, const AuditOptions& opt);
 
 /// Loads the scene file (timed as timing_ms.load), applies --routes (apply_matching_routes),
 /// and audits it. Throws InputError (exit 2)

@@ -189,6 +189,14 @@ json audit_report_json(const AuditReport& rep) {
                    {"pair_tests", r.counters.pair_tests},
                    {"samples", r.counters.samples}};
   j["triangles"] = rep.triangles;
+  if (rep.tessellation.used) {
+    const TessellationByNeed& t = rep.tessellation;
+    json refined = json::array();
+    for (const int q : t.refined) refined.push_back(rep.part_names.at(static_cast<std::size_t>(q)));
+    j["tessellation"] = {{"policy", "by-need"},           {"coarse_deflection", t.coarse_deflection},
+                         {"fine_deflection", t.fine_deflection}, {"refined", refined},
+                         {"coarse_parts", t.coarse_parts}, {"ms", t.ms}};
+  }
   j["notes"] = rep.notes;
   return j;
 }
