@@ -280,6 +280,23 @@ def alpha_sim_split_rows():
     ]
 
 
+def tessellation_need_rows():
+    name = "tessellation_need.csv"
+    t = rows(name)
+    need = [r for r in t if r["policy"] == "by-need"]
+    same = sum(r["same_findings"] == "yes" for r in need)
+    ratios = []
+    for r in need:
+        u = pick(t, name, assembly=r["assembly"], cable_mm=r["cable_mm"], policy="uniform-fine")
+        ratios.append(num(r, "load_ms", name) / num(u, "load_ms", name))
+    return [
+        ("tessellation by need, bundled STEP assemblies × 2 cable sizes: findings; first load against uniform",
+         f"`{name}`", f"as the fine mesh in {same} of {len(need)}; {sig(min(ratios))}–{sig(max(ratios))}× the uniform "
+         "load (fine meshes are cheap here)", "identical; faster where fine meshing costs minutes",
+         status(same == len(need) and max(ratios) < 1)),
+    ]
+
+
 def planning_rows():
     p = rows("planner_summary.csv")
 
@@ -331,7 +348,7 @@ def scan_rows():
 
 def table():
     lines = ["| measure | bench/results | measured | target | status |", "|---|---|---|---|---|"]
-    for group in (audit_rows, harness_audit_rows, fcl_peer_rows, audit_mpi_rows, index_rows, centerline_rows, alpha_sim_rows, planning_rows, scan_rows):
+    for group in (audit_rows, harness_audit_rows, fcl_peer_rows, audit_mpi_rows, index_rows, centerline_rows, alpha_sim_rows, tessellation_need_rows, planning_rows, scan_rows):
         for row in group():
             lines.append("| " + " | ".join(row) + " |")
     return "\n".join(lines) + "\n"

@@ -636,7 +636,8 @@ void retessellate_parts(Scene& scene, const std::vector<int>& parts, double defl
     for (const int k : ks) leaves.push_back(scene.parts[static_cast<std::size_t>(k)].source_leaf);
     std::sort(leaves.begin(), leaves.end());
     leaves.erase(std::unique(leaves.begin(), leaves.end()), leaves.end());
-    std::vector<NamedMesh> pieces = compound ? read_cad_file(file, tp, false) : read_cad_file(file, tp, true, &leaves);
+    std::vector<NamedMesh> pieces = compound ? read_cad_file_cached(file, tp, false)
+                                             : read_cad_file_cached(file, tp, true, nullptr, &leaves);
     for (const int k : ks) {
       Part& p = scene.parts[static_cast<std::size_t>(k)];
       const auto it = std::find_if(pieces.begin(), pieces.end(),

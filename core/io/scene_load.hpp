@@ -42,8 +42,9 @@ Scene load_scene(const std::filesystem::path& toml, const SceneLoadOptions& opt 
                  SceneLoadReport* report = nullptr);
 
 /// Tessellates the given CAD parts of a loaded scene (indices into scene.parts) again at
-/// `deflection` (scene units) from their files, each with its leaf and entry transform;
-/// meshes, closedness and deflection replaced. Throws InputError naming the file.
+/// `deflection` (scene units) from their files, each with its leaf and entry transform,
+/// through the tessellation cache (keyed by the leaves too); meshes, closedness and
+/// deflection replaced. Throws InputError naming the file.
 void retessellate_parts(Scene& scene, const std::vector<int>& parts, double deflection);
 
 /// Replaces the scene's harness by a routed harness XML (`--routes`). Throws InputError

@@ -109,7 +109,8 @@ std::filesystem::path tessellation_cache_dir() {
   return {};
 }
 
-std::string tessellation_cache_key(const std::filesystem::path& file, const TessellationParams& tp, bool split) {
+std::string tessellation_cache_key(const std::filesystem::path& file, const TessellationParams& tp, bool split,
+                                   const std::vector<int>* only_leaves) {
   std::ifstream in(file, std::ios::binary);
   std::uint64_t h = 1469598103934665603ull;
   char buf[1 << 16];
@@ -118,27 +119,32 @@ std::string tessellation_cache_key(const std::filesystem::path& file, const Tess
   h = fnv1a(params, sizeof params, h);
   const unsigned char s = split ? 1 : 0;
   h = fnv1a(&s, 1, h);
+  if (only_leaves) {
+    const std::uint64_t n = only_leaves->size();
+    h = fnv1a(&n, sizeof n, h);
+    h = fnv1a(only_leaves->data(), only_leaves->size() * sizeof(int), h);
+  }
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
   return hex;
 }
 
 std::vector<NamedMesh> read_cad_file_cached(const std::filesystem::path& path, const TessellationParams& tp,
-                                            bool split, bool* hit) {
+                                            bool split, bool* hit, const std::vector<int>* only_leaves) {
   // Before the key hashes its bytes: a FIFO never gives any, a device such as /dev/zero never ends.
   require_input_file(path, "file");
   const auto dir = tessellation_cache_dir();
   std::vector<NamedMesh> out;
   if (dir.empty()) {
     if (hit) *hit = false;
-    return read_cad_file(path, tp, split);
+    return read_cad_file(path, tp, split, only_leaves);
   }
-  const auto f = dir / (tessellation_cache_key(path, tp, split) + ".tess");
+  const auto f = dir / (tessellation_cache_key(path, tp, split, only_leaves) + ".tess");
   if (load(f, out)) {
     if (hit) *hit = true;
     return out;
   }
-  out = read_cad_file(path, tp, split);
+  out = read_cad_file(path, tp, split, only_leaves);
   store(f, out);
   if (hit) *hit = false;
   return out;
