@@ -631,7 +631,8 @@ void retessellate_parts(Scene& scene, const std::vector<int>& parts, double defl
     by_file[{p.source_file, p.source_leaf < 0}].push_back(k);
   }
   for (const auto& [key, ks] : by_file) {
-    const auto& [file, compound] = key;
+    const std::string& file = key.first;
+    const bool compound = key.second;  // a plain variable: lambdas may not capture structured bindings (C++17)
     std::vector<int> leaves;
     for (const int k : ks) leaves.push_back(scene.parts[static_cast<std::size_t>(k)].source_leaf);
     std::sort(leaves.begin(), leaves.end());
