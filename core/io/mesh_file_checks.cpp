@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cerrno>
+#include <climits>
 #include <charconv>
 #include <cstring>
 #include <cmath>
@@ -14,6 +16,7 @@
 #include <cstdint>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -78,7 +81,31 @@ struct PlyProperty {
   bool count_signed = false;  ///< the length field's type is signed (a negative length is corrupt)
   std::uint64_t bytes = 0;
   bool floating = false;  ///< the values are float or double
+  bool value_signed = false;  ///< integer values of a signed type
+  std::string name;
 };
+
+/// True for the list of a face's vertex indices, as Assimp reads it.
+bool vertex_index_list(const std::string& element, const PlyProperty& p) {
+  return element == "face" && p.list && !p.floating && (p.name == "vertex_indices" || p.name == "vertex_index");
+}
+
+/// Refuses a face's vertex index outside [0, vertices). Why: Assimp takes the index as
+/// given, and one far outside the vertex list corrupted its heap (ASan, libFuzzer).
+void check_vertex_index(const std::filesystem::path& path, int line, std::uint64_t instance, long long index,
+                        std::uint64_t vertices) {
+  if (index >= 0 && static_cast<std::uint64_t>(index) < vertices) return;
+  throw InputError({path.string(), line, "element face instance " + std::to_string(instance)},
+                   "vertex index " + std::to_string(index) + " is not one of the " + std::to_string(vertices) +
+                       " vertices");
+}
+
+/// The vertex count a PLY header declares (its "vertex" element), if it has one.
+std::optional<std::uint64_t> ply_vertex_count(const std::vector<PlyElementExtent>& extents) {
+  for (const PlyElementExtent& e : extents)
+    if (e.name == "vertex") return e.count;
+  return std::nullopt;
+}
 
 /// Whether a PLY integer type is signed.
 bool ply_scalar_signed(const std::string& t) {
@@ -150,6 +177,8 @@ PlyProperty read_ply_property(const std::vector<std::string>& w, int line_no, co
   const std::string& type = p.list ? w[3] : w[1];
   p.bytes = ply_scalar_bytes(type);
   p.floating = type.rfind("float", 0) == 0 || type == "double";
+  p.value_signed = ply_scalar_signed(type);
+  p.name = w.back();
   // A list's length is a whole number: a float or double count was read by Assimp as a
   // float and by this check as an integer, so the two walked different faces, and Assimp's
   // aborted its triangulation (ai_assert).
@@ -290,6 +319,19 @@ std::string list_length_text(const std::array<unsigned char, 8>& b, std::size_t 
   return "-" + std::to_string(magnitude);
 }
 
+/// A binary integer of `bytes` ≤ 8 bytes as its PLY type reads it (unsigned values beyond
+/// the range of long long saturate: no vertex list is that long).
+long long ply_binary_int(const std::array<unsigned char, 8>& b, std::size_t bytes, bool big_endian, bool is_signed) {
+  std::uint64_t u = 0;
+  for (std::size_t k = 0; k < bytes; ++k) u = (u << 8) | b[big_endian ? k : bytes - 1 - k];
+  const bool negative = is_signed && ((u >> (8 * bytes - 1)) & 1u);
+  if (negative && bytes < 8) u |= ~std::uint64_t{0} << (8 * bytes);  // sign extension
+  if (!negative && u > static_cast<std::uint64_t>(LLONG_MAX)) return LLONG_MAX;
+  long long v = 0;
+  std::memcpy(&v, &u, sizeof v);  // two's complement, without an implementation-defined cast
+  return v;
+}
+
 [[noreturn]] void bad_list(const std::filesystem::path& path, const PlyElementExtent& e, std::uint64_t instance,
                            const std::string& length, std::uint64_t left) {
   const std::string where = "element " + e.name + " instance " + std::to_string(instance);
@@ -315,6 +357,7 @@ void check_face_length(const std::filesystem::path& path, const PlyElementExtent
 /// skipped whole.
 void check_ply_binary_lists(const std::filesystem::path& path, const PlyLayout& layout, std::uint64_t size) {
   const bool big = layout.format == PlyLayout::Format::BinaryBig;
+  const std::optional<std::uint64_t> vertices = ply_vertex_count(layout.extents);
   ByteCursor cur(path, layout.data_at, size);
   for (std::size_t i = 0; i < layout.extents.size(); ++i) {
     const PlyElementExtent& e = layout.extents[i];
@@ -339,7 +382,14 @@ void check_ply_binary_lists(const std::filesystem::path& path, const PlyLayout& 
             list_length_text(raw, static_cast<std::size_t>(p.count_bytes), big, p.count_signed, n);
         if (n > cur.left() / p.bytes) bad_list(path, e, k, text, cur.left());
         check_face_length(path, e, e.line, k, n);
-        cur.skip(n * p.bytes);
+        if (!(vertices && vertex_index_list(e.name, p))) {
+          cur.skip(n * p.bytes);
+          continue;
+        }
+        for (std::uint64_t v = 0; v < n; ++v) {
+          const auto bytes = static_cast<std::size_t>(p.bytes);
+          check_vertex_index(path, e.line, k, ply_binary_int(cur.take(bytes), bytes, big, p.value_signed), *vertices);
+        }
       }
   }
 }
@@ -384,6 +434,7 @@ std::vector<std::string> ply_words(const std::string& line) {
 /// A list's length is checked against the bytes left before anything else (Assimp allocates
 /// the list first: "4000000000 0 1 2" ended in std::bad_alloc).
 void check_ply_ascii_body(const std::filesystem::path& path, const PlyLayout& layout, std::uint64_t size) {
+  const std::optional<std::uint64_t> vertices = ply_vertex_count(layout.extents);
   std::ifstream in(path, std::ios::binary);
   in.seekg(static_cast<std::streamoff>(layout.data_at));
   std::uint64_t line_at_byte = layout.data_at;
@@ -427,6 +478,11 @@ void check_ply_ascii_body(const std::filesystem::path& path, const PlyLayout& la
           std::string why;
           if (!ply_ascii_value(w[v], p.floating, why))
             throw InputError({path.string(), line_no, where}, "value '" + w[v] + "' " + why);
+          if (vertices && vertex_index_list(e.name, p)) {
+            errno = 0;
+            const long long index = std::strtoll(w[v].c_str(), nullptr, 10);
+            check_vertex_index(path, line_no, k, errno == ERANGE ? -1 : index, *vertices);
+          }
         }
         at += static_cast<std::size_t>(n);
       }

@@ -563,6 +563,31 @@ TEST(FuzzRegression, PlyHeaderFormFeedSeparatorAborted) {
                       "ff.ply:5: PLY header: words separated by a form feed or vertical tab (byte 12)");
 }
 
+// A binary face naming vertex −67,108,867 of 4 (libFuzzer, seed 7): Assimp took the index as
+// given and corrupted its heap (an ASan CHECK on a freed chunk). Every face index is checked
+// against the vertex count now, binary (signed and unsigned types) and ASCII.
+TEST(FuzzRegression, PlyFaceIndexOutsideTheVerticesCorruptedTheHeap) {
+  const fs::path d = scratch();
+  const std::string head = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+                           "property float y\nproperty float z\nelement face 1\nproperty list uchar ";
+  std::string verts;
+  for (const float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) verts.append(reinterpret_cast<const char*>(&v), 4);
+  auto face = [](std::initializer_list<std::int32_t> ids) {
+    std::string f(1, static_cast<char>(ids.size()));
+    for (const std::int32_t i : ids) f.append(reinterpret_cast<const char*>(&i), 4);
+    return f;
+  };
+  expect_part_refused(d, "neg.ply", head + "int vertex_indices\nend_header\n" + verts + face({0, -67108867, 2}),
+                      "neg.ply:7: element face instance 0: vertex index -67108867 is not one of the 3 vertices");
+  expect_part_refused(d, "big.ply", head + "uint vertex_indices\nend_header\n" + verts + face({0, 1, -2}),
+                      "big.ply:7: element face instance 0: vertex index 4294967294 is not one of the 3 vertices");
+  expect_part_refused(d, "three.ply", head + "int vertex_index\nend_header\n" + verts + face({0, 1, 3}),
+                      "vertex index 3 is not one of the 3 vertices");
+  std::string ascii = ascii_ply_triangle("property float y", "property list uchar int vertex_indices");
+  ascii.replace(ascii.rfind("3 0 1 2"), 7, "3 0 -1 2");
+  expect_part_refused(d, "a.ply", ascii, "a.ply:13: element face instance 0: vertex index -1 is not one of the 3 vertices");
+}
+
 // A face whose vertex count is beyond 64 bits (libFuzzer): the count saturated to 2^64 − 1,
 // the check's "count + 1 > words" wrapped to 0 and it read past the face's words (ASan
 // heap-buffer-overflow in the pre-check itself).
