@@ -229,6 +229,14 @@ void read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
         w[0] != "comment" && w[0] != "obj_info")
       refuse("PLY header", "words separated by a form feed or vertical tab (byte " + std::to_string(int(line[odd])) +
                                "): only spaces and tabs separate them");
+    // Assimp also ends a header line at a carriage return: "property float \rz" was a
+    // property without a name to it and a line "z", while this check read "property float
+    // z" (the data laid out apart; Assimp's triangulation aborted). A comment is no
+    // exception: what follows the return would be read as a line of its own. Only the
+    // return of a CRLF line end is a line's last byte.
+    if (const std::size_t cr = line.find('\r'); cr != std::string::npos && cr + 1 < line.size())
+      refuse("PLY header", "a carriage return inside the line (byte 13 at column " + std::to_string(cr + 1) +
+                               "): only line ends may hold one");
     if (w.empty() || w[0] == "comment" || w[0] == "obj_info" || (line_no == 1 && w[0] == "ply")) continue;
     if (w[0] == "format") {
       const std::string name = w.size() >= 2 ? w[1] : std::string();

@@ -588,6 +588,23 @@ TEST(FuzzRegression, PlyFaceIndexOutsideTheVerticesCorruptedTheHeap) {
   expect_part_refused(d, "a.ply", ascii, "a.ply:13: element face instance 0: vertex index -1 is not one of the 3 vertices");
 }
 
+// "property float \rz" (libFuzzer, seed 7): Assimp ends a header line at a carriage return
+// and read a property with no name and a line "z", the pre-check "property float z"; the
+// data was laid out apart and Assimp's triangulation aborted. A comment hides nothing either.
+TEST(FuzzRegression, PlyHeaderCarriageReturnInsideALineAborted) {
+  const fs::path d = scratch();
+  expect_part_refused(d, "cr.ply", ascii_ply_triangle("property float \rz", "property list uchar int vertex_indices"),
+                      "cr.ply:5: PLY header: a carriage return inside the line (byte 13 at column 16)");
+  std::string comment = ascii_ply_triangle("property float y", "property list uchar int vertex_indices");
+  comment.insert(comment.find("element vertex"), "comment a\relement vertex 9\n");
+  expect_part_refused(d, "c.ply", comment, "c.ply:3: PLY header: a carriage return inside the line");
+  // CRLF line ends stay readable.
+  std::string crlf = ascii_ply_triangle("property float y", "property list uchar int vertex_indices");
+  for (std::size_t at = crlf.find('\n'); at != std::string::npos; at = crlf.find('\n', at + 2)) crlf.insert(at, "\r");
+  write(d / "crlf.ply", crlf);
+  EXPECT_EQ(bounded_info_of_part(d, "crlf.ply").status, 0);
+}
+
 // A face whose vertex count is beyond 64 bits (libFuzzer): the count saturated to 2^64 − 1,
 // the check's "count + 1 > words" wrapped to 0 and it read past the face's words (ASan
 // heap-buffer-overflow in the pre-check itself).
