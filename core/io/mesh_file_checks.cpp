@@ -97,7 +97,7 @@ void check_vertex_index(const std::filesystem::path& path, int line, std::uint64
   if (index >= 0 && static_cast<std::uint64_t>(index) < vertices) return;
   throw InputError({path.string(), line, "element face instance " + std::to_string(instance)},
                    "vertex index " + std::to_string(index) + " is not one of the " + std::to_string(vertices) +
-                       " vertices");
+                       " vertices" + (vertices > 0 ? " (0.." + std::to_string(vertices - 1) + ")" : std::string()));
 }
 
 /// The vertex count a PLY header declares (its "vertex" element), if it has one.
