@@ -26,21 +26,21 @@ bool launched_by_mpi() {
   return false;
 }
 
-MpiSession::MpiSession() {
+MpiWorld::MpiWorld() {
   int provided = 0;
   MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
   MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
   MPI_Comm_size(MPI_COMM_WORLD, &size_);
 }
 
-MpiSession::~MpiSession() { MPI_Finalize(); }
+MpiWorld::~MpiWorld() { MPI_Finalize(); }
 
-int MpiSession::broadcast(int value) const {
+int MpiWorld::broadcast(int value) const {
   MPI_Bcast(&value, 1, MPI_INT, 0, MPI_COMM_WORLD);
   return value;
 }
 
-void MpiSession::agree(bool failed, const std::string& message, bool input_error) const {
+void MpiWorld::agree(bool failed, const std::string& message, bool input_error) const {
   int first = failed ? rank_ : size_;
   MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
   if (first == size_) return;
@@ -80,7 +80,7 @@ Bytes exchange(int dst, int src, const Bytes& out) {
 }
 
 /// Every rank's `mine`, by rank (pairwise rounds of exchange()).
-std::vector<Bytes> all_gather(const MpiSession& mpi, const Bytes& mine) {
+std::vector<Bytes> all_gather(const MpiWorld& mpi, const Bytes& mine) {
   std::vector<Bytes> all(static_cast<std::size_t>(mpi.size()));
   all[static_cast<std::size_t>(mpi.rank())] = mine;
   for (int step = 1; step < mpi.size(); ++step) {
@@ -228,20 +228,6 @@ std::string human_bytes(double bytes) {
   return buf;
 }
 
-/// The cables' centrelines as polylines, for the plan's cable-length weights.
-std::vector<std::vector<Vec3>> cable_polylines(const Scene& scene) {
-  std::vector<std::vector<Vec3>> out;
-  if (!scene.has_harness) return out;
-  std::vector<AuditCable> cables;
-  constexpr int kPointsPerCable = 64;
-  for (const CableInput& c : audit_cable_inputs(scene.harness, cables)) {
-    auto& line = out.emplace_back();
-    for (int i = 0; i <= kPointsPerCable; ++i)
-      line.push_back(c.curve.position(c.curve.u_min() + (c.curve.u_max() - c.curve.u_min()) * i / kPointsPerCable));
-  }
-  return out;
-}
-
 /// Refuses a plan in which some rank would need more than `max_memory` bytes.
 void check_memory(const ShardPlan& plan, double max_memory, const std::filesystem::path& scene_file) {
   if (!(max_memory > 0.0)) return;
@@ -278,7 +264,7 @@ TessellationByNeed by_need_summary(const Scene& scene, const std::vector<PartRec
 
 }  // namespace
 
-ShardedAudit sharded_audit(const MpiSession& mpi, const std::filesystem::path& scene_file, const AuditOptions& opt,
+ShardedAudit sharded_audit(const MpiWorld& mpi, const std::filesystem::path& scene_file, const AuditOptions& opt,
                            double max_memory) {
   const Stopwatch t0;
   ShardedAudit out;
@@ -329,7 +315,10 @@ ShardedAudit sharded_audit(const MpiSession& mpi, const std::filesystem::path& s
         throw InputError({scene_file.string(), 0, "part '" + r.name + "'"}, "duplicate part name '" + r.name + "'");
     std::vector<ShardPartBox> boxes;
     for (const PartRecord& r : parts) boxes.push_back({r.box, r.triangles, r.moving});
-    plan = plan_shards(boxes, cable_polylines(out.scene), mpi.size());
+    std::vector<AuditCable> routed;
+    const std::vector<CableInput> cables =
+        out.scene.has_harness ? audit_cable_inputs(out.scene.harness, routed) : std::vector<CableInput>{};
+    plan = plan_shards(boxes, cable_polylines(cables), mpi.size());
     check_memory(plan, max_memory, scene_file);
   });
   // 4. Parts to their owners: pairwise rounds, each rank sending what it read for the partner.

@@ -23,12 +23,12 @@ bool launched_by_mpi();
 
 /// MPI_Init_thread on construction (funneled: only the calling thread talks MPI),
 /// MPI_Finalize on destruction.
-class MpiSession {
+class MpiWorld {
  public:
-  MpiSession();
-  ~MpiSession();
-  MpiSession(const MpiSession&) = delete;
-  MpiSession& operator=(const MpiSession&) = delete;
+  MpiWorld();
+  ~MpiWorld();
+  MpiWorld(const MpiWorld&) = delete;
+  MpiWorld& operator=(const MpiWorld&) = delete;
   int rank() const { return rank_; }
   int size() const { return size_; }
   bool root() const { return rank_ == 0; }
@@ -78,15 +78,15 @@ struct ShardedAudit {
   std::vector<ShardSummary> ranks;  ///< rank 0: one per rank
 };
 
-/// Runs the audit of `scene_file` sharded over the session's ranks (every rank calls it
+/// Runs the audit of `scene_file` sharded over the ranks of MPI_COMM_WORLD (every rank calls it
 /// with the same arguments). `max_memory` > 0: refuse, before any index is built, a plan
 /// in which some rank would need more bytes than that (kRankBytesPerTriangle), naming
 /// the rank, the figure and the ranks the scene needs. Throws ShardFailure.
-ShardedAudit sharded_audit(const MpiSession& mpi, const std::filesystem::path& scene_file, const AuditOptions& opt,
+ShardedAudit sharded_audit(const MpiWorld& mpi, const std::filesystem::path& scene_file, const AuditOptions& opt,
                            double max_memory);
 
 template <class F>
-void MpiSession::collective(F&& fn) const {
+void MpiWorld::collective(F&& fn) const {
   std::string message;
   bool failed = false, input = false;
   try {

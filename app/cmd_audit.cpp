@@ -112,7 +112,7 @@ void print_outcome(const AuditFlags& f, const AuditReport& rep, const nlohmann::
 /// another report.
 int run_sharded_audit_command(const AuditFlags& f, AuditOptions opt) {
   const double max_memory = f.max_memory.empty() ? 0.0 : byte_size_value(f.max_memory);
-  MpiSession mpi;
+  MpiWorld mpi;
   try {
     std::optional<OutputSet> outputs;
     const auto report_path = std::filesystem::path(f.out) / "report.json";

@@ -314,19 +314,6 @@ class ByteCursor {
   std::uint64_t pos_ = 0, size_ = 0;
 };
 
-/// A binary list length of `bytes` bytes as the integer the header names, in decimal
-/// ("-1" for a signed field with its top bit set).
-std::string list_length_text(const std::array<unsigned char, 8>& b, std::size_t bytes, bool big_endian,
-                             bool is_signed, std::uint64_t& value) {
-  value = 0;
-  for (std::size_t k = 0; k < bytes; ++k) value = (value << 8) | b[big_endian ? k : bytes - 1 - k];
-  const std::uint64_t top = std::uint64_t{1} << (8 * bytes - 1);
-  if (!is_signed || (value & top) == 0) return std::to_string(value);
-  const std::uint64_t magnitude = (top << 1) - value;  // two's complement of a `bytes`-byte field
-  value = UINT64_MAX;                                    // no file holds a negative length
-  return "-" + std::to_string(magnitude);
-}
-
 /// A binary integer of `bytes` ≤ 8 bytes as its PLY type reads it (unsigned values beyond
 /// the range of long long saturate: no vertex list is that long).
 long long ply_binary_int(const std::array<unsigned char, 8>& b, std::size_t bytes, bool big_endian, bool is_signed) {
@@ -338,6 +325,16 @@ long long ply_binary_int(const std::array<unsigned char, 8>& b, std::size_t byte
   long long v = 0;
   std::memcpy(&v, &u, sizeof v);  // two's complement, without an implementation-defined cast
   return v;
+}
+
+/// A binary list length of `bytes` bytes as the integer the header names, in decimal
+/// ("-1" for a signed field with its top bit set); `value` is UINT64_MAX for a negative one
+/// (no file holds a negative length).
+std::string list_length_text(const std::array<unsigned char, 8>& b, std::size_t bytes, bool big_endian,
+                             bool is_signed, std::uint64_t& value) {
+  const long long v = ply_binary_int(b, bytes, big_endian, is_signed);
+  value = v < 0 ? UINT64_MAX : static_cast<std::uint64_t>(v);
+  return std::to_string(v);
 }
 
 [[noreturn]] void bad_list(const std::filesystem::path& path, const PlyElementExtent& e, std::uint64_t instance,

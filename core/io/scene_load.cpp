@@ -447,7 +447,8 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
   scene.tessellation.linear_deflection = {dmin > 0 ? dmin / 20.0 : 0.1 * mm,
                                           dmin > 0 ? "default: smallest cable radius / 10" : "default: 0.1 mm (no cables)"};
   scene.tessellation.angular_deflection_deg = {20.0, "default: 20 degrees"};
-  if (const toml::table* tt = r.section(doc, "tessellation")) {
+  const toml::table* tt = r.section(doc, "tessellation");
+  if (tt) {
     r.only_keys(*tt, "tessellation", {"linear_deflection", "angular_deflection_deg", "by_need", "coarse_deflection"});
     if (const toml::node* n = tt->get("by_need")) {
       const auto b = n->as_boolean();
@@ -466,7 +467,8 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
   }
   scene.tessellation.coarse_deflection = {kCoarseDeflectionFactor * scene.tessellation.linear_deflection.value,
                                           "default: 20 x linear_deflection"};
-  if (const toml::table* tt = r.section(doc, "tessellation"))
+  // Its default and its bound follow the fine deflection, read above.
+  if (tt)
     if (auto v = r.number(*tt, "tessellation", "coarse_deflection")) {
       if (!(*v >= scene.tessellation.linear_deflection.value))
         r.fail(tt->get("coarse_deflection"), "tessellation.coarse_deflection",

@@ -61,6 +61,16 @@ void bisect(std::vector<Item>& items, std::size_t first, std::size_t last, int r
 
 }  // namespace
 
+std::vector<std::vector<Vec3>> cable_polylines(const std::vector<CableInput>& cables, int chords) {
+  std::vector<std::vector<Vec3>> out;
+  for (const CableInput& c : cables) {
+    auto& line = out.emplace_back();
+    const double u0 = c.curve.u_min(), du = c.curve.u_max() - u0;
+    for (int i = 0; i <= chords; ++i) line.push_back(c.curve.position(u0 + du * i / chords));
+  }
+  return out;
+}
+
 ShardPlan plan_shards(const std::vector<ShardPartBox>& parts, const std::vector<std::vector<Vec3>>& cables,
                       int regions) {
   if (regions < 1) throw std::invalid_argument("plan_shards: " + std::to_string(regions) + " regions");

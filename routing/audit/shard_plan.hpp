@@ -7,6 +7,7 @@
 /// Deterministic: every rank computes the same plan from the same input.
 
 #include "core/geometry.hpp"
+#include "routing/audit/clash_check.hpp"
 
 #include <cstddef>
 #include <vector>
@@ -27,6 +28,10 @@ struct ShardPlan {
   std::vector<double> region_work;   ///< each region's share of the work (sums to 1)
   std::vector<std::size_t> region_triangles;  ///< triangles each region owns
 };
+
+/// Each cable's centreline as a polyline of `chords` + 1 points evenly spaced in its
+/// parameter: the cable length plan_shards weighs (a plan needs no finer).
+std::vector<std::vector<Vec3>> cable_polylines(const std::vector<CableInput>& cables, int chords = 64);
 
 /// Splits the parts and the cable chords (`cables`: polylines, world frame) into `regions`
 /// ≥ 1 regions by recursive bisection across the widest extent, at the weighted median

@@ -24,49 +24,49 @@ bool coarse(const Part& p, double fine) { return is_cad_file(p.source_file) && p
 
 std::vector<int> parts_within_reach(const std::vector<Part>& parts, const std::vector<CableInput>& cables,
                                     double routing_clearance, double fine_deflection, double tolerance) {
+  // Only the coarse CAD parts are candidates: the index holds them alone (the scene's
+  // meshes and fine parts can be far larger and are never refined).
   std::vector<int> candidates;
-  double widest = 0.0;  // the largest reach beyond a cable's radius and sample spacing
+  std::vector<Part> coarse_parts;
+  std::vector<double> reach_beyond;  // per candidate: required clearance + its deflection
   for (std::size_t q = 0; q < parts.size(); ++q)
     if (coarse(parts[q], fine_deflection)) {
       candidates.push_back(static_cast<int>(q));
-      widest = std::max(widest, std::max(0.0, routing_clearance + parts[q].clearance) + parts[q].deflection);
+      coarse_parts.push_back(parts[q]);
+      reach_beyond.push_back(std::max(0.0, routing_clearance + parts[q].clearance) + parts[q].deflection);
     }
   if (candidates.empty() || cables.empty()) return {};
-  const EmbreeIndex index(parts);
-  std::vector<AABB> boxes(parts.size());
-  for (std::size_t q = 0; q < parts.size(); ++q) boxes[q] = *index.part_bounds(static_cast<int>(q));
+  const double widest = *std::max_element(reach_beyond.begin(), reach_beyond.end());
+  const EmbreeIndex index(coarse_parts);
+  std::vector<AABB> boxes(coarse_parts.size());
+  for (std::size_t k = 0; k < boxes.size(); ++k) boxes[k] = *index.part_bounds(static_cast<int>(k));
   const BoxTree tree(std::move(boxes));
-  std::vector<char> near(parts.size(), 0);
+  std::vector<char> near(coarse_parts.size(), 0);
   std::mutex mu;
   tbb::parallel_for(std::size_t{0}, cables.size(), [&](std::size_t c) {
     const CableInput& cable = cables[c];
     const double r = cable.radius;
-    std::vector<char> mine(parts.size(), 0);
+    std::vector<char> mine(coarse_parts.size(), 0);
     std::vector<std::uint32_t> cand;
     std::vector<int> inside;
     for (const auto& [s, p] : cable.curve.sample_by_arc_length(r)) {
       (void)s;
       tree.overlapping(AABB{p, p}.inflated(1.5 * r + tolerance + widest), cand);
-      for (const std::uint32_t q : cand) {
-        const Part& part = parts[q];
-        if (mine[q] || !coarse(part, fine_deflection)) continue;
-        const double reach =
-            1.5 * r + tolerance + std::max(0.0, routing_clearance + part.clearance) + part.deflection;
-        if (index.closest_on_part(p, static_cast<int>(q), reach).found()) mine[q] = 1;
-      }
+      for (const std::uint32_t k : cand)
+        if (!mine[k] && index.closest_on_part(p, static_cast<int>(k), 1.5 * r + tolerance + reach_beyond[k]).found())
+          mine[k] = 1;
       if (!cand.empty()) {
         // Deep inside a large closed part no surface is near, and that is a clash too.
         index.inside_parts(p, inside);
-        for (const int q : inside)
-          if (coarse(parts[static_cast<std::size_t>(q)], fine_deflection)) mine[static_cast<std::size_t>(q)] = 1;
+        for (const int k : inside) mine[static_cast<std::size_t>(k)] = 1;
       }
     }
     std::lock_guard<std::mutex> lock(mu);
-    for (std::size_t q = 0; q < parts.size(); ++q) near[q] = static_cast<char>(near[q] | mine[q]);
+    for (std::size_t k = 0; k < near.size(); ++k) near[k] = static_cast<char>(near[k] | mine[k]);
   });
   std::vector<int> out;
-  for (const int q : candidates)
-    if (near[static_cast<std::size_t>(q)]) out.push_back(q);
+  for (std::size_t k = 0; k < candidates.size(); ++k)
+    if (near[k]) out.push_back(candidates[k]);
   return out;
 }
 

@@ -106,22 +106,12 @@ AuditOptions one_thread() {
   return o;
 }
 
-/// The cables as polylines (for the plan), from the audit's own inputs.
-std::vector<std::vector<Vec3>> cable_polylines(const Harness& h) {
-  std::vector<AuditCable> cables;
-  std::vector<std::vector<Vec3>> out;
-  for (const CableInput& c : audit_cable_inputs(h, cables)) {
-    auto& line = out.emplace_back();
-    for (int i = 0; i <= 32; ++i) line.push_back(c.curve.position(c.curve.u_min() + (c.curve.u_max() - c.curve.u_min()) * i / 32));
-  }
-  return out;
-}
-
 /// The audit of `sc` sharded K ways, merged.
 AuditReport sharded(const Scene& sc, int k) {
   std::vector<ShardPartBox> boxes;
   for (const Part& p : sc.parts) boxes.push_back({p.mesh.bounds(), p.mesh.triangle_count(), p.motion.has_value()});
-  const ShardPlan plan = plan_shards(boxes, cable_polylines(sc.harness), k);
+  std::vector<AuditCable> routed;
+  const ShardPlan plan = plan_shards(boxes, cable_polylines(audit_cable_inputs(sc.harness, routed), 32), k);
   std::vector<ShardPart> parts;
   for (const Part& p : sc.parts) parts.push_back({p.name, p.role == PartRole::KeepOut, p.mesh.triangle_count()});
   std::vector<AuditReport> reports;
