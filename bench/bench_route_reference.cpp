@@ -10,7 +10,8 @@
 // seeds; per (scene, seed): routed, clashes, bend violations, length / reference, plan time.
 // Writes bench/results/route_reference.csv.
 //
-//   bench_route_reference [SEEDS]   (default 4)
+//   bench_route_reference [SEEDS] [SCENE]   (default 4 seeds, every scene; with SCENE the CSV is
+//   not written)
 #include "box_mesh.hpp"
 #include "core/stopwatch.hpp"
 #include "index/embree_index.hpp"
@@ -351,8 +352,12 @@ double routed_length(const Harness& h) {
 
 int main(int argc, char** argv) {
   const int seeds = argc > 1 ? std::max(1, std::atoi(argv[1])) : 4;
-  const std::vector<Case> cases = {open_room(), corridor(), bug_trap(), star("y-harness", 3), star("5-way", 5)};
-  const std::string path = std::string(LOOM_SOURCE_DIR) + "/bench/results/route_reference.csv";
+  std::vector<Case> cases = {open_room(), corridor(), bug_trap(), star("y-harness", 3), star("5-way", 5)};
+  const std::string only = argc > 2 ? argv[2] : "";
+  if (!only.empty())
+    cases.erase(std::remove_if(cases.begin(), cases.end(), [&](const Case& c) { return c.name != only; }), cases.end());
+  const std::string path =
+      only.empty() ? std::string(LOOM_SOURCE_DIR) + "/bench/results/route_reference.csv" : "/dev/null";
   std::ofstream csv(path);
   csv << "scene,seed,routed,cables,clashes,bend_violations,length_mm,reference_mm,ratio,plan_ms,longest_plan_ms\n";
   int pairs = 0, clean = 0;
@@ -386,7 +391,9 @@ int main(int argc, char** argv) {
       for (const auto& u : rep.unrouted) std::printf("    not routed %s: %s\n", u.cable.c_str(), u.message.c_str());
       if (bends > 0)
         for (const auto& sg : rep.segments)
-          if (!sg.bend_status.empty()) std::printf("    segment %d: bend %s\n", sg.segment, sg.bend_status.c_str());
+          if (!sg.bend_status.empty())
+            std::printf("    segment %d: bend %s%s%s\n", sg.segment, sg.bend_status.c_str(),
+                        sg.bend_plan.empty() ? "" : "; bend-feasible plan ", sg.bend_plan.c_str());
       csv << c.name << ',' << seed << ',' << routed << ',' << rep.routed.cables.size() << ',' << clashes << ','
           << bends << ',' << len << ',' << ref << ',' << len / ref << ',' << rep.timing.plan << ',' << longest << '\n';
       csv.flush();

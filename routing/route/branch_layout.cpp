@@ -27,6 +27,10 @@ constexpr double kCompassStartShare = 0.25;
 constexpr double kCompassStopShare = 0.01;
 /// Rounds of pairwise opening of exit directions at a node without a main line.
 constexpr int kOpenRounds = 32;
+/// Directions tried for an exit whose run is blocked (≈ 6° apart over the sphere).
+constexpr int kExitCandidates = 1024;
+/// Least angle between two exits of one node that share no cables (radians).
+constexpr double kMinExitGap = M_PI / 6.0;
 /// Turns are clamped below a full reversal so that tan(θ/2) stays finite.
 constexpr double kMaxTurn = M_PI * (179.0 / 180.0);
 
@@ -247,6 +251,36 @@ std::vector<std::string> place_branch_points(Harness& h, const HarnessTopology& 
   return placed;
 }
 
+namespace {
+
+/// Cables passing through node `id` between each pair of its segments (ordered pair of
+/// segment indices → count).
+std::map<std::pair<int, int>, int> passes_at(const Harness& h, const HarnessTopology& topo, const std::string& id) {
+  std::map<std::pair<int, int>, int> passes;
+  for (std::size_t c = 0; c < h.cables.size(); ++c) {
+    const auto& chain = topo.cable_chain(static_cast<int>(c));
+    for (std::size_t k = 0; k + 1 < chain.size(); ++k) {
+      const Segment& sg = h.segments[chain[k].segment];
+      const std::string& at = chain[k].reversed ? sg.from : sg.to;
+      if (at == id) passes[std::minmax(chain[k].segment, chain[k + 1].segment)]++;
+    }
+  }
+  return passes;
+}
+
+/// `n` unit directions spread evenly over the sphere (a Fibonacci lattice), deterministic.
+std::vector<Vec3> sphere_directions(int n) {
+  std::vector<Vec3> out;
+  const double golden = M_PI * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / n, r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    out.emplace_back(r * std::cos(golden * i), r * std::sin(golden * i), z);
+  }
+  return out;
+}
+
+}  // namespace
+
 std::map<std::pair<int, bool>, Vec3> branch_exit_directions(const Harness& h, const HarnessTopology& topo,
                                                             const std::vector<SegmentEnds>& ends) {
   std::map<std::pair<int, bool>, Vec3> exit_dir;
@@ -263,15 +297,7 @@ std::map<std::pair<int, bool>, Vec3> branch_exit_directions(const Harness& h, co
       const Vec3 d = target - bp;
       natural[s] = d.norm() > 1e-12 ? Vec3(d.normalized()) : Vec3::UnitX();
     }
-    std::map<std::pair<int, int>, int> passes;
-    for (std::size_t c = 0; c < h.cables.size(); ++c) {
-      const auto& chain = topo.cable_chain(static_cast<int>(c));
-      for (std::size_t k = 0; k + 1 < chain.size(); ++k) {
-        const Segment& sg = h.segments[chain[k].segment];
-        const std::string& at = chain[k].reversed ? sg.from : sg.to;
-        if (at == br.id) passes[std::minmax(chain[k].segment, chain[k + 1].segment)]++;
-      }
-    }
+    std::map<std::pair<int, int>, int> passes = passes_at(h, topo, br.id);
     // The main line: most cables among the pairs that are nearly a straight line; ties go
     // to the straighter pair.
     std::pair<int, int> main{-1, -1};
@@ -332,6 +358,46 @@ std::map<std::pair<int, bool>, Vec3> branch_exit_directions(const Harness& h, co
     for (int s : inc) exit_dir[{s, h.segments[s].from == br.id}] = e[s];
   }
   return exit_dir;
+}
+
+int free_blocked_exits(const ObstacleIndex& index, const Harness& h, const HarnessTopology& topo,
+                       const std::vector<SegmentEnds>& ends, const std::map<std::string, double>& breakout,
+                       double clearance, std::map<std::pair<int, bool>, Vec3>& exit_dir) {
+  const std::vector<Vec3> candidates = sphere_directions(kExitCandidates);
+  int turned = 0;
+  for (const auto& br : h.branches) {
+    if (!br.position) continue;
+    const Vec3 bp = *br.position;
+    const auto inc = topo.incident_segments(br.id);
+    const auto passes = passes_at(h, topo, br.id);
+    const double out = breakout.count(br.id) ? breakout.at(br.id) : 0.0;
+    for (int s : inc) {
+      const std::pair<int, bool> key{s, h.segments[s].from == br.id};
+      Vec3& e = exit_dir.at(key);
+      const double required = ends[s].radius + clearance;
+      const double run = out + ends[s].min_bend_radius;
+      auto free = [&](const Vec3& u) { return !index.segment_within(bp, bp + run * u, required); };
+      if (!(run > 0.0) || free(e)) continue;
+      // The other exits of this node: those sharing cables with s stay ≥ 90° away, the rest
+      // kMinExitGap (two legs leaving along one line would lie in each other's bundle).
+      auto apart = [&](const Vec3& u) {
+        for (int t : inc) {
+          if (t == s) continue;
+          const Vec3& o = exit_dir.at({t, h.segments[t].from == br.id});
+          const double limit = passes.count(std::minmax(s, t)) ? 0.0 : std::cos(kMinExitGap);
+          if (u.dot(o) > limit) return false;
+        }
+        return true;
+      };
+      const Vec3* best = nullptr;
+      for (const Vec3& u : candidates)
+        if ((!best || u.dot(e) > best->dot(e)) && apart(u) && free(u)) best = &u;
+      if (!best) continue;
+      e = *best;
+      ++turned;
+    }
+  }
+  return turned;
 }
 
 }  // namespace loom

@@ -69,4 +69,15 @@ constexpr double kMaxMainLineTurn = 1.0471975511965976;  // 60°
 std::map<std::pair<int, bool>, Vec3> branch_exit_directions(const Harness& h, const HarnessTopology& topo,
                                                             const std::vector<SegmentEnds>& ends);
 
+/// Turns each exit direction (from branch_exit_directions) whose run — the node's breakout
+/// plus the segment's bend radius, the straight length a leg needs before it can turn — comes
+/// within the segment's radius + `clearance` of a part of `index`: to the free direction
+/// nearest to it among ~1000 spread over the sphere that keeps ≥ 90° from the node's other
+/// exits sharing cables with it and ≥ 30° from the rest. An exit with no such direction is
+/// kept (its breakout stub is then shortened where the segment is planned). A leg leaving
+/// into a part has no room to turn towards its far end. Returns how many exits turned.
+int free_blocked_exits(const ObstacleIndex& index, const Harness& h, const HarnessTopology& topo,
+                       const std::vector<SegmentEnds>& ends, const std::map<std::string, double>& breakout,
+                       double clearance, std::map<std::pair<int, bool>, Vec3>& exit_dir);
+
 }  // namespace loom

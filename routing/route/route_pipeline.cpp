@@ -1,5 +1,6 @@
 #include "routing/route/route_pipeline.hpp"
 
+#include "routing/route/bend_planner.hpp"
 #include "routing/route/support_pull.hpp"
 
 #include "core/stopwatch.hpp"
@@ -41,6 +42,17 @@ constexpr double kStubShare = 0.5;
 /// Re-plans of a segment whose bend repair failed: each with a fresh seed and twice the
 /// previous budget; the first whose curve meets the bend radius is kept.
 constexpr int kBendReplans = 2;
+
+/// The bend-feasible plan rounds its corners this much wider than the bend radius: the
+/// cubic through the arc points bends up to ~22% tighter than the arcs where they meet a leg
+/// (the curvature jumps there; test_arc_line checks the margin on random routes).
+constexpr double kBendPlanMargin = 1.3;
+/// Samples of a bend-feasible plan when the run has no iteration budget (the time limit
+/// then ends it), and at least this many when it has one.
+constexpr std::uint64_t kBendPlanSamples = 20000;
+constexpr std::uint64_t kMinBendPlanSamples = 4000;
+/// The bend-feasible plan's seed is mixed with this, so that it differs from the planner's.
+constexpr std::uint32_t kBendPlanSeedSalt = 0xB3ADu;
 
 /// Grid budget of the voxel layer (cells; ~9 bytes each: distance, nearest part, flags).
 constexpr std::size_t kVoxelLayerCells = std::size_t(16) << 20;
@@ -199,6 +211,8 @@ class RouteRun {
   void add_bundle_tube(int s);
   std::string blocker_name(const ObstacleIndex& index, int part, int s) const;
   int pull_to_supports(const ObstacleIndex& index, const SegmentExits& x, std::vector<Vec3>& key_points) const;
+  std::vector<Vec3> bend_feasible_points(int s, const SegmentGeometry& g, const std::vector<Vec3>& key_points,
+                                         const ObstacleIndex& index, SegmentRouteInfo& info) const;
   void record_unrouted(int s, const PlanResult& plan, bool branch_blocked);
   void build_splines();
   void build_curve(int s);
@@ -388,6 +402,8 @@ void RouteRun::layout_branches() {
     rep_.notes.push_back("branch point '" + id + "' placed by the router");
   exit_dir_ = branch_exit_directions(h_, topo_, ends_);
   for (const auto& br : h_.branches) breakout_[br.id] = breakout_length(topo_, br.id);
+  if (const int turned = free_blocked_exits(*plan_index_, h_, topo_, ends_, breakout_, rep_.clearance + part_extra_, exit_dir_))
+    rep_.notes.push_back(std::to_string(turned) + " branch exit(s) turned away from a part that blocked their run");
 }
 
 EndFrame RouteRun::end_frame(int seg, bool from_end) const {
@@ -700,13 +716,64 @@ void RouteRun::plan_segment(int s, const std::vector<int>& visible) {
   g.b_stub = x.b_stub;
   g.b = x.eb.position;
   g.request = req;
-  g.points = assemble(g, plan.key_points, eps_);
   g.interp.start_tangent = x.ea.exit;
   g.interp.end_tangent = -x.eb.exit;
   g.visible = visible;
+  g.points = bend_feasible_points(s, g, plan.key_points, *obstacles, info);
+  rep_.timing.plan += info.bend_plan_ms;
   geom_[s] = g;
   add_bundle_tube(s);
   store_info(info);
+}
+
+/// The key-point polyline of segment `s` (node to node) from the planner's key points: as
+/// planned when every corner can be rounded clear at the bend radius (the bend repair rounds
+/// them); otherwise the rounded route of a bend-feasible plan around the planner's corridor
+/// (its first and last points lie on the stubs), or, if none is found, as planned (the bend
+/// repair then says where the radius fails).
+std::vector<Vec3> RouteRun::bend_feasible_points(int s, const SegmentGeometry& g, const std::vector<Vec3>& key_points,
+                                                 const ObstacleIndex& index, SegmentRouteInfo& info) const {
+  std::vector<Vec3> planned = assemble(g, key_points, eps_);
+  const double bend = ends_[s].min_bend_radius;
+  // Without a stub at each end the headings are the curve's end tangents at the nodes
+  // themselves; the bend repair handles those.
+  if (!(bend > 0.0) || (g.a_stub - g.a).norm() <= eps_ || (g.b - g.b_stub).norm() <= eps_ || planned.size() < 4 ||
+      !g.interp.start_tangent || !g.interp.end_tangent)
+    return planned;
+  ArcLineEnds ends;
+  ends.start_heading = *g.interp.start_tangent;
+  ends.start_run = (g.a_stub - g.a).norm();
+  ends.end_heading = *g.interp.end_tangent;
+  ends.end_run = (g.b - g.b_stub).norm();
+  const std::vector<Vec3> corners(planned.begin() + 1, planned.end() - 1);  // stub end to stub end
+  const double radius = kBendPlanMargin * bend;
+  const double required = g.request.radius + g.request.clearance;
+  if (arcs_fit(index, corners, ends, radius, required)) return planned;
+  BendPlanRequest bq;
+  bq.start = g.a_stub;
+  bq.goal = g.b_stub;
+  bq.ends = ends;
+  bq.required = required;
+  bq.bend_radius = radius;
+  bq.bounds = g.request.scene_box;
+  for (const Vec3& p : {g.a, g.a_stub, g.b_stub, g.b}) bq.bounds.extend(p);
+  bq.bounds = bq.bounds.inflated(2.0 * radius + required);
+  bq.hint = corners;
+  bq.seed = g.request.seed ^ kBendPlanSeedSalt;
+  const PortfolioBudget budget = portfolio_budget(g.request);
+  bq.time_limit = budget.feasibility_seconds;
+  bq.max_iterations = g.request.max_iterations > 0 ? std::max(budget.feasibility_iterations, kMinBendPlanSamples)
+                                                   : kBendPlanSamples;
+  const BendPlanResult r = plan_bend_feasible(index, bq);
+  info.bend_plan = r.solved() ? "planned" : "failed: " + r.message;
+  info.bend_plan_samples = r.iterations;
+  info.bend_plan_ms = r.time_ms;
+  info.time_limited = info.time_limited || r.time_limited;
+  if (!r.solved()) return planned;
+  std::vector<Vec3> out{g.a};
+  out.insert(out.end(), r.key_points.begin(), r.key_points.end());
+  out.push_back(g.b);
+  return dedupe_consecutive(out, eps_);
 }
 
 /// Records how segment `s` was routed: replaces its entry (a re-plan) or appends one.
@@ -887,7 +954,8 @@ void RouteRun::replan_bend_failures() {
       if (!plan.solved()) continue;
       const SegmentGeometry saved = g;
       const SegmentRouteInfo saved_info = info_of(s);
-      g.points = assemble(g, plan.key_points, eps_);
+      g.points = bend_feasible_points(s, g, plan.key_points, *obstacles_for(s, g.visible), scratch);
+      rep_.timing.plan += scratch.bend_plan_ms;
       build_curve(s);
       if (bend_failed(s)) {
         g = saved;
@@ -898,6 +966,9 @@ void RouteRun::replan_bend_failures() {
       } else {
         info_of(s).plan = plan;
         info_of(s).portfolio = scratch.portfolio;
+        info_of(s).bend_plan = scratch.bend_plan;
+        info_of(s).bend_plan_samples = scratch.bend_plan_samples;
+        info_of(s).bend_plan_ms = scratch.bend_plan_ms;
         info_of(s).replans = attempt;
       }
     }

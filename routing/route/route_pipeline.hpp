@@ -75,6 +75,12 @@ struct SegmentRouteInfo {
   /// (pull_to_structure; only when the scene sets clamp_spacing).
   int support_points = 0;
   std::string bend_status;    ///< outcome of the bend-radius repair
+  /// The bend-feasible plan (routing/route/bend_planner.hpp), run when some corner of the
+  /// planner's route cannot be rounded clear at the bend radius: empty if not run, else
+  /// "planned" or "failed: <why>".
+  std::string bend_plan;
+  std::uint64_t bend_plan_samples = 0;  ///< samples the bend-feasible plan drew
+  double bend_plan_ms = 0.0;            ///< its wall time (part of RouteTimings::plan)
   /// True if the time limit ended any plan of this segment (first plan, clearance retry or
   /// bend re-plan) before its iteration budget: this segment's route is not reproducible.
   bool time_limited = false;

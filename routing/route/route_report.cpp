@@ -111,6 +111,10 @@ json route_report_json(const RouteReport& rep) {
         o["replans"] = info.replans;
         o["support_points"] = info.support_points;
         o["bend_repair"] = info.bend_status;
+        if (!info.bend_plan.empty())
+          o["bend_plan"] = {{"status", info.bend_plan},
+                            {"samples", info.bend_plan_samples},
+                            {"ms", info.bend_plan_ms}};
       }
     }
     segs.push_back(o);
