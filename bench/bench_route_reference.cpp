@@ -384,10 +384,12 @@ int main(int argc, char** argv) {
       clean += ok;
       if (rep.unrouted.empty()) ratios.push_back(len / ref);
       longest_plan = std::max(longest_plan, longest);
+      int bend_plans = 0;
+      for (const auto& s : rep.segments) bend_plans += s.bend_plan == "planned";
       std::printf("  seed %d: %zu/%zu routed, %zu clashes, %zu bend violations, %.1f mm = %.3f x reference, plan %.2f s "
-                  "(longest segment %.2f s)%s\n",
+                  "(longest segment %.2f s), %d of %zu segments bend-feasibly re-planned%s\n",
                   seed, routed, rep.routed.cables.size(), clashes, bends, len, len / ref, rep.timing.plan / 1000.0,
-                  longest / 1000.0, ok ? "" : "  <-");
+                  longest / 1000.0, bend_plans, rep.segments.size(), ok ? "" : "  <-");
       for (const auto& u : rep.unrouted) std::printf("    not routed %s: %s\n", u.cable.c_str(), u.message.c_str());
       if (bends > 0)
         for (const auto& sg : rep.segments)

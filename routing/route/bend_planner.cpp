@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 
@@ -20,10 +21,18 @@ namespace {
 /// Longest step of a tree, in bend radii: long enough that a step can hold the tangent of a
 /// right-angle corner, short enough to turn along a corridor.
 constexpr double kStepRadii = 2.0;
+/// Nodes near a sample among which the one to step from is chosen.
+constexpr unsigned kStepCandidates = 8;
 /// Nodes of the other tree a new node tries to join.
 constexpr unsigned kJoinCandidates = 8;
 /// Share of the samples drawn around the hint (when there is one).
 constexpr double kHintShare = 0.5;
+/// After the first route, the trees grow on for as many samples again, at least this many.
+constexpr std::uint64_t kMoreSamples = 2000;
+/// Sweeps of pulling corners towards their neighbours' midpoint (ends early when none moves).
+constexpr int kRelaxSweeps = 30;
+/// Routes compared (each shortened; the shortest is kept).
+constexpr int kMostRoutes = 16;
 /// Points closer than this share of `required` are one point (shortcut ends, zero steps).
 constexpr double kSamePoint = 1e-6;
 
@@ -118,12 +127,23 @@ class Planner {
     BendPlanResult res;
     trees_[0].add({req_.start, req_.ends.start_heading.normalized(), req_.ends.start_run, -1, Vec3::Zero()});
     trees_[1].add({req_.goal, Vec3(-req_.ends.end_heading.normalized()), req_.ends.end_run, -1, Vec3::Zero()});
-    std::vector<Vec3> path;
-    if (join(0, 0, 0)) path = path_of(0, 0);
-    for (int side = 0; path.empty(); side ^= 1) {
-      if (res.iterations >= req_.max_iterations) break;
+    std::vector<Vec3> best;
+    double best_len = std::numeric_limits<double>::infinity();
+    // Every join is a route: shortened, the shortest is kept. After the first, the trees grow
+    // on for as many samples again (at least kMoreSamples), up to kMostRoutes routes.
+    int routes = 0;
+    std::uint64_t stop = req_.max_iterations;
+    auto take = [&](std::vector<Vec3> path) {
+      res.shortcuts += shorten(path);
+      const double len = arc_line_length(path, req_.ends, req_.bend_radius);
+      if (len < best_len) best_len = len, best = std::move(path);
+      if (routes++ == 0) stop = std::min(req_.max_iterations, std::max(2 * res.iterations, res.iterations + kMoreSamples));
+    };
+    if (join(0, 0, 0)) take(path_of(0, 0));
+    for (int side = 0; routes == 0 || (routes < kMostRoutes && res.iterations < stop); side ^= 1) {
+      if (res.iterations >= stop) break;
       if (t0.seconds() >= req_.time_limit) {
-        res.time_limited = true;
+        res.time_limited = routes == 0;
         break;
       }
       ++res.iterations;
@@ -134,18 +154,17 @@ class Planner {
       trees_[other].nearest_k(trees_[side].nodes[added].p, kJoinCandidates, near);
       for (int b : near)
         if (join(side, added, b)) {
-          path = side == 0 ? path_of(added, b) : path_of(b, added);
+          take(side == 0 ? path_of(added, b) : path_of(b, added));
           break;
         }
     }
-    if (path.empty()) {
+    if (best.empty()) {
       finish_failure(res);
     } else {
-      res.shortcuts = shorten(path);
       res.status = BendPlanStatus::Solved;
-      res.vertices = path;
-      res.length = arc_line_length(path, req_.ends, req_.bend_radius);
-      res.key_points = arc_line_points(path, req_.ends, req_.bend_radius, 0.0);
+      res.vertices = best;
+      res.length = best_len;
+      res.key_points = arc_line_points(best, req_.ends, req_.bend_radius, 0.0);
     }
     res.time_ms = t0.ms();
     return res;
@@ -173,11 +192,31 @@ class Planner {
     return corner_tangent(n.h, u, req_.bend_radius) + leg_slack(n.normal, corner_normal(n.h, u), req_.bend_radius);
   }
 
-  /// Steps from the node of `tree` nearest to q towards it; the new node's id, or −1. The
+  /// Among the kStepCandidates nodes of `tree` nearest to q, the one that reaches q with the
+  /// least distance plus R × the turn it lacks (nearest by position alone keeps choosing a
+  /// node that heads into a wall with no run left to turn).
+  int closest_reachable(Tree& tree, const Vec3& q) {
+    std::vector<int> near;
+    tree.nearest_k(q, kStepCandidates, near);
+    int best = near.front();
+    double best_score = std::numeric_limits<double>::infinity();
+    for (int i : near) {
+      const Node& n = tree.nodes[i];
+      const Vec3 e = q - n.p;
+      const double len = e.norm();
+      const double th = len > 0.0 ? std::atan2(n.h.cross(e).norm(), n.h.dot(e)) : 0.0;
+      const double can = 2.0 * std::atan(std::min(n.run, std::min(len, step_)) / req_.bend_radius);
+      const double score = len + req_.bend_radius * std::max(0.0, th - can);
+      if (score < best_score) best_score = score, best = i;
+    }
+    return best;
+  }
+
+  /// Steps from a node of `tree` near q (closest_reachable) towards it; the new node's id, or −1. The
   /// step turns as far as the node's run allows: first as if no slack were needed (a turn
   /// continuing the corner before), else with the whole slack set aside.
   int extend(Tree& tree, const Vec3& q) {
-    const int ni = tree.nearest(q);
+    const int ni = closest_reachable(tree, q);
     const Node n = tree.nodes[ni];
     Vec3 e = q - n.p;
     const double len = std::min(e.norm(), step_);
@@ -235,8 +274,8 @@ class Planner {
     return arcs_clear(index_, cand, req_.ends, req_.bend_radius, req_.required, lo, hi);
   }
 
-  /// Random shortcuts between two points along the path, then every vertex left out in turn;
-  /// returns how many were kept.
+  /// Random shortcuts between two points along the path, corners pulled towards their
+  /// neighbours, then every vertex left out in turn; returns how many changes were kept.
   std::uint64_t shorten(std::vector<Vec3>& path) {
     std::uint64_t kept = 0;
     for (int round = 0; round < req_.shortcut_rounds && path.size() > 2; ++round) {
@@ -263,6 +302,23 @@ class Planner {
         path = std::move(cand);
         ++kept;
       }
+    }
+    // Pull each corner towards the midpoint of its neighbours while that shortens the route:
+    // shortcuts cut corners, this moves them (a detour a shortcut cannot cross).
+    for (int sweep = 0; sweep < kRelaxSweeps; ++sweep) {
+      bool moved = false;
+      for (std::size_t k = 1; k + 1 < path.size(); ++k)
+        for (double a : {0.5, 0.125}) {
+          std::vector<Vec3> cand = path;
+          cand[k] += a * (0.5 * (path[k - 1] + path[k + 1]) - path[k]);
+          if (better(cand, k - 1, k + 1, arc_line_length(path, req_.ends, req_.bend_radius))) {
+            path = std::move(cand);
+            moved = true;
+            ++kept;
+            break;
+          }
+        }
+      if (!moved) break;
     }
     for (std::size_t k = 1; k + 1 < path.size();) {
       std::vector<Vec3> cand = path;

@@ -11,8 +11,10 @@
 /// is kept only if the step and the arc at its corner are clear. A new node joins the other
 /// tree where the segment between them, the arcs at both ends and the tangents on the
 /// segment fit. Consecutive arcs keep leg_slack of straight between them. A corridor known to be clear (`hint`, e.g. the plan of an unconstrained
-/// planner) draws half the samples around it. The path is then shortened by shortcuts that
-/// keep it bend-feasible and clear (random pairs of points along it, then every vertex).
+/// planner) draws half the samples around it. Each route found is shortened by shortcuts that
+/// keep it bend-feasible and clear (random pairs of points along it, then every vertex); the
+/// trees grow on after the first for as many samples again (at least 2,000, within the
+/// budget), and the shortest of up to 16 routes is kept.
 ///
 /// Reproducible: samples and shortcuts draw from an RNG seeded by BendPlanRequest::seed, so a
 /// run that ends on its iteration budget or on a connection is the same in any process.
@@ -42,7 +44,7 @@ struct BendPlanRequest {
   std::uint32_t seed = 1;    ///< seed of every random draw
   std::uint64_t max_iterations = 20000;  ///< samples drawn at most (both trees together)
   double time_limit = 5.0;   ///< seconds (wall clock; the iteration budget is tested first)
-  int shortcut_rounds = 300;  ///< random shortcut attempts after a solution
+  int shortcut_rounds = 1000;  ///< random shortcut attempts after a solution
 };
 
 /// Outcome of a bend-feasible plan.
@@ -55,8 +57,8 @@ struct BendPlanResult {
   std::vector<Vec3> key_points;  ///< arc_line_points of the vertices (tangent and arc points)
   double length = 0.0;           ///< arc_line_length of the vertices (scene units)
   std::uint64_t iterations = 0;  ///< samples drawn
-  std::uint64_t shortcuts = 0;   ///< shortcuts kept
-  bool time_limited = false;     ///< the wall clock ended the search before its budget
+  std::uint64_t shortcuts = 0;   ///< shortcuts kept (over every route compared)
+  bool time_limited = false;     ///< the wall clock ended the search before a route was found
   double time_ms = 0.0;          ///< wall time of the query
   /// When NoPath: where the hint's corners need more straight run than their legs hold
   /// (ShortLeg::leg −1 if the hint is bend-feasible or absent), and a message with it.

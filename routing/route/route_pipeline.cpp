@@ -98,6 +98,9 @@ struct SegmentGeometry {
   Vec3 a, a_stub, b_stub, b;  ///< the ends and their stub ends, as planned
   PlanRequest request;        ///< what the planner was asked (for re-planning)
   std::vector<int> visible;   ///< segments whose bundles were its obstacles when it was planned
+  /// The planned corners rounded by arcs (node to node) when they fit clear: the points used
+  /// if the bend repair of `points` fails. Empty otherwise.
+  std::vector<Vec3> arc_points;
 };
 
 
@@ -211,8 +214,8 @@ class RouteRun {
   void add_bundle_tube(int s);
   std::string blocker_name(const ObstacleIndex& index, int part, int s) const;
   int pull_to_supports(const ObstacleIndex& index, const SegmentExits& x, std::vector<Vec3>& key_points) const;
-  std::vector<Vec3> bend_feasible_points(int s, const SegmentGeometry& g, const std::vector<Vec3>& key_points,
-                                         const ObstacleIndex& index, SegmentRouteInfo& info) const;
+  void set_bend_feasible_points(int s, SegmentGeometry& g, const std::vector<Vec3>& key_points,
+                                const ObstacleIndex& index, SegmentRouteInfo& info) const;
   void record_unrouted(int s, const PlanResult& plan, bool branch_blocked);
   void build_splines();
   void build_curve(int s);
@@ -719,27 +722,30 @@ void RouteRun::plan_segment(int s, const std::vector<int>& visible) {
   g.interp.start_tangent = x.ea.exit;
   g.interp.end_tangent = -x.eb.exit;
   g.visible = visible;
-  g.points = bend_feasible_points(s, g, plan.key_points, *obstacles, info);
+  set_bend_feasible_points(s, g, plan.key_points, *obstacles, info);
   rep_.timing.plan += info.bend_plan_ms;
   geom_[s] = g;
   add_bundle_tube(s);
   store_info(info);
 }
 
-/// The key-point polyline of segment `s` (node to node) from the planner's key points: as
-/// planned when every corner can be rounded clear at the bend radius (the bend repair rounds
-/// them); otherwise the rounded route of a bend-feasible plan around the planner's corridor
-/// (its first and last points lie on the stubs), or, if none is found, as planned (the bend
-/// repair then says where the radius fails).
-std::vector<Vec3> RouteRun::bend_feasible_points(int s, const SegmentGeometry& g, const std::vector<Vec3>& key_points,
-                                                 const ObstacleIndex& index, SegmentRouteInfo& info) const {
-  std::vector<Vec3> planned = assemble(g, key_points, eps_);
+/// Sets the key-point polyline of segment `s` (node to node) from the planner's key points:
+/// as planned when every corner can be rounded clear at the bend radius (the bend repair
+/// rounds them; g.arc_points keeps the arcs' rounding in case it cannot); otherwise the
+/// rounded route of a bend-feasible plan around the planner's corridor (its first and last
+/// points lie on the stubs), or, if none is found, as planned (the bend repair then says
+/// where the radius fails).
+void RouteRun::set_bend_feasible_points(int s, SegmentGeometry& g, const std::vector<Vec3>& key_points,
+                                        const ObstacleIndex& index, SegmentRouteInfo& info) const {
+  g.points = assemble(g, key_points, eps_);
+  g.arc_points.clear();
+  const std::vector<Vec3>& planned = g.points;
   const double bend = ends_[s].min_bend_radius;
   // Without a stub at each end the headings are the curve's end tangents at the nodes
   // themselves; the bend repair handles those.
   if (!(bend > 0.0) || (g.a_stub - g.a).norm() <= eps_ || (g.b - g.b_stub).norm() <= eps_ || planned.size() < 4 ||
       !g.interp.start_tangent || !g.interp.end_tangent)
-    return planned;
+    return;
   ArcLineEnds ends;
   ends.start_heading = *g.interp.start_tangent;
   ends.start_run = (g.a_stub - g.a).norm();
@@ -748,7 +754,16 @@ std::vector<Vec3> RouteRun::bend_feasible_points(int s, const SegmentGeometry& g
   const std::vector<Vec3> corners(planned.begin() + 1, planned.end() - 1);  // stub end to stub end
   const double radius = kBendPlanMargin * bend;
   const double required = g.request.radius + g.request.clearance;
-  if (arcs_fit(index, corners, ends, radius, required)) return planned;
+  auto node_to_node = [&](const std::vector<Vec3>& rounded) {
+    std::vector<Vec3> out{g.a};
+    out.insert(out.end(), rounded.begin(), rounded.end());
+    out.push_back(g.b);
+    return dedupe_consecutive(out, eps_);
+  };
+  if (arcs_fit(index, corners, ends, radius, required)) {
+    g.arc_points = node_to_node(arc_line_points(corners, ends, radius, 0.0));
+    return;
+  }
   BendPlanRequest bq;
   bq.start = g.a_stub;
   bq.goal = g.b_stub;
@@ -769,11 +784,7 @@ std::vector<Vec3> RouteRun::bend_feasible_points(int s, const SegmentGeometry& g
   info.bend_plan_samples = r.iterations;
   info.bend_plan_ms = r.time_ms;
   info.time_limited = info.time_limited || r.time_limited;
-  if (!r.solved()) return planned;
-  std::vector<Vec3> out{g.a};
-  out.insert(out.end(), r.key_points.begin(), r.key_points.end());
-  out.push_back(g.b);
-  return dedupe_consecutive(out, eps_);
+  if (r.solved()) g.points = node_to_node(r.key_points);
 }
 
 /// Records how segment `s` was routed: replaces its entry (a re-plan) or appends one.
@@ -900,7 +911,13 @@ void RouteRun::build_curve(int s) {
   SegmentGeometry& g = geom_[s];
   std::string status = "not checked";
   if (ends_[s].min_bend_radius > 0.0) {
-    const BendRepairResult chosen = round_corners(s, g, *obstacles_for(s, g.visible));
+    BendRepairResult chosen = round_corners(s, g, *obstacles_for(s, g.visible));
+    if (chosen.status == BendRepairStatus::Failed && !g.arc_points.empty()) {
+      // The planned corners fit arcs of the bend radius (with margin): use those.
+      g.points = std::move(g.arc_points);
+      g.arc_points.clear();
+      chosen = round_corners(s, g, *obstacles_for(s, g.visible));
+    }
     g.curve = chosen.curve;
     g.points = chosen.points.empty() ? g.points : chosen.points;
     status = chosen.status == BendRepairStatus::Failed ? "failed: " + chosen.reason
@@ -954,7 +971,7 @@ void RouteRun::replan_bend_failures() {
       if (!plan.solved()) continue;
       const SegmentGeometry saved = g;
       const SegmentRouteInfo saved_info = info_of(s);
-      g.points = bend_feasible_points(s, g, plan.key_points, *obstacles_for(s, g.visible), scratch);
+      set_bend_feasible_points(s, g, plan.key_points, *obstacles_for(s, g.visible), scratch);
       rep_.timing.plan += scratch.bend_plan_ms;
       build_curve(s);
       if (bend_failed(s)) {
