@@ -12,6 +12,9 @@ namespace {
 constexpr double kStraight = 1e-9;
 /// Chords of a checked arc span at most this angle (radians): sagitta ≤ R·(1 − cos 7.5°) ≈ 0.009 R.
 constexpr double kCheckStep = M_PI / 12.0;
+/// Relative rounding allowed when a leg holds exactly its tangents (a planner steering to the
+/// largest turn a run allows makes the two equal).
+constexpr double kLegTolerance = 1e-9;
 /// A stub's straight run shorter than this (in radii) is none: the arc starts at its node.
 constexpr double kSameRun = 1e-3;
 /// Fewest pieces of a rounded arc (fewer leave a small turn's cubic further from its arc).
@@ -76,7 +79,7 @@ ShortLeg arc_line_short_leg(const std::vector<Vec3>& v, const ArcLineEnds& ends,
     const bool inner = k > 0 && k < n;
     const double length = k == 0 ? ends.start_run : k == n ? ends.end_run : (v[k] - v[k - 1]).norm();
     const double needed = before + after + (inner ? leg_slack(normal(k - 1), normal(k), radius) : 0.0);
-    if (needed > length) {
+    if (needed > length * (1.0 + kLegTolerance)) {
       ShortLeg s;
       s.leg = static_cast<int>(k);
       s.at = (k == n || (k > 0 && before >= after)) ? v[k - 1] : v[k];

@@ -214,8 +214,11 @@ class RouteRun {
   void add_bundle_tube(int s);
   std::string blocker_name(const ObstacleIndex& index, int part, int s) const;
   int pull_to_supports(const ObstacleIndex& index, const SegmentExits& x, std::vector<Vec3>& key_points) const;
-  void set_bend_feasible_points(int s, SegmentGeometry& g, const std::vector<Vec3>& key_points,
-                                const ObstacleIndex& index, SegmentRouteInfo& info) const;
+  void set_planned_points(int s, SegmentGeometry& g, const std::vector<Vec3>& key_points,
+                          const ObstacleIndex& index) const;
+  std::optional<ArcLineEnds> arc_line_ends(int s, const SegmentGeometry& g) const;
+  bool bend_plan(int s, SegmentGeometry& g, const ObstacleIndex& index, SegmentRouteInfo& info) const;
+  bool try_bend_plan(int s);
   void record_unrouted(int s, const PlanResult& plan, bool branch_blocked);
   void build_splines();
   void build_curve(int s);
@@ -722,58 +725,64 @@ void RouteRun::plan_segment(int s, const std::vector<int>& visible) {
   g.interp.start_tangent = x.ea.exit;
   g.interp.end_tangent = -x.eb.exit;
   g.visible = visible;
-  set_bend_feasible_points(s, g, plan.key_points, *obstacles, info);
-  rep_.timing.plan += info.bend_plan_ms;
+  set_planned_points(s, g, plan.key_points, *obstacles);
   geom_[s] = g;
   add_bundle_tube(s);
   store_info(info);
 }
 
-/// Sets the key-point polyline of segment `s` (node to node) from the planner's key points:
-/// as planned when every corner can be rounded clear at the bend radius (the bend repair
-/// rounds them; g.arc_points keeps the arcs' rounding in case it cannot); otherwise the
-/// rounded route of a bend-feasible plan around the planner's corridor (its first and last
-/// points lie on the stubs), or, if none is found, as planned (the bend repair then says
-/// where the radius fails).
-void RouteRun::set_bend_feasible_points(int s, SegmentGeometry& g, const std::vector<Vec3>& key_points,
-                                        const ObstacleIndex& index, SegmentRouteInfo& info) const {
+/// Sets the key-point polyline of segment `s` (node to node) from the planner's key points,
+/// and g.arc_points, their corners rounded by arcs of the bend radius (with margin) when
+/// those fit clear: build_curve uses them if the bend repair of the polyline fails.
+void RouteRun::set_planned_points(int s, SegmentGeometry& g, const std::vector<Vec3>& key_points,
+                                  const ObstacleIndex& index) const {
   g.points = assemble(g, key_points, eps_);
   g.arc_points.clear();
-  const std::vector<Vec3>& planned = g.points;
-  const double bend = ends_[s].min_bend_radius;
-  // Without a stub at each end the headings are the curve's end tangents at the nodes
-  // themselves; the bend repair handles those.
-  if (!(bend > 0.0) || (g.a_stub - g.a).norm() <= eps_ || (g.b - g.b_stub).norm() <= eps_ || planned.size() < 4 ||
-      !g.interp.start_tangent || !g.interp.end_tangent)
-    return;
+  const std::optional<ArcLineEnds> ends = arc_line_ends(s, g);
+  if (!ends) return;
+  const std::vector<Vec3> corners(g.points.begin() + 1, g.points.end() - 1);  // stub end to stub end
+  const double radius = kBendPlanMargin * ends_[s].min_bend_radius;
+  if (!arcs_fit(index, corners, *ends, radius, g.request.radius + g.request.clearance)) return;
+  g.arc_points = {g.a};
+  for (const Vec3& p : arc_line_points(corners, *ends, radius, 0.0)) g.arc_points.push_back(p);
+  g.arc_points.push_back(g.b);
+  g.arc_points = dedupe_consecutive(g.arc_points, eps_);
+}
+
+/// The stubs of segment `s` as an arc-line route sees them, when its cables have a bend
+/// radius and both ends have a stub (without one the headings are the curve's end tangents
+/// at the nodes themselves, which the bend repair handles).
+std::optional<ArcLineEnds> RouteRun::arc_line_ends(int s, const SegmentGeometry& g) const {
+  if (!(ends_[s].min_bend_radius > 0.0) || (g.a_stub - g.a).norm() <= eps_ || (g.b - g.b_stub).norm() <= eps_ ||
+      g.points.size() < 4 || !g.interp.start_tangent || !g.interp.end_tangent)
+    return std::nullopt;
   ArcLineEnds ends;
   ends.start_heading = *g.interp.start_tangent;
   ends.start_run = (g.a_stub - g.a).norm();
   ends.end_heading = *g.interp.end_tangent;
   ends.end_run = (g.b - g.b_stub).norm();
-  const std::vector<Vec3> corners(planned.begin() + 1, planned.end() - 1);  // stub end to stub end
-  const double radius = kBendPlanMargin * bend;
+  return ends;
+}
+
+/// Plans segment `s` bend-feasibly (bend_planner) around the corridor of its current key
+/// points; on success its corners become the segment's key points as a planner's would
+/// (pulled to supports where the scene asks for clamps, then set_planned_points: the arcs'
+/// rounding is kept as the fallback of the bend repair). The outcome is kept in `info`.
+bool RouteRun::bend_plan(int s, SegmentGeometry& g, const ObstacleIndex& index, SegmentRouteInfo& info) const {
+  const std::optional<ArcLineEnds> ends = arc_line_ends(s, g);
+  if (!ends) return false;
+  const double radius = kBendPlanMargin * ends_[s].min_bend_radius;
   const double required = g.request.radius + g.request.clearance;
-  auto node_to_node = [&](const std::vector<Vec3>& rounded) {
-    std::vector<Vec3> out{g.a};
-    out.insert(out.end(), rounded.begin(), rounded.end());
-    out.push_back(g.b);
-    return dedupe_consecutive(out, eps_);
-  };
-  if (arcs_fit(index, corners, ends, radius, required)) {
-    g.arc_points = node_to_node(arc_line_points(corners, ends, radius, 0.0));
-    return;
-  }
   BendPlanRequest bq;
   bq.start = g.a_stub;
   bq.goal = g.b_stub;
-  bq.ends = ends;
+  bq.ends = *ends;
   bq.required = required;
   bq.bend_radius = radius;
   bq.bounds = g.request.scene_box;
   for (const Vec3& p : {g.a, g.a_stub, g.b_stub, g.b}) bq.bounds.extend(p);
   bq.bounds = bq.bounds.inflated(2.0 * radius + required);
-  bq.hint = corners;
+  bq.hint.assign(g.points.begin() + 1, g.points.end() - 1);
   bq.seed = g.request.seed ^ kBendPlanSeedSalt;
   const PortfolioBudget budget = portfolio_budget(g.request);
   bq.time_limit = budget.feasibility_seconds;
@@ -784,7 +793,28 @@ void RouteRun::set_bend_feasible_points(int s, SegmentGeometry& g, const std::ve
   info.bend_plan_samples = r.iterations;
   info.bend_plan_ms = r.time_ms;
   info.time_limited = info.time_limited || r.time_limited;
-  if (r.solved()) g.points = node_to_node(r.key_points);
+  if (!r.solved()) return false;
+  std::vector<Vec3> corners = r.vertices;
+  if (scene_.routing.supports) pull_to_supports(index, segment_exits(s), corners);
+  set_planned_points(s, g, corners, index);
+  return true;
+}
+
+/// Replaces the key points of segment `s`, whose bend repair failed, by a bend-feasible plan
+/// around them, kept only if its curve then meets the bend radius. The plan's outcome goes
+/// into the segment's route info either way. Returns whether the bend radius is met.
+bool RouteRun::try_bend_plan(int s) {
+  SegmentGeometry& g = geom_.at(s);
+  const SegmentGeometry saved = g;
+  SegmentRouteInfo& info = info_of(s);
+  const bool planned = bend_plan(s, g, *obstacles_for(s, g.visible), info);
+  rep_.timing.plan += info.bend_plan_ms;
+  if (!planned) return false;
+  build_curve(s);
+  if (!bend_failed(s)) return true;
+  g = saved;
+  build_curve(s);
+  return false;
 }
 
 /// Records how segment `s` was routed: replaces its entry (a re-plan) or appends one.
@@ -949,13 +979,16 @@ SegmentRouteInfo& RouteRun::info_of(int s) {
 
 bool RouteRun::bend_failed(int s) { return info_of(s).bend_status.rfind("failed", 0) == 0; }
 
-/// A segment whose corners cannot be rounded within what the obstacles allow is re-planned
-/// (another seed, twice the budget, up to kBendReplans times); the new key points are kept
-/// only if their curve meets the bend radius.
+/// A segment whose corners cannot be rounded within what the obstacles allow is planned
+/// bend-feasibly around its corridor (try_bend_plan); if that fails it is re-planned (another
+/// seed, twice the budget, up to kBendReplans times), each re-plan planned bend-feasibly in
+/// turn where its own corners cannot be rounded; new key points are kept only if their curve
+/// meets the bend radius.
 void RouteRun::replan_bend_failures() {
   for (auto& [s, g] : geom_) {
     // Stub ends that coincide leave nothing to re-plan (and plan_path refuses equal ends).
-    if ((g.b_stub - g.a_stub).norm() <= eps_) continue;
+    if ((g.b_stub - g.a_stub).norm() <= eps_ || !bend_failed(s)) continue;
+    try_bend_plan(s);
     for (int attempt = 1; attempt <= kBendReplans && bend_failed(s); ++attempt) {
       PlanRequest req = g.request;
       req.seed = g.request.seed + 7919u * static_cast<unsigned>(attempt);
@@ -971,9 +1004,10 @@ void RouteRun::replan_bend_failures() {
       if (!plan.solved()) continue;
       const SegmentGeometry saved = g;
       const SegmentRouteInfo saved_info = info_of(s);
-      set_bend_feasible_points(s, g, plan.key_points, *obstacles_for(s, g.visible), scratch);
-      rep_.timing.plan += scratch.bend_plan_ms;
+      set_planned_points(s, g, plan.key_points, *obstacles_for(s, g.visible));
+      info_of(s).bend_plan.clear();
       build_curve(s);
+      if (bend_failed(s)) try_bend_plan(s);
       if (bend_failed(s)) {
         g = saved;
         build_curve(s);
@@ -983,9 +1017,6 @@ void RouteRun::replan_bend_failures() {
       } else {
         info_of(s).plan = plan;
         info_of(s).portfolio = scratch.portfolio;
-        info_of(s).bend_plan = scratch.bend_plan;
-        info_of(s).bend_plan_samples = scratch.bend_plan_samples;
-        info_of(s).bend_plan_ms = scratch.bend_plan_ms;
         info_of(s).replans = attempt;
       }
     }
@@ -1057,7 +1088,11 @@ void RouteRun::audit_and_repair() {
     if (bad.empty()) break;
     for (int s : bad) {
       geom_[s].points = densify(geom_[s].points);
+      geom_[s].arc_points.clear();
       build_curve(s);
+      // Denser key points leave the bend repair shorter legs: plan the corners bend-feasibly
+      // around them where it fails.
+      if (bend_failed(s)) try_bend_plan(s);
       for (auto& info : rep_.segments)
         if (info.segment == s) info.repair_rounds = round + 1;
     }

@@ -118,7 +118,9 @@ RC_GTEST_PROP(ArcLine, CubicThroughRoundedPointsKeepsTheRadiusWithinTheMargin, (
                             leg_slack(corner_normal(dirs[k - 1], dirs[k]), corner_normal(dirs[k], dirs[k + 1]), arc) +
                             (tight ? 0.0 : 3.0 * arc * extra(rng))) *
                                dirs[k]);
-  const ArcLineEnds ends{dirs.front(), t.front() + (tight ? 1e-9 : arc), dirs.back(), t.back() + (tight ? 1e-9 : arc)};
+  // Stubs as long as their arcs' tangents, or a little or much longer.
+  const double stub_extra = *rc::gen::element(1e-9, 0.01, 0.05, 0.2, 1.0) * arc;
+  const ArcLineEnds ends{dirs.front(), t.front() + stub_extra, dirs.back(), t.back() + stub_extra};
   RC_PRE(arc_line_short_leg(v, ends, arc).leg < 0);
   std::vector<Vec3> pts{v.front() - ends.start_run * ends.start_heading};
   for (const Vec3& p : arc_line_points(v, ends, arc, 0.0)) pts.push_back(p);
