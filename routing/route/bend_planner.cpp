@@ -33,8 +33,6 @@ constexpr std::uint64_t kMoreSamples = 2000;
 constexpr int kRelaxSweeps = 30;
 /// Routes compared (each shortened; the shortest is kept).
 constexpr int kMostRoutes = 16;
-/// Points closer than this share of `required` are one point (shortcut ends, zero steps).
-constexpr double kSamePoint = 1e-6;
 
 std::string num(double v) {
   char buf[64];
@@ -116,7 +114,7 @@ class Planner {
   Planner(const ObstacleIndex& index, const BendPlanRequest& req) : index_(index), req_(req), rng_(req.seed) {
     step_ = kStepRadii * req.bend_radius;
     slack_ = kInnerLegSlack * req.bend_radius;
-    same_ = kSamePoint * req.required;
+    same_ = kBendPlanSamePoint * req.required;
     width_ = req.hint_width > 0.0 ? req.hint_width : 2.0 * req.bend_radius + req.required;
     for (std::size_t i = 0; i + 1 < req.hint.size(); ++i) hint_len_.push_back((req.hint[i + 1] - req.hint[i]).norm());
     for (double l : hint_len_) hint_total_ += l;
@@ -363,7 +361,7 @@ BendPlanResult plan_bend_feasible(const ObstacleIndex& index, const BendPlanRequ
     throw std::invalid_argument("plan_bend_feasible: the required distance must be positive and finite");
   if (!(request.bend_radius > 0.0) || !std::isfinite(request.bend_radius))
     throw std::invalid_argument("plan_bend_feasible: the bend radius must be positive and finite");
-  if ((request.goal - request.start).norm() <= kSamePoint * request.required)
+  if ((request.goal - request.start).norm() <= kBendPlanSamePoint * request.required)
     throw std::invalid_argument("plan_bend_feasible: the two ends coincide");
   return Planner(index, request).run();
 }

@@ -29,6 +29,10 @@
 
 namespace loom {
 
+/// Points closer than this × the required distance are one point (the two ends of a query
+/// must be farther apart).
+inline constexpr double kBendPlanSamePoint = 1e-6;
+
 /// One bend-feasible planning query.
 struct BendPlanRequest {
   Vec3 start = Vec3::Zero();  ///< first stub end (world frame)
@@ -68,7 +72,8 @@ struct BendPlanResult {
 };
 
 /// Plans a bend-feasible route among the parts of `index`. Throws std::invalid_argument
-/// for non-positive or non-finite required distance or bend radius, or coincident ends.
+/// for non-positive or non-finite required distance or bend radius, or ends closer than
+/// kBendPlanSamePoint × required.
 BendPlanResult plan_bend_feasible(const ObstacleIndex& index, const BendPlanRequest& request);
 
 /// True iff the polyline `v` (stub end to stub end) is bend-feasible under `ends` at

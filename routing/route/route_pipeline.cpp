@@ -601,20 +601,16 @@ std::vector<int> RouteRun::routed_now(int except) const {
 /// `visible`, each cut back near a node the two share (there they meet legitimately: within
 /// the audit's junction reach, twice the breakout, and at least far enough that the breakout
 /// stubs leave clear of each other). Bundles of classes kept apart from the segment's are grown
-/// by the separation (class_gap).
+/// by the separation (class_gap). The breakouts of segments still to be routed are obstacles
+/// too, cut back alike.
 std::unique_ptr<HarnessAwareIndex> RouteRun::obstacles_for(int s, const std::vector<int>& visible) const {
   const Segment& sg = h_.segments[s];
   const double required = ends_[s].radius + rep_.clearance + part_extra_;
   std::vector<BundleTube> tubes;
-  for (int t : visible) {
-    const auto found = tubes_.find(t);
-    if (t == s || found == tubes_.end()) continue;
-    const BundleTube& tube = found->second;
+  // Segment t's run as an obstacle, cut back near a node it shares with s.
+  auto add = [&](int t, const std::vector<Vec3>& points, double radius) {
     const Segment& st = h_.segments[t];
-    // A bundle of another class grows by the classes' separation: the planner then keeps the
-    // routing clearance beyond it, the margin for the curve's deviation from the key points.
-    const double radius = tube.radius + class_gap(scene_.routing, classes_[s], classes_[t]);
-    std::vector<std::vector<Vec3>> runs{tube.points};
+    std::vector<std::vector<Vec3>> runs{points};
     for (const std::string& n : {sg.from, sg.to}) {
       if (n != st.from && n != st.to) continue;
       const double breakout = breakout_length(topo_, n);
@@ -626,7 +622,24 @@ std::unique_ptr<HarnessAwareIndex> RouteRun::obstacles_for(int s, const std::vec
       runs = std::move(kept);
     }
     for (auto& r : runs) tubes.push_back({t, std::move(r), radius});
+  };
+  for (int t : visible) {
+    const auto found = tubes_.find(t);
+    if (t == s || found == tubes_.end()) continue;
+    // A bundle of another class grows by the classes' separation: the planner then keeps the
+    // routing clearance beyond it, the margin for the curve's deviation from the key points.
+    add(t, found->second.points, found->second.radius + class_gap(scene_.routing, classes_[s], classes_[t]));
   }
+  // The breakouts of segments not routed yet at branch points: their straight runs from the
+  // node will be there (a route through a node of others' would leave their legs no start).
+  if (opt_.harness_aware)
+    for (const auto& [key, exit] : exit_dir_) {
+      const int t = key.first;
+      if (t == s || tubes_.count(t)) continue;
+      const std::string& n = key.second ? h_.segments[t].from : h_.segments[t].to;
+      const Vec3 at = *h_.node_position(n);
+      add(t, {at, at + breakout_.at(n) * exit}, ends_[t].radius);
+    }
   return std::make_unique<HarnessAwareIndex>(planning_index(), tubes);
 }
 
@@ -658,6 +671,7 @@ std::string RouteRun::blocker_name(const ObstacleIndex& index, int part, int s) 
   const auto* aware = dynamic_cast<const HarnessAwareIndex*>(&index);
   const int t = aware ? aware->bundle_segment(part) : -1;
   if (t < 0) return "";
+  if (!tubes_.count(t)) return "the breakout of segment " + h_.segments[t].from + " -> " + h_.segments[t].to + ", routed after it";
   const double gap = class_gap(scene_.routing, classes_[s], classes_[t]);
   return "the bundle of segment " + h_.segments[t].from + " -> " + h_.segments[t].to + ", routed before it" +
          (gap > 0.0 ? ", kept " + full_precision(gap) + " away by the separation of their classes" : "");
@@ -773,6 +787,7 @@ bool RouteRun::bend_plan(int s, SegmentGeometry& g, const ObstacleIndex& index, 
   if (!ends) return false;
   const double radius = kBendPlanMargin * ends_[s].min_bend_radius;
   const double required = g.request.radius + g.request.clearance;
+  if (!((g.b_stub - g.a_stub).norm() > kBendPlanSamePoint * required)) return false;  // nothing between the stubs
   BendPlanRequest bq;
   bq.start = g.a_stub;
   bq.goal = g.b_stub;

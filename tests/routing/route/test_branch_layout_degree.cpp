@@ -3,6 +3,8 @@
 // 90° from both of its directions (no cable folds back at the node), all are unit vectors.
 #include "routing/route/branch_layout.hpp"
 
+#include "index/embree_index.hpp"
+#include "index/index_test_meshes.hpp"
 #include "routing/curve/cable_geometry.hpp"
 
 #include <gtest/gtest.h>
@@ -61,6 +63,55 @@ TEST_P(ExitDirections, MainLineStraightAndNoFoldBack) {
   EXPECT_NEAR(exit_of(0).dot(exit_of(1)), -1.0, 1e-12) << "the main line runs straight through the node";
   // Legs sharing cables with leg 0 leave at least 90° from it (the turn of each cable ≤ 90°).
   for (int s = 2; s < n; ++s) EXPECT_LE(exit_of(s).dot(exit_of(0)), 1e-12) << "leg " << s;
+}
+
+
+// A wall 8 mm beside the hub (x ∈ [8, 40]) blocks the run of legs heading into it. Every exit
+// that turns turns to a free direction (the run — breakout plus bend radius — clear by radius
+// + clearance, checked exactly) away from the wall, ≥ 90° from the exits sharing cables with
+// it and ≥ 30° from the rest; at the 4-way node every blocked exit finds one (at 8 and 16
+// legs the main line, sharing cables with every leg, finds none and is kept); exits that were
+// free stay as they were.
+TEST_P(ExitDirections, BlockedExitsTurnToTheNearestFreeDirection) {
+  const int n = GetParam();
+  const Harness h = hub(n);
+  const HarnessTopology topo(h);
+  const auto ends = segment_ends(topo, derived_stub_length);
+  const auto before = branch_exit_directions(h, topo, ends);
+  auto dirs = before;
+  const EmbreeIndex index({testmesh::box_part("wall", Vec3(8, -200, -200), Vec3(40, 200, 200))});
+  const std::map<std::string, double> breakout{{"H", breakout_length(topo, "H")}};
+  const double clearance = 1.0;
+  const int turned = free_blocked_exits(index, h, topo, ends, breakout, clearance, dirs);
+  auto key = [&](int s) { return std::make_pair(s, h.segments[s].from == "H"); };
+  auto blocked = [&](int s, const Vec3& e) {
+    return index.segment_within(Vec3::Zero(), (breakout.at("H") + ends[s].min_bend_radius) * e, ends[s].radius + clearance);
+  };
+  // Cables pass between leg 0 and every other leg, and between legs 0 and 1 (the main line).
+  auto shares = [](int a, int b) { return a == 0 || b == 0; };
+  int was_blocked = 0, moved = 0;
+  for (int s = 0; s < n; ++s) {
+    const Vec3 e0 = before.at(key(s)), e = dirs.at(key(s));
+    EXPECT_NEAR(e.norm(), 1.0, 1e-12);
+    was_blocked += blocked(s, e0);
+    if (e == e0) {
+      EXPECT_TRUE(n > 4 || !blocked(s, e0)) << "leg " << s << " stayed blocked";
+      continue;
+    }
+    ++moved;
+    EXPECT_TRUE(blocked(s, e0)) << "leg " << s << " was free";
+    EXPECT_FALSE(blocked(s, e)) << "leg " << s;
+    EXPECT_LT(e.x(), 0.3) << "leg " << s << " turns away from the wall, not through it";
+    for (int t = 0; t < n; ++t) {
+      if (t == s) continue;
+      EXPECT_LE(e.dot(dirs.at(key(t))), shares(s, t) ? 1e-12 : std::cos(M_PI / 6) + 1e-12) << s << ", " << t;
+    }
+  }
+  EXPECT_GT(was_blocked, 0);
+  if (n == 4) {
+    EXPECT_GT(moved, 0);
+  }
+  EXPECT_EQ(turned, moved);
 }
 
 INSTANTIATE_TEST_SUITE_P(Ways, ExitDirections, ::testing::Values(4, 8, 16));
