@@ -332,6 +332,39 @@ def planning_rows():
     ]
 
 
+def route_quality_rows():
+    ref = rows("route_reference.csv")
+    clean = [x for x in ref if x["routed"] == x["cables"] and x["clashes"] == "0" and x["bend_violations"] == "0"]
+    ratios = sorted(num(x, "ratio", "route_reference.csv") for x in ref if x["routed"] == x["cables"])
+    median = ratios[len(ratios) // 2] if ratios else math.inf
+    longest = max(num(x, "longest_plan_ms", "route_reference.csv") for x in ref) / 1e3
+    scenes = len({x["scene"] for x in ref})
+    share = len(clean) / len(ref)
+    h = rows("route_harness.csv")
+    empty = pick(h, "route_harness.csv", variant="harness-aware portfolio")
+    inside = pick(h, "route_harness.csv", variant="harness-aware portfolio in structure")
+
+    def harness(r):
+        return (f"{r['routed_cables']}/{r['wires']} routed, {r['all_clashes']} clashes, {r['bend_violations']} bend "
+                f"violations, {sig(num(r, 'length_ratio', 'route_harness.csv'), strip=False)} × straight tree, "
+                f"{sig(num(r, 'total_ms', 'route_harness.csv') / 1e3)} s")
+
+    def harness_ok(r):
+        return (r["routed_cables"] == r["wires"] and r["all_clashes"] == "0" and r["bend_violations"] == "0"
+                and num(r, "length_ratio", "route_harness.csv") <= 1.3 and num(r, "total_ms", "route_harness.csv") <= 30e3)
+
+    return [
+        (f"hard scenes ({scenes}: room, 4 d corridor, bug trap, Y, 5-way) × {len(ref) // scenes} seeds: "
+         "clean; median length / grid reference; longest plan", "`route_reference.csv`",
+         f"{len(clean)}/{len(ref)} ({share:.0%}); {sig(median, strip=False)}; {sig(longest)} s",
+         "≥ 95%; ≤ 1.10; ≤ 5 s", status(share >= 0.95 and median <= 1.10 and longest <= 5.0)),
+        ("generated 250-wire harness (181 segments, nodes ≤ 16 legs), empty space, 2 threads",
+         "`route_harness.csv`", harness(empty), "all routed, 0 clashes, ≤ 1.3 ×, ≤ 30 s", status(harness_ok(empty))),
+        (f"same, inside {inside['parts']} generated parts", "`route_harness.csv`", harness(inside),
+         "same", status(harness_ok(inside))),
+    ]
+
+
 def scan_rows():
     sp = pick(rows("scan_speed.csv"), "scan_speed.csv", points="76503", method="graph", threads="2")
     ms, rate = num(sp, "wall_ms", "scan_speed.csv"), num(sp, "points_per_s_wall", "scan_speed.csv")
@@ -348,7 +381,7 @@ def scan_rows():
 
 def table():
     lines = ["| measure | bench/results | measured | target | status |", "|---|---|---|---|---|"]
-    for group in (audit_rows, harness_audit_rows, fcl_peer_rows, audit_mpi_rows, index_rows, centerline_rows, alpha_sim_rows, tessellation_need_rows, planning_rows, scan_rows):
+    for group in (audit_rows, harness_audit_rows, fcl_peer_rows, audit_mpi_rows, index_rows, centerline_rows, alpha_sim_rows, tessellation_need_rows, planning_rows, route_quality_rows, scan_rows):
         for row in group():
             lines.append("| " + " | ".join(row) + " |")
     return "\n".join(lines) + "\n"

@@ -402,7 +402,10 @@ void RouteRun::layout_branches() {
   bpo.clearance_of = [&](int b) {
     double r = 0.0;
     for (int s : topo_.incident_segments(h_.branches[b].id)) r = std::max(r, ends_[s].radius);
-    return r + rep_.clearance + part_extra_;
+    // The node's breakout stubs leave it straight for the breakout length: a node as near a
+    // part as its bundle allows has stubs that run into the part (nothing then rounds its
+    // legs' corners), so it keeps the breakout too.
+    return r + rep_.clearance + part_extra_ + breakout_length(topo_, h_.branches[b].id);
   };
   for (const auto& id : place_branch_points(h_, topo_, *plan_index_, ends_, bpo))
     rep_.notes.push_back("branch point '" + id + "' placed by the router");
