@@ -135,13 +135,14 @@ class Planner {
       res.shortcuts += shorten(path);
       const double len = arc_line_length(path, req_.ends, req_.bend_radius);
       if (len < best_len) best_len = len, best = std::move(path);
-      if (routes++ == 0) stop = std::min(req_.max_iterations, std::max(2 * res.iterations, res.iterations + kMoreSamples));
+      if (routes++ == 0)
+        stop = std::min(req_.max_iterations, std::max(2 * res.iterations, res.iterations + kMoreSamples));
     };
     if (join(0, 0, 0)) take(path_of(0, 0));
     for (int side = 0; routes == 0 || (routes < kMostRoutes && res.iterations < stop); side ^= 1) {
       if (res.iterations >= stop) break;
       if (t0.seconds() >= req_.time_limit) {
-        res.time_limited = routes == 0;
+        res.time_limited = true;
         break;
       }
       ++res.iterations;
@@ -281,8 +282,12 @@ class Planner {
       for (std::size_t i = 0; i + 1 < path.size(); ++i) acc.push_back(acc.back() + (path[i + 1] - path[i]).norm());
       double s1 = rng_.uniformReal(0.0, acc.back()), s2 = rng_.uniformReal(0.0, acc.back());
       if (s1 > s2) std::swap(s1, s2);
-      const std::size_t i = std::min<std::size_t>(std::upper_bound(acc.begin(), acc.end(), s1) - acc.begin() - 1, path.size() - 2);
-      const std::size_t j = std::min<std::size_t>(std::upper_bound(acc.begin(), acc.end(), s2) - acc.begin() - 1, path.size() - 2);
+      // The edges holding s1 and s2.
+      auto edge_at = [&](double x) {
+        const auto k = std::upper_bound(acc.begin(), acc.end(), x) - acc.begin() - 1;
+        return std::min<std::size_t>(static_cast<std::size_t>(std::max<long>(k, 0)), path.size() - 2);
+      };
+      const std::size_t i = edge_at(s1), j = edge_at(s2);
       if (i == j) continue;
       auto at = [&](std::size_t k, double s) {
         const double l = acc[k + 1] - acc[k];

@@ -6,18 +6,21 @@
 ///
 /// Two trees grow from the stub ends (a bidirectional RRT; OMPL's GNAT finds neighbours,
 /// OMPL's RNG draws samples). A node is a position, the heading it is reached with and the
-/// straight run before it that its corner may still use; a step towards a sample turns at
-/// most as much as that run and the step allow (steered towards the heading otherwise), and
-/// is kept only if the step and the arc at its corner are clear. A new node joins the other
-/// tree where the segment between them, the arcs at both ends and the tangents on the
-/// segment fit. Consecutive arcs keep leg_slack of straight between them. A corridor known to be clear (`hint`, e.g. the plan of an unconstrained
-/// planner) draws half the samples around it. Each route found is shortened by shortcuts that
-/// keep it bend-feasible and clear (random pairs of points along it, then every vertex); the
-/// trees grow on after the first for as many samples again (at least 2,000, within the
+/// straight run before it that its corner may still use; a step towards a sample leaves from
+/// the near node that lacks the least turn to reach it, turns at most as much as its run and
+/// the step allow (steered towards the heading otherwise), and is kept only if the step and
+/// the arc at its corner are clear. A new node joins the other tree where the segment between
+/// them, the arcs at both ends and the tangents on the segment fit. Consecutive arcs keep
+/// leg_slack of straight between them. A corridor known to be clear (`hint`, e.g. the plan
+/// of an unconstrained planner) draws half the samples around it. Each route found is
+/// shortened while it stays bend-feasible and clear (shortcuts between random pairs of
+/// points along it, corners pulled towards their neighbours, then every vertex left out);
+/// the trees grow on after the first for as many samples again (at least 2,000, within the
 /// budget), and the shortest of up to 16 routes is kept.
 ///
 /// Reproducible: samples and shortcuts draw from an RNG seeded by BendPlanRequest::seed, so a
-/// run that ends on its iteration budget or on a connection is the same in any process.
+/// run that ends on its sample budget is the same in any process (BendPlanResult::
+/// time_limited says when the clock ended it).
 
 #include "core/geometry.hpp"
 #include "index/obstacle_index.hpp"
@@ -62,7 +65,9 @@ struct BendPlanResult {
   double length = 0.0;           ///< arc_line_length of the vertices (scene units)
   std::uint64_t iterations = 0;  ///< samples drawn
   std::uint64_t shortcuts = 0;   ///< shortcuts kept (over every route compared)
-  bool time_limited = false;     ///< the wall clock ended the search before a route was found
+  /// The wall clock ended the search before its sample budget (or, after a first route, its
+  /// extra samples) did: another run may return another route.
+  bool time_limited = false;
   double time_ms = 0.0;          ///< wall time of the query
   /// When NoPath: where the hint's corners need more straight run than their legs hold
   /// (ShortLeg::leg −1 if the hint is bend-feasible or absent), and a message with it.

@@ -47,10 +47,9 @@ constexpr int kBendReplans = 2;
 /// cubic through the arc points bends up to ~22% tighter than the arcs where they meet a leg
 /// (the curvature jumps there; test_arc_line checks the margin on random routes).
 constexpr double kBendPlanMargin = 1.3;
-/// Samples of a bend-feasible plan when the run has no iteration budget (the time limit
-/// then ends it), and at least this many when it has one.
+/// Samples of a bend-feasible plan: at least this many, or the run's feasibility budget if
+/// larger (the wall-clock budget may end it first).
 constexpr std::uint64_t kBendPlanSamples = 20000;
-constexpr std::uint64_t kMinBendPlanSamples = 4000;
 /// The bend-feasible plan's seed is mixed with this, so that it differs from the planner's.
 constexpr std::uint32_t kBendPlanSeedSalt = 0xB3ADu;
 
@@ -411,7 +410,8 @@ void RouteRun::layout_branches() {
     rep_.notes.push_back("branch point '" + id + "' placed by the router");
   exit_dir_ = branch_exit_directions(h_, topo_, ends_);
   for (const auto& br : h_.branches) breakout_[br.id] = breakout_length(topo_, br.id);
-  if (const int turned = free_blocked_exits(*plan_index_, h_, topo_, ends_, breakout_, rep_.clearance + part_extra_, exit_dir_))
+  const double clearance = rep_.clearance + part_extra_;
+  if (const int turned = free_blocked_exits(*plan_index_, h_, topo_, ends_, breakout_, clearance, exit_dir_))
     rep_.notes.push_back(std::to_string(turned) + " branch exit(s) turned away from a part that blocked their run");
 }
 
@@ -674,7 +674,8 @@ std::string RouteRun::blocker_name(const ObstacleIndex& index, int part, int s) 
   const auto* aware = dynamic_cast<const HarnessAwareIndex*>(&index);
   const int t = aware ? aware->bundle_segment(part) : -1;
   if (t < 0) return "";
-  if (!tubes_.count(t)) return "the breakout of segment " + h_.segments[t].from + " -> " + h_.segments[t].to + ", routed after it";
+  if (!tubes_.count(t))
+    return "the breakout of segment " + h_.segments[t].from + " -> " + h_.segments[t].to + ", routed after it";
   const double gap = class_gap(scene_.routing, classes_[s], classes_[t]);
   return "the bundle of segment " + h_.segments[t].from + " -> " + h_.segments[t].to + ", routed before it" +
          (gap > 0.0 ? ", kept " + full_precision(gap) + " away by the separation of their classes" : "");
@@ -782,9 +783,9 @@ std::optional<ArcLineEnds> RouteRun::arc_line_ends(int s, const SegmentGeometry&
 }
 
 /// Plans segment `s` bend-feasibly (bend_planner) around the corridor of its current key
-/// points; on success its corners become the segment's key points as a planner's would
-/// (pulled to supports where the scene asks for clamps, then set_planned_points: the arcs'
-/// rounding is kept as the fallback of the bend repair). The outcome is kept in `info`.
+/// points; on success its corners, pulled to supports where the scene asks for clamps,
+/// rounded by their arcs become the segment's key points (the polyline itself where a pull
+/// leaves corners no arc fits; the bend repair then rounds it). The outcome is kept in `info`.
 bool RouteRun::bend_plan(int s, SegmentGeometry& g, const ObstacleIndex& index, SegmentRouteInfo& info) const {
   const std::optional<ArcLineEnds> ends = arc_line_ends(s, g);
   if (!ends) return false;
@@ -804,8 +805,7 @@ bool RouteRun::bend_plan(int s, SegmentGeometry& g, const ObstacleIndex& index, 
   bq.seed = g.request.seed ^ kBendPlanSeedSalt;
   const PortfolioBudget budget = portfolio_budget(g.request);
   bq.time_limit = budget.feasibility_seconds;
-  bq.max_iterations = g.request.max_iterations > 0 ? std::max(budget.feasibility_iterations, kMinBendPlanSamples)
-                                                   : kBendPlanSamples;
+  bq.max_iterations = std::max(budget.feasibility_iterations, kBendPlanSamples);
   const BendPlanResult r = plan_bend_feasible(index, bq);
   info.bend_plan = r.solved() ? "planned" : "failed: " + r.message;
   info.bend_plan_samples = r.iterations;
@@ -815,6 +815,10 @@ bool RouteRun::bend_plan(int s, SegmentGeometry& g, const ObstacleIndex& index, 
   std::vector<Vec3> corners = r.vertices;
   if (scene_.routing.supports) pull_to_supports(index, segment_exits(s), corners);
   set_planned_points(s, g, corners, index);
+  // The arcs were checked clear; the bend repair's fairing may move the curve by up to half
+  // the bend radius and would give that up. They are lost only where a support pull broke them.
+  if (!g.arc_points.empty()) g.points = std::move(g.arc_points);
+  g.arc_points.clear();
   return true;
 }
 

@@ -49,7 +49,8 @@ TEST(ArcLine, SlackOnlyBetweenArcsOfOppositeSense) {
   EXPECT_EQ(leg_slack(up, up, r), 0.0);
   EXPECT_NEAR(leg_slack(up, down, r), kInnerLegSlack * r, 1e-12);
   EXPECT_EQ(leg_slack(up, Vec3::Zero(), r), 0.0);
-  EXPECT_NEAR(leg_slack(Vec3::UnitZ(), Vec3(0, std::sin(0.5), std::cos(0.5)), r), kInnerLegSlack * r * 2.0 * std::sin(0.25), 1e-12);
+  EXPECT_NEAR(leg_slack(Vec3::UnitZ(), Vec3(0, std::sin(0.5), std::cos(0.5)), r),
+              kInnerLegSlack * r * 2.0 * std::sin(0.25), 1e-12);
   EXPECT_NEAR(leg_slack(Vec3::UnitZ(), Vec3::UnitY(), r), kInnerLegSlack * r, 1e-12);
   // An S: two right angles of opposite sense joined by a leg of exactly 2R; a U: of one sense.
   const ArcLineEnds ends{Vec3::UnitX(), r, Vec3::UnitX(), r};

@@ -58,7 +58,8 @@ double least_distance(const EmbreeIndex& index, const BendPlanResult& r) {
   double least = 1e300;
   for (std::size_t i = 0; i + 1 < k.size(); ++i) {
     const int n = std::max(1, static_cast<int>(std::ceil((k[i + 1] - k[i]).norm() / 0.1)));
-    for (int j = 0; j <= n; ++j) least = std::min(least, index.closest(k[i] + (k[i + 1] - k[i]) * (double(j) / n), 1e3).distance);
+    for (int j = 0; j <= n; ++j)
+      least = std::min(least, index.closest(k[i] + (k[i + 1] - k[i]) * (double(j) / n), 1e3).distance);
   }
   return least;
 }

@@ -242,6 +242,35 @@ TEST(RouteAdversarial, ScaleExtremesAndFarOffsetsAgreeWithTheOracle) {
   }
 }
 
+// A U-turn at the end of an enclosed corridor 4 diameters wide (d = 8, bend radius 24,
+// clearance 1): the two legs' centre lines are 64 apart, room for a turn of the bend radius
+// (with the router's 1.3 margin: 62.4) only if it swings wide of the wall between the legs,
+// not round its end. The route is clean by the oracle's own curvature and distances, within
+// an iteration budget (reproducible), and the segment's corners were planned bend-feasibly
+// where the bend repair could not round the planner's.
+TEST(RouteAdversarial, AUTurnInACorridorFourDiametersWideMeetsTheBendRadius) {
+  const double t = 10.0;
+  const std::vector<BoxSpec> walls = {
+      {"floor", Vec3(-t, -t, -t), Vec3(232 + t, 96 + t, 0)},   {"ceiling", Vec3(-t, -t, 32), Vec3(232 + t, 96 + t, 32 + t)},
+      {"south", Vec3(-t, -t, 0), Vec3(232 + t, 0, 32)},        {"north", Vec3(-t, 96, 0), Vec3(232 + t, 96 + t, 32)},
+      {"east", Vec3(232, 0, 0), Vec3(232 + t, 96, 32)},        {"west", Vec3(-t, 0, 0), Vec3(0, 96, 32)},
+      {"between", Vec3(0, 32, 0), Vec3(200, 64, 32)}};
+  Scene sc = make_scene(walls,
+                        harness_xml({{"C1", "A", "B", 8.0, 24.0}},
+                                    {{"A", Vec3(20, 16, 16), Vec3(1, 0, 0)}, {"B", Vec3(20, 80, 16), Vec3(1, 0, 0)}},
+                                    {{"A", "B"}}),
+                        1.0, 30.0, 3);
+  sc.routing.iterations = {1500.0, "test"};
+  const RouteReport rep = route_and_check(sc, "u_turn");
+  EXPECT_EQ(rep.exit_code(), 0);
+  EXPECT_TRUE(rep.unreproducible.empty());
+  ASSERT_EQ(rep.segments.size(), 1u);
+  EXPECT_EQ(rep.segments[0].bend_plan, "planned") << rep.segments[0].bend_status;
+  const auto f = route_oracle::measure_cable(rep.routed, sc.parts, 0, 1.0, kOracleSamples);
+  EXPECT_GE(f.min_bend_radius, 24.0 * (1.0 - kBendRel));
+  EXPECT_LE(f.worst_clearance_shortfall, rep.audit.result.tolerance);
+}
+
 TEST(RouteAdversarial, KeepOutZoneAndPerPartClearance) {
   const std::vector<BoxSpec> parts{BoxSpec{"box", kBox.lo, kBox.hi, PartRole::Structure, 5.0},
                                    BoxSpec{"zone", Vec3(-45, -60, -60), Vec3(-40, 60, 60), PartRole::KeepOut}};
