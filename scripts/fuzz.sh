@@ -39,7 +39,7 @@ shared="${LOOM_SHARED_DATA:-$root/../shared/data}"
 unit_test_select='^(HarnessXml|HarnessXmlProps|HarnessTopology|SceneDir|TempDir|RealCad|Mesh|MeshProps|'
 unit_test_select+='InputAdversarial|FuzzRegression|LimitRegression|ScanRegression|'
 unit_test_select+='Kbl[A-Za-z]*|PointCloudIo|PointCloudIoProperty|FileStems|OutputSet|AuditCli|CliOutputs|'
-unit_test_select+='ClashCheck|ClashAdversarial|ClashLimits|Centerline|BSplineOps|MeshCut|PartSplit|AuditShard|ShardPlan|TessellationNeed|regressions)\.'
+unit_test_select+='ClashCheck|ClashAdversarial|ClashLimits|Centerline|BSplineOps|MeshCut|PartSplit|AuditShard|ShardPlan|TessellationNeed|ArcLine|BendPlanner|regressions)\.'
 
 unit_tests=0
 seconds=60
