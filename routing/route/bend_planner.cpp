@@ -1,5 +1,6 @@
 #include "routing/route/bend_planner.hpp"
 
+#include "core/error.hpp"
 #include "core/stopwatch.hpp"
 
 #include <iostream>  // NearestNeighborsGNATNoThreadSafety.h uses std::cout without including it
@@ -9,7 +10,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -33,14 +33,6 @@ constexpr std::uint64_t kMoreSamples = 2000;
 constexpr int kRelaxSweeps = 30;
 /// Routes compared (each shortened; the shortest is kept).
 constexpr int kMostRoutes = 16;
-
-std::string num(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
-std::string point(const Vec3& p) { return "(" + num(p.x()) + ", " + num(p.y()) + ", " + num(p.z()) + ")"; }
 
 /// A node of a tree: reached at `p` heading `h` (unit), with `run` of straight leg before it
 /// that its corner's tangent (and the leg_slack to the corner before) may use; `normal` is
@@ -338,13 +330,13 @@ class Planner {
 
   void finish_failure(BendPlanResult& res) const {
     res.status = BendPlanStatus::NoPath;
-    res.message = "no bend-feasible route (bend radius " + num(req_.bend_radius) + ") within " +
+    res.message = "no bend-feasible route (bend radius " + full_precision(req_.bend_radius) + ") within " +
                   std::to_string(res.iterations) + " samples" + (res.time_limited ? " (time limit)" : "");
     if (req_.hint.size() >= 2) {
       res.tightest = arc_line_short_leg(req_.hint, req_.ends, req_.bend_radius);
       if (res.tightest.leg >= 0)
-        res.message += "; the corridor found turns at " + point(res.tightest.at) + " where its legs hold " +
-                       num(res.tightest.length) + " of the " + num(res.tightest.needed) +
+        res.message += "; the corridor found turns at " + full_precision(res.tightest.at) + " where its legs hold " +
+                       full_precision(res.tightest.length) + " of the " + full_precision(res.tightest.needed) +
                        " of straight run the arcs need";
     }
   }
