@@ -2,8 +2,9 @@
 // oracle), their cut-back near a shared node (closed form), and a hand-made harness whose two
 // segments clash when each is planned among the parts only and do not when the second is
 // planned among the first's bundle too (the audit is the judge); the same crossing with the
-// two bundles in separated classes, planned apart by the separation; and the crossing planned
-// with the voxel layer in front of Embree (clean, the map deciding part of the queries).
+// two bundles in separated classes, planned apart by the separation; a bundle routed first
+// past a branch point whose legs come later (it keeps off their breakouts); and the crossing
+// planned with the voxel layer in front of Embree (clean, the map deciding part of the queries).
 #include "core/io/harness_xml.hpp"
 #include "index/embree_index.hpp"
 #include "index/index_test_meshes.hpp"
@@ -14,6 +15,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -190,6 +192,44 @@ TEST(HarnessAware, SeparatedClassesArePlannedApart) {
   EXPECT_TRUE(apart.audit.segregation.empty())
       << "closest " << apart.audit.segregation.front().distance << " at " << full_precision(apart.audit.segregation.front().point);
   EXPECT_TRUE(apart.audit.result.clashes.empty());
+}
+
+// A bundle routed first (A1–A2, three cables) whose straight way runs through a branch point
+// fixed by the file (N, legs still to be routed, fewer cables): it keeps off N's breakouts,
+// so N's legs start clear of it and every cable is routed without a contact.
+TEST(HarnessAware, AnEarlierBundleKeepsOffTheBreakoutsOfANodeStillToBeRouted) {
+  std::string x = "<harness name=\"H\" units=\"mm\"><attributes>\n";
+  x += cable_xml("C1", "A1", "A2") + cable_xml("C2", "A1", "A2") + cable_xml("C3", "A1", "A2");
+  x += cable_xml("C4", "B1", "B2") + cable_xml("C5", "B1", "B3");
+  x += "</attributes><structure>\n";
+  x += port_xml("A1", Vec3(-100, 0, 0), Vec3::UnitX()) + port_xml("A2", Vec3(100, 0, 0), -Vec3::UnitX());
+  x += port_xml("B1", Vec3(0, -100, 0), Vec3::UnitY()) + port_xml("B2", Vec3(0, 100, 0), -Vec3::UnitY());
+  x += port_xml("B3", Vec3(0, 0, 100), -Vec3::UnitZ());
+  x += "<segment from=\"A1\" to=\"A2\"/>\n";
+  x += "<branch id=\"N\" x=\"0\" y=\"0\" z=\"0\"><segment to=\"B1\"/><segment to=\"B2\"/><segment to=\"B3\"/></branch>\n";
+  x += "</structure></harness>\n";
+  Scene sc = crossing_scene();
+  sc.harness = parse_harness_xml(x, "node.xml");
+  RouteOptions opt;
+  opt.threads = 2;
+  const RouteReport rep = route_scene(sc, opt);
+  EXPECT_TRUE(rep.unrouted.empty()) << (rep.unrouted.empty() ? "" : rep.unrouted.front().message);
+  EXPECT_EQ(cable_cable_clashes(rep), 0u);
+  // A1–A2's curve keeps its radius, N's bundle radius and the clearance from N.
+  const HarnessTopology topo(rep.routed);
+  const auto& segs = rep.routed.segments;
+  const int ia = static_cast<int>(std::find_if(segs.begin(), segs.end(),
+                                               [](const Segment& g) { return g.from == "A1" && g.to == "A2"; }) -
+                                  segs.begin());
+  ASSERT_LT(ia, static_cast<int>(segs.size()));
+  const Segment& a = rep.routed.segments[static_cast<std::size_t>(ia)];
+  ASSERT_TRUE(a.bspline.has_value());
+  const Centerline c(a.bspline->degree, a.bspline->knots, a.bspline->control_points);
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const auto& [s, p] : c.sample_by_arc_length(0.5)) nearest = std::min(nearest, p.norm());
+  double leg_radius = 0.0;
+  for (int t : topo.incident_segments("N")) leg_radius = std::max(leg_radius, topo.segment_diameter(t) / 2.0);
+  EXPECT_GT(nearest, topo.segment_diameter(ia) / 2.0 + leg_radius + sc.routing.clearance.value - 1e-6);
 }
 
 TEST(HarnessAware, VoxelLayerDecidesQueriesAndKeepsTheRouteClean) {
