@@ -52,6 +52,27 @@ void print_portfolio_budgets(const RouteReport& rep) {
               scale_lo, scale_hi, corridor_s, optimise_s, optimised, planned);
 }
 
+/// One line on the segments planned bend-feasibly where the bend repair failed, and one per
+/// segment where no bend-feasible route was found (its message names the corner).
+void print_bend_plans(const RouteReport& rep, const std::vector<Segment>& segments) {
+  std::size_t tried = 0, planned = 0;
+  double ms = 0.0;
+  for (const auto& info : rep.segments) {
+    if (info.bend_plan.empty()) continue;
+    ++tried;
+    planned += info.bend_plan == "planned";
+    ms += info.bend_plan_ms;
+  }
+  if (tried == 0) return;
+  std::printf("  bend-feasible plans: %zu of %zu segments whose bend repair failed, %.0f ms\n", planned, tried, ms);
+  for (const auto& info : rep.segments) {
+    const auto k = static_cast<std::size_t>(info.segment);
+    if (info.bend_plan.empty() || info.bend_plan == "planned" || info.segment < 0 || k >= segments.size()) continue;
+    std::printf("  segment %s -> %s: bend-feasible plan %s\n", segments[k].from.c_str(), segments[k].to.c_str(),
+                info.bend_plan.c_str());
+  }
+}
+
 void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
   const auto& a = rep.audit;
   std::set<std::string> unrouted;
@@ -76,6 +97,7 @@ void print_summary(const RouteReport& rep, const std::filesystem::path& out) {
                 rep.clamps_placed, 100.0 * rep.share_within_reach, a.supports.spans.size());
   print_support_findings(a, 10);
   print_portfolio_budgets(rep);
+  print_bend_plans(rep, rep.routed.segments);
   print_motion_clashes(a, 10);
   for (const auto& u : rep.unrouted)
     std::printf("  NOT ROUTED %s (segment %s): %s — %s\n", u.cable.c_str(), u.segment.c_str(), u.reason.c_str(),
