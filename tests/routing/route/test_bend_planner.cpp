@@ -2,7 +2,8 @@
 // cannot be rounded clear (its arc would cut the inner corner): the plan is bend-feasible,
 // every point of the rounded route keeps the required distance (brute-force exact distances),
 // it is reproducible per seed, and a U-turn in a dead end narrower than the bend needs fails
-// naming the corner of the corridor it was given. Bounded by iterations, never by time.
+// naming the corner of the corridor it was given; on random scenes every route is feasible
+// and clear by brute force. Bounded by iterations, never by time.
 #include "index/embree_index.hpp"
 #include "index/index_test_meshes.hpp"
 #include "routing/route/bend_planner.hpp"
@@ -10,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 namespace loom {
 namespace {
@@ -126,6 +128,50 @@ TEST(BendPlanner, AUTurnInADeadEndNarrowerThanTheBendFailsNamingTheCorner) {
   ASSERT_GE(res.tightest.leg, 0);
   EXPECT_GT(res.tightest.needed, res.tightest.length);
   EXPECT_NE(res.message.find("(100, 12, 0)"), std::string::npos) << res.message;
+}
+
+// Random scenes (fixed seed): 6–14 boxes between two stub ends with random headings. Every
+// route returned is bend-feasible (the legs hold the tangents) and every point of its rounded
+// route keeps the required distance, by brute-force exact distances; most scenes are solved.
+TEST(BendPlanner, RandomScenesGiveFeasibleClearRoutesByBruteForce) {
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  auto unit = [&] {
+    Vec3 d;
+    do d = Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5);
+    while (d.norm() < 0.1);
+    return Vec3(d.normalized());
+  };
+  int solved = 0;
+  const int scenes = 20;
+  for (int k = 0; k < scenes; ++k) {
+    std::vector<Part> parts;
+    const int n = 6 + static_cast<int>(u(rng) * 9);
+    for (int b = 0; b < n; ++b) {
+      const Vec3 lo(40 + 120 * u(rng), -60 + 120 * u(rng), -60 + 120 * u(rng));
+      parts.push_back(testmesh::box_part("b" + std::to_string(b), lo, lo + Vec3(5 + 30 * u(rng), 5 + 30 * u(rng), 5 + 30 * u(rng))));
+    }
+    const EmbreeIndex index(parts);
+    BendPlanRequest r;
+    r.start = Vec3(0, 0, 0);
+    r.goal = Vec3(200, 0, 0);
+    r.ends = {unit(), 20.0, unit(), 20.0};
+    r.required = 4.0;
+    r.bend_radius = 15.0;
+    r.bounds.extend(Vec3(-60, -100, -100));
+    r.bounds.extend(Vec3(260, 100, 100));
+    r.seed = static_cast<std::uint32_t>(k + 1);
+    r.max_iterations = 3000;
+    r.time_limit = kTimeCap;
+    if (index.any_within(r.start, r.required) || index.any_within(r.goal, r.required)) continue;
+    const BendPlanResult res = plan_bend_feasible(index, r);
+    if (!res.solved()) continue;
+    ++solved;
+    EXPECT_EQ(arc_line_short_leg(res.vertices, r.ends, r.bend_radius).leg, -1) << "scene " << k;
+    // Chords of the rounded points lie within the arcs' sagitta (R (1 − cos 7.5°) < 0.13) of them.
+    EXPECT_GE(least_distance(index, res), r.required - 0.13) << "scene " << k;
+  }
+  EXPECT_GE(solved, scenes / 2);
 }
 
 TEST(BendPlanner, RefusesBadRequests) {
