@@ -266,6 +266,9 @@ TEST(RouteAdversarial, AUTurnInACorridorFourDiametersWideMeetsTheBendRadius) {
   EXPECT_TRUE(rep.unreproducible.empty());
   ASSERT_EQ(rep.segments.size(), 1u);
   EXPECT_EQ(rep.segments[0].bend_plan, "planned") << rep.segments[0].bend_status;
+  const nlohmann::json j = route_report_json(rep);
+  EXPECT_EQ(j["segments"][0]["bend_plan"]["status"], "planned");
+  EXPECT_GT(j["segments"][0]["bend_plan"]["samples"].get<int>(), 0);
   const auto f = route_oracle::measure_cable(rep.routed, sc.parts, 0, 1.0, kOracleSamples);
   EXPECT_GE(f.min_bend_radius, 24.0 * (1.0 - kBendRel));
   EXPECT_LE(f.worst_clearance_shortfall, rep.audit.result.tolerance);
