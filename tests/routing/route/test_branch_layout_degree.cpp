@@ -49,14 +49,18 @@ Harness hub(int n) {
   return h;
 }
 
-class ExitDirections : public ::testing::TestWithParam<int> {};
-
-TEST_P(ExitDirections, MainLineStraightAndNoFoldBack) {
+/// The hub of GetParam() legs, its topology, segment ends and exit directions.
+class ExitDirections : public ::testing::TestWithParam<int> {
+ protected:
   const int n = GetParam();
   const Harness h = hub(n);
-  const HarnessTopology topo(h);
-  const auto ends = segment_ends(topo, derived_stub_length);
-  const auto dirs = branch_exit_directions(h, topo, ends);
+  const HarnessTopology topo{h};
+  const std::vector<SegmentEnds> ends = segment_ends(topo, derived_stub_length);
+  const std::map<std::pair<int, bool>, Vec3> before = branch_exit_directions(h, topo, ends);
+};
+
+TEST_P(ExitDirections, MainLineStraightAndNoFoldBack) {
+  const auto& dirs = before;
   ASSERT_EQ(static_cast<int>(dirs.size()), n);
   auto exit_of = [&](int s) { return dirs.at({s, h.segments[s].from == "H"}); };
   for (int s = 0; s < n; ++s) EXPECT_NEAR(exit_of(s).norm(), 1.0, 1e-12);
@@ -65,7 +69,6 @@ TEST_P(ExitDirections, MainLineStraightAndNoFoldBack) {
   for (int s = 2; s < n; ++s) EXPECT_LE(exit_of(s).dot(exit_of(0)), 1e-12) << "leg " << s;
 }
 
-
 // A wall 8 mm beside the hub (x ∈ [8, 40]) blocks the run of legs heading into it. Every exit
 // that turns turns to a free direction (the run — breakout plus bend radius — clear by radius
 // + clearance, checked exactly) away from the wall, ≥ 90° from the exits sharing cables with
@@ -73,11 +76,6 @@ TEST_P(ExitDirections, MainLineStraightAndNoFoldBack) {
 // legs the main line, sharing cables with every leg, finds none and is kept); exits that were
 // free stay as they were.
 TEST_P(ExitDirections, BlockedExitsTurnToTheNearestFreeDirection) {
-  const int n = GetParam();
-  const Harness h = hub(n);
-  const HarnessTopology topo(h);
-  const auto ends = segment_ends(topo, derived_stub_length);
-  const auto before = branch_exit_directions(h, topo, ends);
   auto dirs = before;
   const EmbreeIndex index({testmesh::box_part("wall", Vec3(8, -200, -200), Vec3(40, 200, 200))});
   const std::map<std::string, double> breakout{{"H", breakout_length(topo, "H")}};
