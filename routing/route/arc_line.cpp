@@ -24,16 +24,6 @@ constexpr int kLeadPoints = 2;
 
 double turn(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
 
-/// Unit direction into vertex k (k ≥ 1: from the previous vertex; k = 0: the start heading).
-Vec3 dir_in(const std::vector<Vec3>& v, const ArcLineEnds& e, std::size_t k) {
-  return k == 0 ? Vec3(e.start_heading.normalized()) : Vec3((v[k] - v[k - 1]).normalized());
-}
-
-/// Unit direction out of vertex k.
-Vec3 dir_out(const std::vector<Vec3>& v, const ArcLineEnds& e, std::size_t k) {
-  return k + 1 == v.size() ? Vec3(e.end_heading.normalized()) : Vec3((v[k + 1] - v[k]).normalized());
-}
-
 /// Point of the arc rounding a corner (tangent point p1, unit normal n towards the centre,
 /// unit incoming direction u) at angle phi from p1.
 Vec3 arc_point(const Vec3& p1, const Vec3& n, const Vec3& u, double radius, double phi) {
@@ -45,6 +35,14 @@ Vec3 arc_point(const Vec3& p1, const Vec3& n, const Vec3& u, double radius, doub
 Vec3 towards_centre(const Vec3& in, const Vec3& out) { return (out - in.dot(out) * in).normalized(); }
 
 }  // namespace
+
+Vec3 arc_line_in(const std::vector<Vec3>& v, const ArcLineEnds& ends, std::size_t k) {
+  return k == 0 ? Vec3(ends.start_heading.normalized()) : Vec3((v[k] - v[k - 1]).normalized());
+}
+
+Vec3 arc_line_out(const std::vector<Vec3>& v, const ArcLineEnds& ends, std::size_t k) {
+  return k + 1 == v.size() ? Vec3(ends.end_heading.normalized()) : Vec3((v[k + 1] - v[k]).normalized());
+}
 
 Vec3 corner_normal(const Vec3& in, const Vec3& out) {
   if (turn(in, out) < kStraight) return Vec3::Zero();
@@ -65,14 +63,14 @@ double corner_tangent(const Vec3& in, const Vec3& out, double radius) {
 
 std::vector<double> arc_line_tangents(const std::vector<Vec3>& v, const ArcLineEnds& ends, double radius) {
   std::vector<double> t(v.size());
-  for (std::size_t k = 0; k < v.size(); ++k) t[k] = corner_tangent(dir_in(v, ends, k), dir_out(v, ends, k), radius);
+  for (std::size_t k = 0; k < v.size(); ++k) t[k] = corner_tangent(arc_line_in(v, ends, k), arc_line_out(v, ends, k), radius);
   return t;
 }
 
 ShortLeg arc_line_short_leg(const std::vector<Vec3>& v, const ArcLineEnds& ends, double radius) {
   const std::vector<double> t = arc_line_tangents(v, ends, radius);
   const std::size_t n = v.size();
-  auto normal = [&](std::size_t k) { return corner_normal(dir_in(v, ends, k), dir_out(v, ends, k)); };
+  auto normal = [&](std::size_t k) { return corner_normal(arc_line_in(v, ends, k), arc_line_out(v, ends, k)); };
   for (std::size_t k = 0; k <= n; ++k) {
     const double before = k == 0 ? 0.0 : t[k - 1];
     const double after = k == n ? 0.0 : t[k];
@@ -97,7 +95,7 @@ double arc_line_length(const std::vector<Vec3>& v, const ArcLineEnds& ends, doub
   for (std::size_t k = 0; k + 1 < v.size(); ++k) len += (v[k + 1] - v[k]).norm();
   for (std::size_t k = 0; k < v.size(); ++k) {
     if (!(t[k] > 0.0)) continue;
-    len += radius * turn(dir_in(v, ends, k), dir_out(v, ends, k)) - 2.0 * t[k];
+    len += radius * turn(arc_line_in(v, ends, k), arc_line_out(v, ends, k)) - 2.0 * t[k];
   }
   // The end vertices' arcs reach into the stubs: count the rounded route from the first
   // tangent point to the last one.
@@ -116,7 +114,7 @@ std::vector<Vec3> arc_line_points(const std::vector<Vec3>& v, const ArcLineEnds&
   };
   std::vector<Vec3> out;
   for (std::size_t k = 0; k < n; ++k) {
-    const Vec3 in = dir_in(v, ends, k), o = dir_out(v, ends, k);
+    const Vec3 in = arc_line_in(v, ends, k), o = arc_line_out(v, ends, k);
     const double th = turn(in, o);
     if (!(t[k] > 0.0) || !std::isfinite(t[k])) {
       out.push_back(v[k]);

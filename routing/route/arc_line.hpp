@@ -37,6 +37,11 @@ struct ShortLeg {
   double length = 0.0;     ///< the leg's length (scene units)
 };
 
+/// Unit direction of travel into vertex k of `v` (the start heading at k = 0).
+Vec3 arc_line_in(const std::vector<Vec3>& v, const ArcLineEnds& ends, std::size_t k);
+/// Unit direction of travel out of vertex k of `v` (the end heading at the last vertex).
+Vec3 arc_line_out(const std::vector<Vec3>& v, const ArcLineEnds& ends, std::size_t k);
+
 /// Unit normal in × out of a corner's plane (zero for a corner that does not turn).
 Vec3 corner_normal(const Vec3& in, const Vec3& out);
 

@@ -73,21 +73,11 @@ struct Tree {
   }
 };
 
-/// Unit direction into vertex k of `v` (the start heading at k = 0).
-Vec3 dir_in(const std::vector<Vec3>& v, const ArcLineEnds& e, std::size_t k) {
-  return k == 0 ? Vec3(e.start_heading.normalized()) : Vec3((v[k] - v[k - 1]).normalized());
-}
-
-/// Unit direction out of vertex k of `v` (the end heading at the last vertex).
-Vec3 dir_out(const std::vector<Vec3>& v, const ArcLineEnds& e, std::size_t k) {
-  return k + 1 == v.size() ? Vec3(e.end_heading.normalized()) : Vec3((v[k + 1] - v[k]).normalized());
-}
-
 /// True iff the rounding arcs of vertices lo..hi of `v` keep `required` from every part.
 bool arcs_clear(const ObstacleIndex& index, const std::vector<Vec3>& v, const ArcLineEnds& ends, double radius,
                 double required, std::size_t lo, std::size_t hi) {
   for (std::size_t k = lo; k <= hi && k < v.size(); ++k)
-    if (!corner_arc_clear(index, v[k], dir_in(v, ends, k), dir_out(v, ends, k), radius, required)) return false;
+    if (!corner_arc_clear(index, v[k], arc_line_in(v, ends, k), arc_line_out(v, ends, k), radius, required)) return false;
   return true;
 }
 
