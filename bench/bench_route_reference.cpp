@@ -8,10 +8,11 @@
 // minimises the sum of the legs' grid distances, each leg string-pulled. loom routes each
 // scene with the defaults a user gets (portfolio planner, 5 s cap per plan) for several
 // seeds; per (scene, seed): routed, clashes, bend violations, length / reference, plan time.
-// Writes bench/results/route_reference.csv.
+// Writes bench/results/route_reference.csv and route_reference.png.
 //
 //   bench_route_reference [SEEDS] [SCENE]   (default 4 seeds, every scene; with SCENE the CSV is
 //   not written)
+//   bench_route_reference --chart           (redraws the chart from the CSV)
 #include "box_mesh.hpp"
 #include "core/stopwatch.hpp"
 #include "index/embree_index.hpp"
@@ -21,6 +22,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <queue>
@@ -340,6 +342,27 @@ double reference_length(const Case& c) {
   return len;
 }
 
+/// Draws route_reference.png from the CSV (gnuplot): length / reference and the longest plan
+/// of each (scene, seed), clean pairs filled, the others open.
+void chart(const std::string& dir) {
+  const std::string gp = dir + "route_reference.gp";
+  std::ofstream(gp)
+      << "set datafile separator ','\nset terminal pngcairo size 1200,450\nset output '" << dir
+      << "route_reference.png'\nset multiplot layout 1,2 title 'Routing hard scenes against a grid shortest path "
+         "(4 seeds each; filled: 0 clashes and 0 bend violations)'\nset xtics rotate by 60 right font ',8'\n"
+         "set grid\nset key off\nclean(c, b) = (c == 0 && b == 0)\n"
+         "set ylabel 'routed length / reference'\n"
+         "plot '" << dir << "route_reference.csv' every ::1 using 0:(clean($5, $6) ? $9 : 1/0):xtic(sprintf('%s %d', "
+         "strcol(1), $2)) with points pt 7 ps 1.2, '' every ::1 using 0:(clean($5, $6) ? 1/0 : $9) with points pt 6 "
+         "ps 1.5, 1.1 with lines dt 2\n"
+         "set ylabel 'longest plan of a segment (s)'\n"
+         "plot '" << dir << "route_reference.csv' every ::1 using 0:($11 / 1000):xtic(sprintf('%s %d', strcol(1), $2)) "
+         "with impulses lw 6, 5 with lines dt 2\nunset multiplot\n";
+  const std::string cmd = "gnuplot " + gp + " 2>/dev/null";
+  if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "gnuplot failed (chart not drawn)\n");
+  std::filesystem::remove(gp);
+}
+
 /// Length of the routed harness: every segment's curve once.
 double routed_length(const Harness& h) {
   double len = 0.0;
@@ -351,6 +374,10 @@ double routed_length(const Harness& h) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc > 1 && std::string(argv[1]) == "--chart") {  // redraw from the CSV only
+    chart(std::string(LOOM_SOURCE_DIR) + "/bench/results/");
+    return 0;
+  }
   const int seeds = argc > 1 ? std::max(1, std::atoi(argv[1])) : 4;
   std::vector<Case> cases = {open_room(), corridor(), bug_trap(), star("y-harness", 3), star("5-way", 5)};
   const std::string only = argc > 2 ? argv[2] : "";
@@ -406,5 +433,9 @@ int main(int argc, char** argv) {
   std::printf("%d/%d (scene, seed) pairs routed clean (%.0f%%); median length %.3f x reference; longest plan %.2f s\n",
               clean, pairs, 100.0 * clean / pairs, median, longest_plan / 1000.0);
   std::printf("wrote %s\n", path.c_str());
+  if (only.empty()) {
+    csv.close();
+    chart(std::string(LOOM_SOURCE_DIR) + "/bench/results/");
+  }
   return 0;
 }
