@@ -6,6 +6,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <random>
@@ -20,11 +21,14 @@ constexpr std::uint64_t kSampleSeed = 0x6c6f6f6d;  // "loom"
 /// Smallest cap on one drawn box's counted overlaps (the cap is 4 · max_overlaps / boxes,
 /// at least this): a chord block in a large bundle meets a few blocks of every cable in it.
 constexpr std::size_t kMinCountCap = 1000;
+/// Refuse without enumerating when the estimated kept pairs exceed filter.max_pairs by
+/// this factor (BoxPairResult::estimated_kept).
+constexpr double kKeptEstimateMargin = 2.0;
 
 /// Fills result.estimated_overlaps and result.busiest (see BoxPairResult). Why a sample:
 /// counting every box's overlaps costs what enumerating them does.
 void estimate_overlaps(const BoxTree& tree, const std::vector<AABB>& boxes, std::size_t budget,
-                       BoxPairResult& result) {
+                       const BoxTree::PairFilter& filter, BoxPairResult& result) {
   const std::size_t n = boxes.size();
   if (n < 2) return;
   std::vector<std::size_t> drawn(std::min(n, kBoxPairSample));
@@ -38,18 +42,29 @@ void estimate_overlaps(const BoxTree& tree, const std::vector<AABB>& boxes, std:
   // No box overlaps more than n boxes, so a cap of n counts exactly (and cannot overflow).
   const std::size_t per_box = budget / n + 1;
   const std::size_t cap = std::max(kMinCountCap, per_box > n / 4 ? n : 4 * per_box);
-  std::vector<std::size_t> count(drawn.size());
-  tbb::parallel_for(std::size_t{0}, drawn.size(),
-                    [&](std::size_t k) { count[k] = tree.count_overlapping(boxes[drawn[k]], cap); });
-  double sum = 0.0;
+  std::vector<std::size_t> count(drawn.size()), kept(drawn.size());
+  tbb::parallel_for(std::size_t{0}, drawn.size(), [&](std::size_t k) {
+    const auto i = static_cast<std::uint32_t>(drawn[k]);
+    // The filter sees each pair as self_pairs hands it over: lower index first.
+    const std::function<bool(std::uint32_t)> keep = [&](std::uint32_t j) {
+      return j != i && (!filter.keep || filter.keep(std::min(i, j), std::max(i, j)));
+    };
+    const BoxTree::OverlapCount c = tree.count_overlapping(boxes[i], cap, keep);
+    count[k] = c.all;
+    kept[k] = c.kept;
+  });
+  double sum = 0.0, sum_kept = 0.0;
   std::size_t busiest = 0;
   for (std::size_t k = 0; k < drawn.size(); ++k) {
     sum += static_cast<double>(count[k] > 0 ? count[k] - 1 : 0);  // a box overlaps itself
+    sum_kept += static_cast<double>(kept[k]);
     if (count[k] > count[busiest]) busiest = k;
   }
   result.busiest = static_cast<std::uint32_t>(drawn[busiest]);
   // Each pair is counted from both its boxes.
-  result.estimated_overlaps = 0.5 * sum * static_cast<double>(n) / static_cast<double>(drawn.size());
+  const double scale = 0.5 * static_cast<double>(n) / static_cast<double>(drawn.size());
+  result.estimated_overlaps = sum * scale;
+  result.estimated_kept = sum_kept * scale;
 }
 
 }  // namespace
@@ -66,9 +81,15 @@ BoxPairResult overlapping_box_pairs(const std::vector<AABB>& boxes, const BoxPai
   arena.execute([&] {
     const BoxTree tree(boxes);  // validates every box, so even one or two boxes are checked
     const bool bounded = request.max_overlaps != std::numeric_limits<std::size_t>::max();
-    if (bounded) estimate_overlaps(tree, boxes, request.max_overlaps, result);
+    if (bounded) estimate_overlaps(tree, boxes, request.max_overlaps, request.filter, result);
     if (bounded && result.estimated_overlaps > static_cast<double>(request.max_overlaps)) {
       result.status = BoxPairStatus::TooManyOverlaps;
+      return;
+    }
+    // Why a margin: near the limit the estimate may err either way, and the enumeration
+    // decides exactly; far beyond it the enumeration would only confirm the refusal.
+    if (bounded && result.estimated_kept > kKeptEstimateMargin * static_cast<double>(request.filter.max_pairs)) {
+      result.status = BoxPairStatus::TooManyKept;
       return;
     }
     try {

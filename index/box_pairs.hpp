@@ -34,7 +34,7 @@ struct BoxPairRequest {
 enum class BoxPairStatus {
   Done,             ///< `pairs` holds every kept pair
   TooManyOverlaps,  ///< the estimate exceeds max_overlaps: nothing enumerated
-  TooManyKept,      ///< more than filter.max_pairs pairs kept: enumeration abandoned
+  TooManyKept,      ///< more than filter.max_pairs pairs kept (or estimated far beyond it)
 };
 
 /// The outcome of overlapping_box_pairs(boxes, request).
@@ -46,6 +46,9 @@ struct BoxPairResult {
   /// max_overlaps; exact when every box is counted and none reaches the cap. 0 when
   /// max_overlaps is unbounded (no estimate is made).
   double estimated_overlaps = 0.0;
+  /// Of estimated_overlaps, the pairs filter.keep would keep (same sample). Past twice
+  /// filter.max_pairs the call refuses (TooManyKept) without enumerating.
+  double estimated_kept = 0.0;
   std::uint32_t busiest = 0;  ///< a counted box with the most overlaps (for messages)
 };
 

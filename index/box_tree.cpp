@@ -92,6 +92,8 @@ struct OverlapQuery {
   AABB query;
   std::vector<std::uint32_t>* out = nullptr;  ///< null: count only
   std::size_t count = 0;                      ///< boxes found (counting)
+  const std::function<bool(std::uint32_t)>* keep = nullptr;  ///< counting: which count as kept
+  std::size_t kept = 0;                                       ///< of `count`, those keep accepts
   std::size_t cap = std::numeric_limits<std::size_t>::max();
 };
 
@@ -104,6 +106,7 @@ bool overlap_callback(RTCPointQueryFunctionArguments* args) {
     q->out->push_back(i);
     return false;  // the search sphere never shrinks: every overlapping box is wanted
   }
+  if (!*q->keep || (*q->keep)(i)) ++q->kept;
   if (++q->count < q->cap) return false;
   args->query->radius = 0.0f;  // enough counted: let the traversal end
   return true;
@@ -218,15 +221,21 @@ void BoxTree::overlapping(const AABB& query, std::vector<std::uint32_t>& out) co
 }
 
 std::size_t BoxTree::count_overlapping(const AABB& query, std::size_t cap) const {
+  return count_overlapping(query, cap, {}).all;
+}
+
+BoxTree::OverlapCount BoxTree::count_overlapping(const AABB& query, std::size_t cap,
+                                                 const std::function<bool(std::uint32_t)>& keep) const {
   check_box(query, "query");
   const Impl& im = *impl_;
-  if (box_is_unset(query) || im.ids.empty() || cap == 0) return 0;
+  if (box_is_unset(query) || im.ids.empty() || cap == 0) return {};
   OverlapQuery q;
   q.im = &im;
   q.query = query;
   q.cap = cap;
+  q.keep = &keep;
   run_overlap_query(im, q);
-  return std::min(q.count, cap);
+  return {std::min(q.count, cap), std::min(q.kept, cap)};
 }
 
 std::vector<BoxPair> BoxTree::self_pairs() const { return self_pairs(PairFilter{}); }

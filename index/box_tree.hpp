@@ -57,6 +57,17 @@ class BoxTree {
   /// std::invalid_argument if the query is not finite.
   std::size_t count_overlapping(const AABB& query, std::size_t cap) const;
 
+  /// Boxes counted by count_overlapping(query, cap), and how many of them `keep` accepts
+  /// (called with each counted box's index, from the calling thread).
+  struct OverlapCount {
+    std::size_t all = 0;   ///< as count_overlapping(query, cap)
+    std::size_t kept = 0;  ///< of those, the ones `keep` accepts
+  };
+  /// As count_overlapping(query, cap), also counting the boxes `keep` accepts; the traversal
+  /// stops when `all` reaches cap. An empty `keep` accepts every box.
+  OverlapCount count_overlapping(const AABB& query, std::size_t cap,
+                                 const std::function<bool(std::uint32_t)>& keep) const;
+
   /// Every pair {i, j}, i < j, of overlapping boxes, sorted, without duplicates (Embree's
   /// rtcCollide of the tree with itself). Runs on the calling thread's TBB arena.
   std::vector<BoxPair> self_pairs() const;

@@ -3,6 +3,7 @@
 #include "core/error.hpp"
 #include "core/io/input_file.hpp"
 #include "core/io/mesh_node_checks.hpp"
+#include "core/io/stl_file_checks.hpp"
 
 #include <algorithm>
 #include <array>
@@ -645,6 +646,7 @@ void check_mesh_file_structure(const std::filesystem::path& path) {
   const std::string ext = lower_extension(path);
   if (ext == ".ply") check_ply(path);
   else if (ext == ".off") check_off(path);
+  else if (ext == ".stl") check_stl_file(path);
   else if (ext == ".dae") check_dae_file(path);
   else if (ext == ".gltf") check_gltf_file(path, false);
   else if (ext == ".glb") check_gltf_file(path, true);

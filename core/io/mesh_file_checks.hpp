@@ -10,6 +10,8 @@
 ///  - A PLY header must end (Assimp's line reader spun forever on one that did not), and
 ///    each ASCII instance must be one line of its properties' values (Assimp takes a missing
 ///    one as 0, and aborted on the face of no vertices that made).
+///  - ASCII STL facets (stl_file_checks.hpp): a normal and three vertices each, numbers
+///    that are numbers (Assimp leaked every solid it rejected).
 ///  - DAE (COLLADA) and glTF/GLB node graphs (mesh_node_checks.hpp): nesting deeper than
 ///    kMaxMeshNesting, instancing cycles and fan-outs, DAE index lists and accessor ranges.
 ///
@@ -51,9 +53,9 @@ void check_ply_extents(const std::vector<PlyElementExtent>& elements, bool ascii
 std::string lower_extension(const std::filesystem::path& path);
 
 /// Throws InputError naming the file (and the line or element) when the file's declared
-/// counts exceed what its size can hold, an OFF face names no vertex, a PLY header does not
-/// end or an ASCII PLY line does not hold its instance, or a DAE/glTF node graph fails
-/// check_dae_file / check_gltf_file.
+/// counts exceed what its size can hold, an OFF face names no vertex, an ASCII STL facet
+/// fails check_stl_file, a PLY header does not end or an ASCII PLY line does not hold its
+/// instance, or a DAE/glTF node graph fails check_dae_file / check_gltf_file.
 void check_mesh_file_structure(const std::filesystem::path& path);
 
 }  // namespace loom

@@ -120,7 +120,9 @@ std::vector<BoxPair> bounded_block_pairs(Context& ctx, const std::vector<AABB>& 
   if (found.status == BoxPairStatus::TooManyKept)
     throw CableLimitError(busiest, "more than " + full_precision(static_cast<double>(lim.max_block_pairs)) +
                                        " pairs of chord blocks of different cables, or of one cable πr apart, come "
-                                       "within reach of each other (cable '" + busiest + "' among them): " + kFoldBack);
+                                       "within reach of each other (about " +
+                                       full_precision(std::round(found.estimated_kept)) + " estimated; cable '" +
+                                       busiest + "' among them): " + kFoldBack);
   ctx.counters.block_pairs = as_i64(found.pairs.size());
   return std::move(found.pairs);
 }

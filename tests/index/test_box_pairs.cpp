@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <rapidcheck/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -121,6 +122,7 @@ TEST(BoxPairs, BoundedFormKeepsTheFilteredPairsAndEstimatesExactlyWhenAllAreCoun
   for (const BoxPair& p : all)
     if ((p.first ^ p.second) & 1u) kept.push_back(p);
   EXPECT_EQ(r.pairs, kept);
+  EXPECT_DOUBLE_EQ(r.estimated_kept, static_cast<double>(kept.size()));
   req.max_overlaps = all.size() - 1;
   const BoxPairResult over = overlapping_box_pairs(boxes, req);
   EXPECT_EQ(over.status, BoxPairStatus::TooManyOverlaps);
@@ -149,6 +151,33 @@ TEST(BoxPairs, SampledEstimateIsCloseAndNamesABusyBox) {
       EXPECT_LT(r.busiest, 1500u);  // one of the 1,500 equal boxes overlaps the most
     }
   }
+}
+
+TEST(BoxPairs, KeptPairsFarBeyondTheLimitAreRefusedFromTheEstimate) {
+  // More boxes than the sample; a filter that keeps a third of the pairs.
+  const auto boxes = random_boxes(14, 6000, 1.0, 0.03);
+  const auto all = brute_pairs(boxes);
+  auto keep = [](std::uint32_t i, std::uint32_t j) { return (i + j) % 3 == 0; };
+  double truth = 0.0;
+  for (const BoxPair& p : all) truth += keep(p.first, p.second) ? 1.0 : 0.0;
+  std::atomic<std::size_t> calls{0};
+  BoxPairRequest req;
+  req.max_overlaps = 10 * all.size();
+  req.filter.keep = [&](std::uint32_t i, std::uint32_t j) {
+    ++calls;
+    return keep(i, j);
+  };
+  const BoxPairResult r = overlapping_box_pairs(boxes, req);
+  ASSERT_EQ(r.status, BoxPairStatus::Done);
+  EXPECT_NEAR(r.estimated_kept / truth, 1.0, 0.25) << r.estimated_kept << " vs " << truth;
+  // Three times the limit: refused before the enumeration, which would call the filter once
+  // per overlapping pair.
+  calls = 0;
+  req.filter.max_pairs = static_cast<std::size_t>(truth / 3);
+  const BoxPairResult over = overlapping_box_pairs(boxes, req);
+  EXPECT_EQ(over.status, BoxPairStatus::TooManyKept);
+  EXPECT_TRUE(over.pairs.empty());
+  EXPECT_LT(calls.load(), all.size() / 2) << "the pairs were enumerated";
 }
 
 RC_GTEST_PROP(BoxPairs, EqualsBruteForce, ()) {

@@ -6,6 +6,9 @@
 #include "index/random_boxes.hpp"
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <functional>
 #include <rapidcheck/gtest.h>
 
 #include <cmath>
@@ -130,6 +133,14 @@ TEST(BoxTree, CountOverlappingIsTheListSizeUpToItsCap) {
       EXPECT_EQ(tree.count_overlapping(q, 1'000'000), want);
       for (std::size_t cap : {std::size_t{0}, std::size_t{1}, std::size_t{3}, want, want + 1})
         EXPECT_EQ(tree.count_overlapping(q, cap), std::min(want, cap)) << "cap " << cap;
+      // The kept count: the listed boxes the predicate accepts.
+      const std::function<bool(std::uint32_t)> even = [](std::uint32_t i) { return i % 2 == 0; };
+      const auto listed = brute_overlapping(boxes, q);
+      const auto kept = static_cast<std::size_t>(std::count_if(listed.begin(), listed.end(), even));
+      const BoxTree::OverlapCount c = tree.count_overlapping(q, 1'000'000, even);
+      EXPECT_EQ(c.all, want);
+      EXPECT_EQ(c.kept, kept);
+      EXPECT_EQ(tree.count_overlapping(q, 1'000'000, {}).kept, want);  // no predicate: every box
     }
   }
   // Degenerate: all boxes equal, and no boxes.
