@@ -122,10 +122,12 @@ std::vector<std::string> place_branch_points(Harness& h, const HarnessTopology& 
       diameter[static_cast<int>(b)] = std::max(diameter[static_cast<int>(b)], 2.0 * ends[s].radius);
   auto min_gap = [&](int b, int o) {
     const std::string &ib = h.branches[b].id, &io = h.branches[o].id;
+    double gap = std::max(diameter[b], diameter[o]);
+    if (opt.extra_gap) gap = std::max(gap, opt.extra_gap(b, o));
     for (int s : topo.incident_segments(ib))
       if (other_end(h.segments[s], ib) == io)
-        return std::max(breakout_length(topo, ib) + breakout_length(topo, io), std::max(diameter[b], diameter[o]));
-    return std::max(diameter[b], diameter[o]);
+        return std::max(gap, breakout_length(topo, ib) + breakout_length(topo, io));
+    return gap;
   };
   auto branch_at = [&](int o) -> std::optional<Vec3> {
     if (h.branches[o].position) return *h.branches[o].position;

@@ -37,6 +37,10 @@ struct BranchPlacementOptions {
   /// radius costs this much per millimetre missing. Large enough that bend feasibility wins
   /// over a shorter harness, small enough that the length still ranks feasible positions.
   double bend_deficit_weight = 4.0;
+  /// Least distance between branch points b and o beyond the gaps below, by branch index
+  /// (e.g. nodes of cable classes kept apart: their bundles and breakouts must keep the
+  /// separation). Empty: none.
+  std::function<double(int b, int o)> extra_gap;
 };
 
 /// Places the branch points that have no position. Each starts at the geometric median of
@@ -46,7 +50,8 @@ struct BranchPlacementOptions {
 /// missing for each port leg to turn into its connector axis within the bend radius
 /// (R·tan(θ/2) on each side of the corner, plus the breakout run at the branch).
 /// Placed points keep apart from every other branch point: neighbours by the sum of their
-/// breakout lengths, any two by the larger bundle diameter meeting at either; fixed branch
+/// breakout lengths, any two by the larger bundle diameter meeting at either and by
+/// `extra_gap`; fixed branch
 /// points and ports are never moved. Returns the ids placed, in branch order. Throws
 /// InputError naming the branch when no clear, separated position exists near its neighbours.
 std::vector<std::string> place_branch_points(Harness& h, const HarnessTopology& topo, const ObstacleIndex& index,

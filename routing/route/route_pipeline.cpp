@@ -406,6 +406,21 @@ void RouteRun::layout_branches() {
     // legs' corners), so it keeps the breakout too.
     return r + rep_.clearance + part_extra_ + breakout_length(topo_, h_.branches[b].id);
   };
+  // Nodes of classes kept apart: each one's bundles and breakout runs keep the separation
+  // from the other's, with the routing clearance between them.
+  bpo.extra_gap = [&](int b, int o) {
+    double gap = 0.0, rb = 0.0, ro = 0.0;
+    for (int s : topo_.incident_segments(h_.branches[b].id)) {
+      rb = std::max(rb, ends_[s].radius);
+      for (int t : topo_.incident_segments(h_.branches[o].id)) {
+        gap = std::max(gap, class_gap(scene_.routing, classes_[s], classes_[t]));
+        ro = std::max(ro, ends_[t].radius);
+      }
+    }
+    if (gap <= 0.0) return 0.0;
+    return gap + rb + ro + rep_.clearance + breakout_length(topo_, h_.branches[b].id) +
+           breakout_length(topo_, h_.branches[o].id);
+  };
   for (const auto& id : place_branch_points(h_, topo_, *plan_index_, ends_, bpo))
     rep_.notes.push_back("branch point '" + id + "' placed by the router");
   exit_dir_ = branch_exit_directions(h_, topo_, ends_);
@@ -634,14 +649,15 @@ std::unique_ptr<HarnessAwareIndex> RouteRun::obstacles_for(int s, const std::vec
     add(t, found->second.points, found->second.radius + class_gap(scene_.routing, classes_[s], classes_[t]));
   }
   // The breakouts of segments not routed yet at branch points: their straight runs from the
-  // node will be there (a route through a node of others' would leave their legs no start).
+  // node will be there (a route through a node of others' would leave their legs no start),
+  // grown like bundles by the separation of their classes.
   if (opt_.harness_aware)
     for (const auto& [key, exit] : exit_dir_) {
       const int t = key.first;
       if (t == s || tubes_.count(t)) continue;
       const std::string& n = key.second ? h_.segments[t].from : h_.segments[t].to;
       const Vec3 at = *h_.node_position(n);
-      add(t, {at, at + breakout_.at(n) * exit}, ends_[t].radius);
+      add(t, {at, at + breakout_.at(n) * exit}, ends_[t].radius + class_gap(scene_.routing, classes_[s], classes_[t]));
     }
   return std::make_unique<HarnessAwareIndex>(planning_index(), tubes);
 }
@@ -833,7 +849,10 @@ bool RouteRun::try_bend_plan(int s) {
   rep_.timing.plan += info.bend_plan_ms;
   if (!planned) return false;
   build_curve(s);
-  if (!bend_failed(s)) return true;
+  if (!bend_failed(s)) {
+    if (tubes_.count(s)) add_bundle_tube(s);  // later plans avoid the new route
+    return true;
+  }
   g = saved;
   build_curve(s);
   return false;
@@ -1007,6 +1026,10 @@ bool RouteRun::bend_failed(int s) { return info_of(s).bend_status.rfind("failed"
 /// turn where its own corners cannot be rounded; new key points are kept only if their curve
 /// meets the bend radius.
 void RouteRun::replan_bend_failures() {
+  // Every segment is planned now: what changes from here on (bend-feasible plans, re-plans,
+  // the audit's densified curves) keeps clear of every other bundle, not only of those
+  // routed before it (the later ones were planned around its old route).
+  for (auto& [s, g] : geom_) g.visible = routed_now(s);
   for (auto& [s, g] : geom_) {
     // Stub ends that coincide leave nothing to re-plan (and plan_path refuses equal ends).
     if ((g.b_stub - g.a_stub).norm() <= eps_ || !bend_failed(s)) continue;
@@ -1040,6 +1063,7 @@ void RouteRun::replan_bend_failures() {
         info_of(s).plan = plan;
         info_of(s).portfolio = scratch.portfolio;
         info_of(s).replans = attempt;
+        if (tubes_.count(s)) add_bundle_tube(s);
       }
     }
   }

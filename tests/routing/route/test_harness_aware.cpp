@@ -3,7 +3,8 @@
 // segments clash when each is planned among the parts only and do not when the second is
 // planned among the first's bundle too (the audit is the judge); the same crossing with the
 // two bundles in separated classes, planned apart by the separation; a bundle routed first
-// past a branch point whose legs come later (it keeps off their breakouts); and the crossing
+// past a branch point whose legs come later (it keeps off their breakouts); router-placed
+// nodes of separated classes kept apart; and the crossing
 // planned with the voxel layer in front of Embree (clean, the map deciding part of the queries).
 #include "core/io/harness_xml.hpp"
 #include "index/embree_index.hpp"
@@ -230,6 +231,43 @@ TEST(HarnessAware, AnEarlierBundleKeepsOffTheBreakoutsOfANodeStillToBeRouted) {
   double leg_radius = 0.0;
   for (int t : topo.incident_segments("N")) leg_radius = std::max(leg_radius, topo.segment_diameter(t) / 2.0);
   EXPECT_GT(nearest, topo.segment_diameter(ia) / 2.0 + leg_radius + sc.routing.clearance.value - 1e-6);
+}
+
+// Two Y harnesses, power and data, each with its branch point left to the router: six
+// ports 100 mm around the z axis, 60° apart, the data ports 15 mm above the power ports, so
+// the geometric medians of the two nodes lie on the axis 15 mm apart. The nodes were kept
+// only a bundle diameter apart, inside the separation of their classes, and the legs of the
+// node routed second could not start beside the bundles of the first. Nodes of separated
+// classes now keep the separation plus their bundles and breakouts apart.
+TEST(HarnessAware, RouterPlacedNodesOfSeparatedClassesKeepTheSeparation) {
+  constexpr double kSeparation = 20.0;
+  std::string x = "<harness name=\"H\" units=\"mm\"><attributes>\n";
+  x += cable_xml("P1", "A1", "A2", "power") + cable_xml("P2", "A1", "A3", "power");
+  x += cable_xml("D1", "B1", "B2", "data") + cable_xml("D2", "B1", "B3", "data");
+  x += "</attributes><structure>\n";
+  for (int k = 0; k < 6; ++k) {
+    const double a = k * M_PI / 3.0;
+    const Vec3 out(std::cos(a), std::sin(a), 0.0);
+    const bool power = k % 2 == 0;
+    x += port_xml((power ? "A" : "B") + std::to_string(k / 2 + 1), 100.0 * out + Vec3(0, 0, power ? 0.0 : 15.0), -out);
+  }
+  x += "<branch id=\"NP\"><segment to=\"A1\"/><segment to=\"A2\"/><segment to=\"A3\"/></branch>\n";
+  x += "<branch id=\"ND\"><segment to=\"B1\"/><segment to=\"B2\"/><segment to=\"B3\"/></branch>\n";
+  x += "</structure></harness>\n";
+  Scene sc = crossing_scene();
+  sc.harness = parse_harness_xml(x, "two-y.xml");
+  sc.routing.separation[{"data", "power"}] = kSeparation;
+  RouteOptions opt;
+  opt.threads = 2;
+  const RouteReport rep = route_scene(sc, opt);
+  EXPECT_TRUE(rep.unrouted.empty()) << (rep.unrouted.empty() ? "" : rep.unrouted.front().message);
+  EXPECT_TRUE(rep.audit.result.clashes.empty());
+  EXPECT_TRUE(rep.audit.segregation.empty())
+      << "closest " << rep.audit.segregation.front().distance << " at " << full_precision(rep.audit.segregation.front().point);
+  const auto np = rep.routed.node_position("NP"), nd = rep.routed.node_position("ND");
+  ASSERT_TRUE(np && nd);
+  EXPECT_GT((*np - *nd).norm(), kSeparation + 2.0 + 2.0 + sc.routing.clearance.value)
+      << full_precision(*np) << " and " << full_precision(*nd);
 }
 
 TEST(HarnessAware, VoxelLayerDecidesQueriesAndKeepsTheRouteClean) {
