@@ -52,15 +52,17 @@ void chart(const std::string& dir) {
         "support'\nset key top left\nset grid\n"
         "set xlabel 'clamp spacing (mm; reach 25 mm)'\nset ylabel 'length / length without spacing'\n"
         "set y2label 'share within reach (%)'\nset ytics nomirror\nset y2tics\nset logscale x\n"
+        "set yrange [0.9:1.2]\nset y2range [0:100]\n"
         "plot '"
      << dir << "route_supports.csv' every ::1 using ($3 == 1 && $4 == 25 && $5 == 0 && $6 == 0 ? $2 : 1/0):15 "
         "with linespoints title 'length', '' every ::1 using ($3 == 1 && $4 == 25 && $5 == 0 && $6 == 0 ? $2 : 1/0):($13 "
         "* 100) axes x1y2 with linespoints title 'share within reach'\n"
         "set xlabel 'clamp reach (mm; spacing 450 mm)'\nset ylabel 'planning time (s)'\nunset logscale x\n"
+        "set yrange [0:*]\n"
         "plot '"
-     << dir << "route_supports.csv' every ::1 using ($2 == 450 && $5 == 0 && $6 == 0 ? $4 : 1/0):($16 / 1000) with "
+     << dir << "route_supports.csv' every ::1 using ($2 == 450 && $5 == 0 && $6 == 0 ? $4 : 1/0):($16 / 1000) smooth unique with "
         "linespoints title 'plan time', '' every ::1 using ($2 == 450 && $5 == 0 && $6 == 0 ? $4 : 1/0):($13 * 100) axes "
-        "x1y2 with linespoints title 'share within reach'\nunset multiplot\n";
+        "x1y2 smooth unique with linespoints title 'share within reach'\nunset multiplot\n";
   const std::string cmd = "gnuplot <<'EOF'\n" + gp.str() + "EOF\n";
   if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "gnuplot failed (chart not drawn)\n");
 }
