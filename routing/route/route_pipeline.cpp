@@ -96,7 +96,10 @@ struct SegmentGeometry {
   Centerline curve;
   Vec3 a, a_stub, b_stub, b;  ///< the ends and their stub ends, as planned
   PlanRequest request;        ///< what the planner was asked (for re-planning)
-  std::vector<int> visible;   ///< segments whose bundles were its obstacles when it was planned
+  std::vector<int> visible;   ///< segments whose bundles are its obstacles (see replan_bend_failures)
+  /// The segments whose bundles were its obstacles when it was first planned (those routed
+  /// before it): a bend-feasible plan among every bundle that fails is tried among these.
+  std::vector<int> planned_among;
   /// The planned corners rounded by arcs (node to node) when they fit clear: the points used
   /// if the bend repair of `points` fails. Empty otherwise.
   std::vector<Vec3> arc_points;
@@ -850,7 +853,7 @@ bool RouteRun::try_bend_plan(int s) {
   if (!planned) return false;
   build_curve(s);
   if (!bend_failed(s)) {
-    if (tubes_.count(s)) add_bundle_tube(s);  // later plans avoid the new route
+    if (tubes_.count(s)) add_bundle_tube(s);  // the bundles re-planned after it avoid the new route
     return true;
   }
   g = saved;
@@ -1029,7 +1032,10 @@ void RouteRun::replan_bend_failures() {
   // Every segment is planned now: what changes from here on (bend-feasible plans, re-plans,
   // the audit's densified curves) keeps clear of every other bundle, not only of those
   // routed before it (the later ones were planned around its old route).
-  for (auto& [s, g] : geom_) g.visible = routed_now(s);
+  for (auto& [s, g] : geom_) {
+    g.planned_among = g.visible;
+    g.visible = routed_now(s);
+  }
   for (auto& [s, g] : geom_) {
     // Stub ends that coincide leave nothing to re-plan (and plan_path refuses equal ends).
     if ((g.b_stub - g.a_stub).norm() <= eps_ || !bend_failed(s)) continue;
@@ -1065,6 +1071,18 @@ void RouteRun::replan_bend_failures() {
         info_of(s).replans = attempt;
         if (tubes_.count(s)) add_bundle_tube(s);
       }
+    }
+    // Last, among the bundles routed before it only, as it was first planned: the bundles
+    // planned after it went around its old route and may still leave a new one room. The
+    // audit judges what it passes near; the segment keeps that view from here on.
+    if (bend_failed(s) && g.planned_among.size() < g.visible.size()) {
+      std::vector<int> all = std::move(g.visible);
+      g.visible = g.planned_among;
+      if (try_bend_plan(s))
+        rep_.notes.push_back("segment " + h_.segments[s].from + " -> " + h_.segments[s].to +
+                             ": bend-feasible only among the bundles routed before it; the audit judges the later ones");
+      else
+        g.visible = std::move(all);
     }
   }
 }
