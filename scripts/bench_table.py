@@ -365,6 +365,24 @@ def route_quality_rows():
     ]
 
 
+def route_support_rows():
+    t = rows("route_supports.csv")
+    base = pick(t, "route_supports.csv", variant="no spacing")
+    r = pick(t, "route_supports.csv", variant="spacing", clamp_spacing_mm="450")
+    share = num(r, "share_within_reach", "route_supports.csv")
+    ratio = num(r, "length_ratio", "route_supports.csv")
+    slower = num(r, "plan_ms", "route_supports.csv") / num(base, "plan_ms", "route_supports.csv")
+    findings = sum(int(r[k]) for k in ("clashes", "violations", "unsupported_spans", "segregation"))
+    clean = r["routed"] == r["cables"] and findings == 0
+    return [
+        ("wing section, three cable classes, clamps every ≤ 450 mm within 25 mm: routed clean; share of length "
+         "within clamp reach; length and planning time against no spacing", "`route_supports.csv`",
+         f"{r['routed']}/{r['cables']}, {findings} findings; {share:.1%}; {sig(ratio, strip=False)} ×, "
+         f"{sig(slower, strip=False)} ×", "clean; ≥ 90%; ≤ 1.15 ×, ≤ 2 ×",
+         status(clean and share >= 0.9 and ratio <= 1.15 and slower <= 2.0)),
+    ]
+
+
 def scan_rows():
     sp = pick(rows("scan_speed.csv"), "scan_speed.csv", points="76503", method="graph", threads="2")
     ms, rate = num(sp, "wall_ms", "scan_speed.csv"), num(sp, "points_per_s_wall", "scan_speed.csv")
@@ -381,7 +399,7 @@ def scan_rows():
 
 def table():
     lines = ["| measure | bench/results | measured | target | status |", "|---|---|---|---|---|"]
-    for group in (audit_rows, harness_audit_rows, fcl_peer_rows, audit_mpi_rows, index_rows, centerline_rows, alpha_sim_rows, tessellation_need_rows, planning_rows, route_quality_rows, scan_rows):
+    for group in (audit_rows, harness_audit_rows, fcl_peer_rows, audit_mpi_rows, index_rows, centerline_rows, alpha_sim_rows, tessellation_need_rows, planning_rows, route_quality_rows, route_support_rows, scan_rows):
         for row in group():
             lines.append("| " + " | ".join(row) + " |")
     return "\n".join(lines) + "\n"
