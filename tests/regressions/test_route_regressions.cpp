@@ -133,9 +133,10 @@ TEST(RouteRegression, AnUnroutedCableIsNeverDrawn) {
 // (examples/wing-classes, positions removed): the bend-feasible plans and re-plans made after
 // every segment was planned kept clear only of the bundles routed before theirs, so later
 // bundles, planned around their old routes, were crossed (12 cable-cable clashes, 102
-// violations, 21 segregation findings); and data and power nodes placed 30 mm apart left
-// data legs no start (8 of 24 cables unrouted). Re-plans now keep clear of every other
-// bundle and refresh their own.
+// violations, 21 segregation findings); data and power nodes placed 30 mm apart, and
+// breakouts of segments still to be routed not grown by the separation of their classes,
+// left data legs no start (8 of 24 cables unrouted). Re-plans now keep clear of every other
+// bundle and refresh their own; nodes and breakouts keep the separation.
 TEST(RouteRegression, WingClassesWithRouterPlacedBranchPointsIsClean) {
   Scene sc = load_scene(std::string(LOOM_SOURCE_DIR) + "/examples/wing-classes/scene.toml");
   for (auto& b : sc.harness.branches) b.position.reset();
