@@ -25,7 +25,7 @@ constexpr std::size_t kMinCountCap = 1000;
 /// this factor (BoxPairResult::estimated_kept).
 constexpr double kKeptEstimateMargin = 2.0;
 
-/// Fills result.estimated_overlaps and result.busiest (see BoxPairResult). Why a sample:
+/// Fills result.estimated_overlaps, estimated_kept and busiest (see BoxPairResult). Why a sample:
 /// counting every box's overlaps costs what enumerating them does.
 void estimate_overlaps(const BoxTree& tree, const std::vector<AABB>& boxes, std::size_t budget,
                        const BoxTree::PairFilter& filter, BoxPairResult& result) {
