@@ -1,6 +1,7 @@
 // `mpirun -np K loom audit`: loading, planning, part exchange and merge over MPI.
 #include "app/audit_mpi.hpp"
 
+#include "core/io/mesh_read.hpp"
 #include "core/error.hpp"
 #include "core/stopwatch.hpp"
 #include "routing/audit/audit_shard.hpp"
@@ -285,12 +286,14 @@ ShardedAudit sharded_audit(const MpiWorld& mpi, const std::filesystem::path& sce
     share.use_cache = true;
     for (std::size_t e = 0; e < loader.size(); ++e) share.entries.push_back(loader[e] == mpi.rank());
     share.tessellate_by_need = true;
+    CadShapeStore cad_shapes;  // the coarse pass's transferred files, for the refinement
+    share.cad_shapes = &cad_shapes;
     SceneLoadReport rep;
     Scene s = load_scene(scene_file, share, &rep);
     load_notes = rep.notes;
     s.harness = out.scene.harness;  // with --routes applied: tessellation by need follows the audited routes
     s.has_harness = out.scene.has_harness;
-    refine_for_audit(s, opt);
+    refine_for_audit(s, opt, &cad_shapes);
     for (std::size_t k = 0; k < s.parts.size(); ++k) {
       const Part& p = s.parts[k];
       const int entry = rep.part_entries.at(k);

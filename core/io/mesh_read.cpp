@@ -13,6 +13,7 @@
 
 #include <BRepBndLib.hxx>
 #include <BRepMesh_IncrementalMesh.hxx>
+#include <BRepTools.hxx>
 #include <Bnd_Box.hxx>
 #include <BRep_Tool.hxx>
 #include <IGESCAFControl_Reader.hxx>
@@ -229,16 +230,45 @@ void collect_leaves(const Handle(XCAFDoc_ShapeTool)& tool, const TDF_Label& labe
 constexpr double kMinRelativeDeflection = 1e-6;
 constexpr const char* kMinRelativeDeflectionText = "1e-6";
 
-std::vector<NamedMesh> read_cad_file_occ(const std::filesystem::path& path, const TessellationParams& tp, bool split,
-                                         const std::vector<int>* only_leaves);
+std::shared_ptr<CadShapes> transfer_cad_file(const std::filesystem::path& path);
+std::vector<NamedMesh> mesh_cad_shapes(CadShapes& shapes, const std::filesystem::path& path,
+                                       const TessellationParams& tp, bool split, const std::vector<int>* only_leaves);
 }  // namespace
 
+struct CadShapes {
+  std::vector<Leaf> leaves;
+  double diagonal_mm = 0.0;  ///< of the leaves' bounding box (0: void)
+  bool meshed = false;       ///< some leaf carries a triangulation from an earlier meshing
+};
+
+CadShapeStore::CadShapeStore() = default;
+CadShapeStore::~CadShapeStore() = default;
+
+std::shared_ptr<CadShapes> CadShapeStore::find(const std::filesystem::path& path) const {
+  const auto it = files_.find(path.string());
+  return it == files_.end() ? nullptr : it->second;
+}
+
+void CadShapeStore::add(const std::filesystem::path& path, std::shared_ptr<CadShapes> shapes) {
+  files_[path.string()] = std::move(shapes);
+}
+
 std::vector<NamedMesh> read_cad_file(const std::filesystem::path& path, const TessellationParams& tp, bool split,
-                                     const std::vector<int>* only_leaves) {
+                                     const std::vector<int>* only_leaves, CadShapeStore* store) {
   // OpenCASCADE reports failures of its readers and mesher by exceptions of its own: they
   // are the file's (or the deflection's) fault, so they become input errors naming both.
   try {
-    return read_cad_file_occ(path, tp, split, only_leaves);
+    require_input_file(path, "file");
+    if (!is_cad_file(path))
+      throw InputError({path.string(), 0, ""}, "not a STEP/IGES file: '" + path.extension().string() + "'");
+    if (!(tp.linear_deflection > 0.0))
+      throw InputError({path.string(), 0, ""}, "tessellation deflection must be positive");
+    std::shared_ptr<CadShapes> shapes = store ? store->find(path) : nullptr;
+    if (!shapes) {
+      shapes = transfer_cad_file(path);
+      if (store) store->add(path, shapes);
+    }
+    return mesh_cad_shapes(*shapes, path, tp, split, only_leaves);
   } catch (const Standard_Failure& e) {
     throw InputError({path.string(), 0, ""}, std::string("OpenCASCADE failed (") + e.DynamicType()->Name() +
                                                  "): " + (e.GetMessageString() ? e.GetMessageString() : "") +
@@ -248,13 +278,8 @@ std::vector<NamedMesh> read_cad_file(const std::filesystem::path& path, const Te
 }
 
 namespace {
-std::vector<NamedMesh> read_cad_file_occ(const std::filesystem::path& path, const TessellationParams& tp, bool split,
-                                         const std::vector<int>* only_leaves) {
-  require_input_file(path, "file");
-  if (!is_cad_file(path))
-    throw InputError({path.string(), 0, ""}, "not a STEP/IGES file: '" + path.extension().string() + "'");
-  if (!(tp.linear_deflection > 0.0))
-    throw InputError({path.string(), 0, ""}, "tessellation deflection must be positive");
+/// Parses and transfers a STEP/IGES file: its leaf products in the assembly frame (mm).
+std::shared_ptr<CadShapes> transfer_cad_file(const std::filesystem::path& path) {
   Handle(XCAFApp_Application) app = XCAFApp_Application::GetApplication();
   Handle(TDocStd_Document) doc;
   app->NewDocument("MDTV-XCAF", doc);
@@ -284,24 +309,33 @@ std::vector<NamedMesh> read_cad_file_occ(const std::filesystem::path& path, cons
   for (Standard_Integer i = 1; i <= roots.Length(); ++i) collect_leaves(tool, roots.Value(i), TopLoc_Location(), leaves);
   app->Close(doc);
   if (leaves.empty()) throw InputError({path.string(), 0, ""}, "the file contains no shapes");
+  auto shapes = std::make_shared<CadShapes>();
+  Bnd_Box bb;
+  for (const auto& l : leaves) BRepBndLib::Add(l.shape, bb);
+  if (!bb.IsVoid()) shapes->diagonal_mm = std::sqrt(bb.SquareExtent());
+  shapes->leaves = std::move(leaves);
+  return shapes;
+}
 
+/// Meshes transferred shapes as read_cad_file describes. Shapes meshed before lose that
+/// triangulation first, so that the meshes are those of a fresh reading whatever came
+/// before (OpenCASCADE's mesher keeps a finer triangulation it finds).
+std::vector<NamedMesh> mesh_cad_shapes(CadShapes& shapes, const std::filesystem::path& path,
+                                       const TessellationParams& tp, bool split, const std::vector<int>* only_leaves) {
+  const std::vector<Leaf>& leaves = shapes.leaves;
+  if (shapes.meshed)
+    for (const auto& l : leaves) BRepTools::Clean(l.shape);
+  shapes.meshed = true;
   const double scale = 1.0 / tp.unit_in_mm;
   // Deflection is given in scene units; OpenCASCADE meshes in the file's (mm) frame.
   const double lin_mm = tp.linear_deflection * tp.unit_in_mm;
-  {
-    Bnd_Box bb;
-    for (const auto& l : leaves) BRepBndLib::Add(l.shape, bb);
-    if (!bb.IsVoid()) {
-      const double diag_mm = std::sqrt(bb.SquareExtent());
-      if (lin_mm < kMinRelativeDeflection * diag_mm)
-        throw InputError({path.string(), 0, ""},
-                         "tessellation deflection " + full_precision(tp.linear_deflection) + " scene units is below " +
-                             kMinRelativeDeflectionText + " of the file's size (" +
-                             full_precision(diag_mm * scale) +
-                             " scene units): raise tessellation.linear_deflection, or the smallest cable diameter "
-                             "its default follows");
-    }
-  }
+  if (lin_mm < kMinRelativeDeflection * shapes.diagonal_mm)
+    throw InputError({path.string(), 0, ""},
+                     "tessellation deflection " + full_precision(tp.linear_deflection) + " scene units is below " +
+                         kMinRelativeDeflectionText + " of the file's size (" +
+                         full_precision(shapes.diagonal_mm * scale) +
+                         " scene units): raise tessellation.linear_deflection, or the smallest cable diameter "
+                         "its default follows");
   const double ang = tp.angular_deflection_deg * M_PI / 180.0;
   std::vector<NamedMesh> out;
   if (!split) {

@@ -5,7 +5,10 @@
 
 #include "core/mesh.hpp"
 
+#include <cstddef>
 #include <filesystem>
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -45,12 +48,39 @@ Mesh read_mesh_file(const std::filesystem::path& path);
 /// and reads no materials, so the names change nothing it reads.
 std::string obj_text_for_assimp(std::string text);
 
+/// The shapes of a STEP/IGES file as OpenCASCADE transferred them (its leaf products in the
+/// assembly frame, with their names): all that meshing needs. Defined in mesh_read.cpp.
+struct CadShapes;
+
+/// Transferred CAD files by path, kept for the life of one load so that a file is parsed
+/// once however often it is meshed (tessellation by need meshes a file coarse, then some of
+/// its leaves fine: the second parse was the whole of its overhead). Not thread-safe.
+class CadShapeStore {
+ public:
+  CadShapeStore();
+  ~CadShapeStore();
+  CadShapeStore(const CadShapeStore&) = delete;
+  CadShapeStore& operator=(const CadShapeStore&) = delete;
+  /// The shapes of `path` if this store holds them, else null.
+  std::shared_ptr<CadShapes> find(const std::filesystem::path& path) const;
+  /// Keeps the shapes of `path`.
+  void add(const std::filesystem::path& path, std::shared_ptr<CadShapes> shapes);
+  /// Files held.
+  std::size_t size() const { return files_.size(); }
+
+ private:
+  std::map<std::string, std::shared_ptr<CadShapes>> files_;
+};
+
 /// Reads a STEP/IGES file. With `split` true, one NamedMesh per leaf product occurrence
 /// (name = product name, "#k" appended to repeated names); otherwise one compound mesh.
 /// `only_leaves` (split only; ascending leaf indices): tessellate just those leaves, the
-/// others are skipped (names stay those of the whole file's reading).
+/// others are skipped (names stay those of the whole file's reading). With a `store`, the
+/// file's transferred shapes are taken from it when it holds them (the meshes are those of a
+/// fresh reading) and added to it otherwise.
 std::vector<NamedMesh> read_cad_file(const std::filesystem::path& path, const TessellationParams& tp,
-                                     bool split, const std::vector<int>* only_leaves = nullptr);
+                                     bool split, const std::vector<int>* only_leaves = nullptr,
+                                     CadShapeStore* store = nullptr);
 
 /// Removes OpenCASCADE's console printers from its default messenger, for the whole
 /// process: its STEP/IGES readers and writers otherwise print transfer statistics on stdout,

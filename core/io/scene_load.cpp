@@ -555,7 +555,10 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
           tp.linear_deflection = deflection;
           tp.angular_deflection_deg = scene.tessellation.angular_deflection_deg.value;
           tp.unit_in_mm = unit_in_mm(scene.units);
-          pieces = opt.use_cache ? read_cad_file_cached(fpath, tp, !compound) : read_cad_file(fpath, tp, !compound);
+          // Transferred files are kept only for a coarse pass: the refinement meshes from them.
+          CadShapeStore* keep = coarse_first ? opt.cad_shapes : nullptr;
+          pieces = opt.use_cache ? read_cad_file_cached(fpath, tp, !compound, nullptr, nullptr, keep)
+                                 : read_cad_file(fpath, tp, !compound, nullptr, keep);
         } else if (scan) {
           VoxelPart vp = read_voxel_part(fpath, *scan);
           voxel_edge = vp.resolution * xf.linear().col(0).norm();
@@ -618,7 +621,7 @@ Scene load_scene(const std::filesystem::path& toml_path, const SceneLoadOptions&
   return scene;
 }
 
-void retessellate_parts(Scene& scene, const std::vector<int>& parts, double deflection) {
+void retessellate_parts(Scene& scene, const std::vector<int>& parts, double deflection, CadShapeStore* cad_shapes) {
   TessellationParams tp;
   tp.linear_deflection = deflection;
   tp.angular_deflection_deg = scene.tessellation.angular_deflection_deg.value;
@@ -639,8 +642,8 @@ void retessellate_parts(Scene& scene, const std::vector<int>& parts, double defl
     for (const int k : ks) leaves.push_back(scene.parts[static_cast<std::size_t>(k)].source_leaf);
     std::sort(leaves.begin(), leaves.end());
     leaves.erase(std::unique(leaves.begin(), leaves.end()), leaves.end());
-    std::vector<NamedMesh> pieces = compound ? read_cad_file_cached(file, tp, false)
-                                             : read_cad_file_cached(file, tp, true, nullptr, &leaves);
+    std::vector<NamedMesh> pieces = compound ? read_cad_file_cached(file, tp, false, nullptr, nullptr, cad_shapes)
+                                             : read_cad_file_cached(file, tp, true, nullptr, &leaves, cad_shapes);
     for (const int k : ks) {
       Part& p = scene.parts[static_cast<std::size_t>(k)];
       const auto it = std::find_if(pieces.begin(), pieces.end(),

@@ -11,6 +11,8 @@
 
 namespace loom {
 
+class CadShapeStore;  // core/io/mesh_read.hpp
+
 /// What load_scene() should do.
 struct SceneLoadOptions {
   bool load_parts = true;    ///< false: only TOML + harness (fast, for tests of settings)
@@ -25,6 +27,9 @@ struct SceneLoadOptions {
   /// refines what cables come near: retessellate_parts). False: every CAD part at the fine
   /// deflection, and a note when the scene asks for tessellation by need.
   bool tessellate_by_need = false;
+  /// With tessellate_by_need and a scene that asks for it: transferred CAD files to read
+  /// from and keep (read_cad_file) for the refinement (retessellate_parts). Null: none kept.
+  CadShapeStore* cad_shapes = nullptr;
 };
 
 /// What loading took and noticed.
@@ -45,7 +50,8 @@ Scene load_scene(const std::filesystem::path& toml, const SceneLoadOptions& opt 
 /// `deflection` (scene units) from their files, each with its leaf and entry transform,
 /// through the tessellation cache (keyed by the leaves too); meshes, closedness and
 /// deflection replaced. Throws InputError naming the file.
-void retessellate_parts(Scene& scene, const std::vector<int>& parts, double deflection);
+void retessellate_parts(Scene& scene, const std::vector<int>& parts, double deflection,
+                        CadShapeStore* cad_shapes = nullptr);
 
 /// Replaces the scene's harness by a routed harness XML (`--routes`). Throws InputError
 /// naming the routes file for a unit mismatch or any harness error.

@@ -130,21 +130,22 @@ std::string tessellation_cache_key(const std::filesystem::path& file, const Tess
 }
 
 std::vector<NamedMesh> read_cad_file_cached(const std::filesystem::path& path, const TessellationParams& tp,
-                                            bool split, bool* hit, const std::vector<int>* only_leaves) {
+                                            bool split, bool* hit, const std::vector<int>* only_leaves,
+                                            CadShapeStore* shapes) {
   // Before the key hashes its bytes: a FIFO never gives any, a device such as /dev/zero never ends.
   require_input_file(path, "file");
   const auto dir = tessellation_cache_dir();
   std::vector<NamedMesh> out;
   if (dir.empty()) {
     if (hit) *hit = false;
-    return read_cad_file(path, tp, split, only_leaves);
+    return read_cad_file(path, tp, split, only_leaves, shapes);
   }
   const auto f = dir / (tessellation_cache_key(path, tp, split, only_leaves) + ".tess");
   if (load(f, out)) {
     if (hit) *hit = true;
     return out;
   }
-  out = read_cad_file(path, tp, split, only_leaves);
+  out = read_cad_file(path, tp, split, only_leaves, shapes);
   store(f, out);
   if (hit) *hit = false;
   return out;

@@ -22,9 +22,11 @@ std::string tessellation_cache_key(const std::filesystem::path& file, const Tess
 
 /// read_cad_file() through the cache: a hit returns the stored meshes, a miss tessellates
 /// and stores. `hit` (if given) tells which happened. A path that is not a readable regular
-/// file is an InputError before anything is hashed (require_input_file).
+/// file is an InputError before anything is hashed (require_input_file). A miss reads
+/// through `shapes` (read_cad_file's store).
 std::vector<NamedMesh> read_cad_file_cached(const std::filesystem::path& path, const TessellationParams& tp,
                                             bool split, bool* hit = nullptr,
-                                            const std::vector<int>* only_leaves = nullptr);
+                                            const std::vector<int>* only_leaves = nullptr,
+                                            CadShapeStore* shapes = nullptr);
 
 }  // namespace loom

@@ -3,6 +3,7 @@
 
 #include "routing/audit/audit_shard.hpp"
 
+#include "core/io/mesh_read.hpp"
 #include "core/stopwatch.hpp"
 #include "core/error.hpp"
 #include "core/harness_topology.hpp"
@@ -426,13 +427,13 @@ void apply_matching_routes(Scene& scene, const std::filesystem::path& routes) {
   if (same) scene.harness.kbl = designed->kbl;
 }
 
-TessellationByNeed refine_for_audit(Scene& scene, const AuditOptions& opt) {
+TessellationByNeed refine_for_audit(Scene& scene, const AuditOptions& opt, CadShapeStore* cad_shapes) {
   if (!scene.tessellation.by_need) return {};
   std::vector<AuditCable> ignored;
   const std::vector<CableInput> inputs =
       scene.has_harness ? audit_cable_inputs(scene.harness, ignored) : std::vector<CableInput>{};
   const double tol = opt.check.tolerance > 0.0 ? opt.check.tolerance : default_clash_tolerance(inputs);
-  return tessellate_by_need(scene, inputs, tol);
+  return tessellate_by_need(scene, inputs, tol, cad_shapes);
 }
 
 Scene load_audit_scene(const std::filesystem::path& scene_file, const AuditOptions& opt, const SceneLoadOptions& load,
@@ -449,8 +450,16 @@ AuditReport audit_scene_file(const std::filesystem::path& scene_file, const Audi
   SceneLoadOptions load_opt;
   load_opt.progress = opt.progress;
   load_opt.tessellate_by_need = true;
-  Scene scene = load_audit_scene(scene_file, opt, load_opt, &load_rep);
-  const TessellationByNeed tess = refine_for_audit(scene, opt);
+  Scene scene;
+  TessellationByNeed tess;
+  {
+    // The coarse pass's transferred CAD files, meshed again where cables come near (kept
+    // only for the scenes that ask for tessellation by need, freed once refined).
+    CadShapeStore cad_shapes;
+    load_opt.cad_shapes = &cad_shapes;
+    scene = load_audit_scene(scene_file, opt, load_opt, &load_rep);
+    tess = refine_for_audit(scene, opt, &cad_shapes);
+  }
   const double load_ms = t0.ms();
   AuditReport rep = run_audit(scene, opt);
   rep.load_ms = load_ms;

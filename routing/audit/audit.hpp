@@ -20,6 +20,8 @@
 
 namespace loom {
 
+class CadShapeStore;  // core/io/mesh_read.hpp
+
 struct AuditShard;
 
 /// What `loom audit` was asked to do.
@@ -141,7 +143,7 @@ Scene load_audit_scene(const std::filesystem::path& scene_file, const AuditOptio
 /// coarse CAD parts its routed cables come within reach of are meshed at the fine
 /// deflection (tessellate_by_need, at the audit's tolerance). Nothing when the scene does
 /// not ask for it; without a harness every part stays coarse (nothing is checked).
-TessellationByNeed refine_for_audit(Scene& scene, const AuditOptions& opt);
+TessellationByNeed refine_for_audit(Scene& scene, const AuditOptions& opt, CadShapeStore* cad_shapes = nullptr);
 
 /// Loads the scene file (timed as timing_ms.load), applies --routes (apply_matching_routes),
 /// and audits it. Throws InputError (exit 2)

@@ -80,7 +80,8 @@ std::string tessellation_note(const TessellationByNeed& t) {
   return buf;
 }
 
-TessellationByNeed tessellate_by_need(Scene& scene, const std::vector<CableInput>& cables, double tolerance) {
+TessellationByNeed tessellate_by_need(Scene& scene, const std::vector<CableInput>& cables, double tolerance,
+                                      CadShapeStore* cad_shapes) {
   TessellationByNeed out;
   if (!scene.tessellation.by_need) return out;
   const Stopwatch t0;
@@ -88,7 +89,7 @@ TessellationByNeed tessellate_by_need(Scene& scene, const std::vector<CableInput
   out.coarse_deflection = scene.tessellation.coarse_deflection.value;
   out.fine_deflection = scene.tessellation.linear_deflection.value;
   out.refined = parts_within_reach(scene.parts, cables, scene.routing.clearance.value, out.fine_deflection, tolerance);
-  if (!out.refined.empty()) retessellate_parts(scene, out.refined, out.fine_deflection);
+  if (!out.refined.empty()) retessellate_parts(scene, out.refined, out.fine_deflection, cad_shapes);
   for (const Part& p : scene.parts)
     if (coarse(p, out.fine_deflection)) ++out.coarse_parts;
   out.ms = t0.ms();

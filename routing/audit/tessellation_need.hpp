@@ -17,6 +17,8 @@
 
 namespace loom {
 
+class CadShapeStore;  // core/io/mesh_read.hpp
+
 /// What tessellation by need did (report.json "tessellation").
 struct TessellationByNeed {
   bool used = false;               ///< the scene asked for it ([tessellation] by_need)
@@ -40,6 +42,7 @@ std::string tessellation_note(const TessellationByNeed& t);
 /// Refines the scene's coarse CAD parts that the cables come within reach of
 /// (retessellate_parts at the fine deflection) and says what it did; nothing when the
 /// scene does not ask for tessellation by need.
-TessellationByNeed tessellate_by_need(Scene& scene, const std::vector<CableInput>& cables, double tolerance);
+TessellationByNeed tessellate_by_need(Scene& scene, const std::vector<CableInput>& cables, double tolerance,
+                                      CadShapeStore* cad_shapes = nullptr);
 
 }  // namespace loom

@@ -376,6 +376,36 @@ TEST(RealCad, FinerDeflectionMoreTriangles) {
   EXPECT_GT(b[0].mesh.triangle_count(), a[0].mesh.triangle_count());
 }
 
+// A store keeps a file's transferred shapes: meshing them again at another deflection, for
+// other leaves, or coarse after fine, gives exactly the meshes of a fresh reading
+// (OpenCASCADE's mesher would otherwise keep the finer triangulation it finds).
+TEST(RealCad, StoredShapesMeshAsAFreshReading) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
+  const fs::path file = kData / "stepcode/as1-oc-214.stp";
+  TessellationParams coarse, fine;
+  coarse.linear_deflection = 2.0;
+  fine.linear_deflection = 0.25;
+  auto same = [](const std::vector<NamedMesh>& a, const std::vector<NamedMesh>& b) {
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      EXPECT_EQ(a[i].name, b[i].name);
+      EXPECT_EQ(a[i].leaf, b[i].leaf);
+      EXPECT_EQ(a[i].mesh.vertices, b[i].mesh.vertices) << a[i].name;
+      EXPECT_EQ(a[i].mesh.triangles, b[i].mesh.triangles) << a[i].name;
+    }
+  };
+  CadShapeStore store;
+  const auto c1 = read_cad_file(file, coarse, true, nullptr, &store);
+  EXPECT_EQ(store.size(), 1u);
+  same(c1, read_cad_file(file, coarse, true));
+  const std::vector<int> leaves{1, 4, 17};
+  const auto f = read_cad_file(file, fine, true, &leaves, &store);
+  same(f, read_cad_file(file, fine, true, &leaves));
+  EXPECT_NE(f[0].mesh.vertices, c1[1].mesh.vertices);  // meshed again, not the coarse triangulation
+  same(read_cad_file(file, coarse, false, nullptr, &store), read_cad_file(file, coarse, false));  // coarse after fine
+  EXPECT_EQ(store.size(), 1u);
+}
+
 TEST(RealCad, CacheReturnsTheSameMeshes) {
   LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data(""));
   const fs::path dir = fs::temp_directory_path() / "loom_tess_cache_test";
