@@ -18,9 +18,10 @@
 #
 # Environment: LOOM_FUZZ_BUILD_DIR (default build-fuzz), LOOM_JOBS (default nproc),
 # LOOM_FUZZ_TIMEOUT (seconds one input may take, default 30; six times that for routes),
-# LOOM_FUZZ_RSS_MB (default
-# 2048), LOOM_FUZZ_MAX_SEED (bytes, default 65536), LOOM_SHARED_DATA (default
-# ../shared/data beside the repository).
+# LOOM_FUZZ_RSS_MB (default 2048), LOOM_FUZZ_MAX_SEED (bytes, default 65536),
+# LOOM_SHARED_DATA (default ../shared/data beside the repository), LOOM_FUZZ_KEEP_RECENT and LOOM_FUZZ_KEEP_DIR (mesh
+# targets: keep the last N inputs in that directory, to replay the run up to a crash that
+# surfaced after its cause: tests/fuzz/fuzz_support.hpp keep_recent).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${LOOM_FUZZ_BUILD_DIR:-$root/build-fuzz}"

@@ -26,6 +26,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  loom::fuzz::keep_recent(data, size);
   loom::fuzz::write_bytes(loom::fuzz::scratch_dir() / kPartFile, data, size);
   loom::fuzz::expect_only_input_errors([] {
     loom::SceneLoadOptions opt;

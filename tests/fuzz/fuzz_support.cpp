@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <fstream>
 #include <iterator>
@@ -56,6 +57,25 @@ void write_bytes(const std::filesystem::path& path, const std::uint8_t* data, st
 
 void write_text(const std::filesystem::path& path, const std::string& text) {
   write_bytes(path, reinterpret_cast<const std::uint8_t*>(text.data()), text.size());
+}
+
+void keep_recent(const std::uint8_t* data, std::size_t size) {
+  // Read once: the environment does not change while the fuzzer runs.
+  static const long ring = [] {
+    const char* n = std::getenv("LOOM_FUZZ_KEEP_RECENT");
+    return n && std::getenv("LOOM_FUZZ_KEEP_DIR") ? std::strtol(n, nullptr, 10) : 0L;
+  }();
+  if (ring <= 0) return;
+  static long run = 0;
+  static const std::filesystem::path dir = std::getenv("LOOM_FUZZ_KEEP_DIR");
+  auto name = [](long k) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "recent-%012ld", k);
+    return dir / buf;
+  };
+  std::error_code ec;
+  if (run >= ring) std::filesystem::remove(name(run - ring), ec);  // the ring holds the last `ring` runs
+  write_bytes(name(run++), data, size);
 }
 
 std::string read_test_data(const std::string& name) {

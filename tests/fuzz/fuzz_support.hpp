@@ -19,6 +19,13 @@ void write_bytes(const std::filesystem::path& path, const std::uint8_t* data, st
 /// Same for text.
 void write_text(const std::filesystem::path& path, const std::string& text);
 
+/// With LOOM_FUZZ_KEEP_RECENT=N (N > 0) and LOOM_FUZZ_KEEP_DIR set: writes the input to
+/// KEEP_DIR/recent-<run number, 12 digits>, removing the file of N runs before, so that the
+/// last N inputs before a crash can be replayed in order (`fuzz_<target> KEEP_DIR/recent-*`). Why: heap corruption inside an
+/// uninstrumented library is noticed at a later free, under another input than the one
+/// that corrupted it, and libFuzzer saves only the last one. Otherwise does nothing.
+void keep_recent(const std::uint8_t* data, std::size_t size);
+
 /// The bytes of the file `name` of tests/data (`tests/data/<name>`).
 std::string read_test_data(const std::string& name);
 
