@@ -250,6 +250,12 @@ void read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
     } else if (w[0] == "element") {
       PlyElementExtent e;
       if (w.size() != 3 || !parse_count(w[2], e.count)) refuse("element", "expected 'element NAME COUNT' with a whole COUNT");
+      // Assimp keeps one list per element name: a second "element vertex 9" after "element
+      // vertex 8" had its values written past the end of the first one's (heap corruption).
+      for (const PlyElementExtent& before : out.extents)
+        if (before.name == w[1])
+          refuse("element " + printable(w[1]), "declared again (first at line " + std::to_string(before.line) +
+                                                   "): each element name may be declared once");
       e.name = w[1];
       e.line = line_no;
       out.extents.push_back(e);
