@@ -9,7 +9,8 @@
 ///    silently different triangle); such an index is refused, naming its line.
 ///  - A PLY header must end (Assimp's line reader spun forever on one that did not), and
 ///    each ASCII instance must be one line of its properties' values (Assimp takes a missing
-///    one as 0, and aborted on the face of no vertices that made).
+///    one as 0, and aborted on the face of no vertices that made); each element name is
+///    declared once (Assimp wrote a second one's values past the first one's list).
 ///  - ASCII STL facets (stl_file_checks.hpp): a normal and three vertices each, numbers
 ///    that are numbers (Assimp leaked every solid it rejected).
 ///  - DAE (COLLADA) and glTF/GLB node graphs (mesh_node_checks.hpp): nesting deeper than
