@@ -463,6 +463,13 @@ void check_ply_ascii_body(const std::filesystem::path& path, const PlyLayout& la
                              " in the file (a truncated file?)");
       ++line_no;
       const std::uint64_t next_line_at = line_at_byte + line.size() + 1;
+      // Assimp ends a data line at a carriage return too: "0 1\r 1" was a vertex of two
+      // values and a line of one to it, the instances laid out apart from this check's, and
+      // its triangulation aborted. Only the return of a CRLF line end is a line's last byte.
+      if (const std::size_t cr = line.find('\r'); cr != std::string::npos && cr + 1 < line.size())
+        throw InputError({path.string(), line_no, where},
+                         "a carriage return inside the line (byte 13 at column " + std::to_string(cr + 1) +
+                             "): only line ends may hold one");
       const auto w = ply_words(line);
       std::size_t at = 0;  // index in w of the next value
       bool short_line = false;

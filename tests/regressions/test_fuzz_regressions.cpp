@@ -368,6 +368,24 @@ TEST(FuzzRegression, PlyAsciiShortFaceListAborted) {
   EXPECT_EQ(loom::read_mesh_file(d / "ok.ply").triangle_count(), 3u);
 }
 
+// An ASCII vertex line "0 1\r 1" (libFuzzer, seed 7, after the element fix): Assimp ends a
+// data line at a carriage return, read a vertex of two values and a line of one, laid the
+// instances out apart from the pre-check and aborted in its triangulation (SIGABRT in a
+// Release `loom info`). CRLF files stay readable.
+TEST(FuzzRegression, PlyDataCarriageReturnInsideALineAborted) {
+  const fs::path d = scratch();
+  fs::copy_file(fs::path(LOOM_SOURCE_DIR) / "tests/fuzz/findings/mesh_ply/data-carriage-return-abort.ply",
+                d / "cr.ply");
+  const auto r = bounded_info_of_part(d, "cr.ply");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("cr.ply:13: element vertex instance 2: a carriage return inside the line"), std::string::npos)
+      << r.out;
+  std::string crlf = kPlyQuadHeader + "0 0 0\n1 0 0\n0 1 0\n1 1 1\n3 0 1 2\n3 1 2 3\n";
+  for (std::size_t at = crlf.find('\n'); at != std::string::npos; at = crlf.find('\n', at + 2)) crlf.insert(at, "\r");
+  write(d / "crlf.ply", crlf);
+  EXPECT_EQ(loom::read_mesh_file(d / "crlf.ply").triangle_count(), 2u);
+}
+
 // A binary big-endian PLY declaring "element vertex" three times (8 vertices of x, y, z, then
 // 8 and 9 of x alone; libFuzzer, seed 7, caught twice within 16,000 runs once the inputs
 // before the crash were kept): Assimp keeps one list per element name and wrote the later
