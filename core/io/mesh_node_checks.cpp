@@ -406,7 +406,13 @@ void check_dae_file(const std::filesystem::path& path) {
 
 void check_gltf_file(const std::filesystem::path& path, bool binary) {
   const nlohmann::json doc = nlohmann::json::parse(gltf_json(path, binary), nullptr, false);
-  if (doc.is_discarded() || !doc.is_object()) return;
+  // Not left to Assimp: when both of its glTF importers decline a file, it offers the file
+  // to every other importer by content, and a text "indexarray{..." went to one (OpenGEX)
+  // that read past its buffer.
+  if (doc.is_discarded() || !doc.is_object())
+    throw InputError({path.string(), 0, binary ? "GLB JSON chunk" : "glTF"},
+                     std::string(doc.is_discarded() ? "the JSON does not parse" : "the JSON is not an object") +
+                         " (not a glTF file)");
   check_gltf_buffers(doc, path, binary);
   if (!doc.contains("nodes")) return;
   const nlohmann::json& nodes = doc["nodes"];

@@ -31,7 +31,8 @@ void check_dae_file(const std::filesystem::path& path);
 
 /// Throws InputError naming the file and node for a glTF (or GLB, `binary`) file whose node
 /// hierarchy is deeper than kMaxMeshNesting, cyclic, or expands beyond kMaxMeshNodeInstances /
-/// kMaxMeshInstancedCorners. A file whose JSON does not parse is left to Assimp.
+/// kMaxMeshInstancedCorners, and for one whose JSON does not parse or is not an object (Assimp
+/// would offer it to its other importers by content).
 void check_gltf_file(const std::filesystem::path& path, bool binary);
 
 }  // namespace loom

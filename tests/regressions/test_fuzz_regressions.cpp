@@ -368,6 +368,21 @@ TEST(FuzzRegression, PlyAsciiShortFaceListAborted) {
   EXPECT_EQ(loom::read_mesh_file(d / "ok.ply").triangle_count(), 3u);
 }
 
+// A .gltf of 37 bytes that is not JSON ("indexarray{..."; libFuzzer, seed 11): both of Assimp's
+// glTF importers declined it, Assimp offered it to every other importer by content, and
+// the OpenGEX one read past its buffer (ASan heap-buffer-overflow in strncmp). A glTF or GLB
+// whose JSON does not parse to an object is refused before Assimp sees it.
+TEST(FuzzRegression, GltfThatIsNotJsonWentToAnotherImporter) {
+  const fs::path d = scratch();
+  fs::copy_file(fs::path(LOOM_SOURCE_DIR) / "tests/fuzz/findings/mesh_gltf/not-json-other-importer-overread.gltf",
+                d / "other.gltf");
+  const std::string e = input_error([&] { loom::read_mesh_file(d / "other.gltf"); });
+  EXPECT_NE(e.find("other.gltf: glTF: the JSON does not parse (not a glTF file)"), std::string::npos) << e;
+  write(d / "array.gltf", "[1, 2]");
+  const std::string a = input_error([&] { loom::read_mesh_file(d / "array.gltf"); });
+  EXPECT_NE(a.find("array.gltf: glTF: the JSON is not an object"), std::string::npos) << a;
+}
+
 // An ASCII vertex line "0 1\r 1" (libFuzzer, seed 7, after the element fix): Assimp ends a
 // data line at a carriage return, read a vertex of two values and a line of one, laid the
 // instances out apart from the pre-check and aborted in its triangulation (SIGABRT in a
