@@ -316,6 +316,9 @@ PointCloud parse_ply(const std::string& bytes, const std::string& file) {
           const double n = decode(p.count_type, data + pos, swap);
           if (n < 0) fail_at_byte(file, pos, e.name, "negative list length");
           pos += static_cast<std::size_t>(scalar_size(p.count_type));
+          // Before the conversion (7.7e31 from a float count does not fit a size_t): each
+          // value takes a byte at least. NaN fails here too.
+          if (!(n <= static_cast<double>(end - pos))) fail_at_byte(file, pos, e.name, "list length beyond the data");
           const std::size_t bytes_n = static_cast<std::size_t>(n) * static_cast<std::size_t>(scalar_size(p.type));
           need(bytes_n, e.name);
           pos += bytes_n;
@@ -497,6 +500,10 @@ PointCloud parse_pcd(const std::string& bytes, const std::string& file) {
     nvals += fields[i].count;
     rec += fields[i].count * size;
   }
+  // The encoding before the counts are judged by it: an unknown one ("DATA 0") was refused
+  // only after 1.8·10¹² points had been reserved.
+  if (data != "ascii" && data != "binary" && data != "binary_compressed")
+    fail(file, hdr_line, "DATA", "unknown PCD data encoding '" + data + "'");
   // Points against the data, before anything is reserved: a point takes at least a line
   // (ascii), its record (binary), or its share of the uncompressed size (checked below).
   if ((data == "ascii" && points > data_bytes) || (data == "binary" && rec > 0 && points > data_bytes / rec))
