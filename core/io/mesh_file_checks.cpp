@@ -527,6 +527,13 @@ void check_ply(const std::filesystem::path& path) {
   if (ec || size < layout.data_at) return;
   const bool ascii = layout.format == PlyLayout::Format::Ascii;
   check_ply_extents(layout.extents, ascii, size - layout.data_at, path.string());
+  // Assimp takes a newline byte right after end_header's line for part of that line's end
+  // and reads the binary data one byte on from there (a tetrahedron whose first vertex
+  // began with 0x0a aborted in its triangulation); the file cannot be read as written.
+  if (!ascii && size > layout.data_at && file_bytes(path, layout.data_at + 1).back() == '\n')
+    throw InputError({path.string(), layout.header_lines, "PLY data"},
+                     "the binary data starts with a newline byte (0x0a), which Assimp takes for the end of "
+                     "the header: the data would be read one byte off");
   if (ascii) check_ply_ascii_body(path, layout, size);
   else check_ply_binary_lists(path, layout, size);
 }
