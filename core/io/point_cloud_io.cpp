@@ -318,7 +318,8 @@ PointCloud parse_ply(const std::string& bytes, const std::string& file) {
           pos += static_cast<std::size_t>(scalar_size(p.count_type));
           // Before the conversion (7.7e31 from a float count does not fit a size_t): each
           // value takes a byte at least. NaN fails here too.
-          if (!(n <= static_cast<double>(end - pos))) fail_at_byte(file, pos, e.name, "list length beyond the data");
+          if (!(n <= static_cast<double>(end - pos)))
+            fail_at_byte(file, pos, e.name, "truncated data: a list length beyond the bytes left");
           const std::size_t bytes_n = static_cast<std::size_t>(n) * static_cast<std::size_t>(scalar_size(p.type));
           need(bytes_n, e.name);
           pos += bytes_n;
