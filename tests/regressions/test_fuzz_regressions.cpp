@@ -62,6 +62,11 @@ loom::testing::LoomRun bounded_info_of_part(const fs::path& dir, const std::stri
   return run_bounded("info " + (dir / "scene.toml").string() + " --quiet");
 }
 
+/// Copies the kept finding `name` (tests/fuzz/findings/<name>) into `dir` as `as`.
+void kept_finding(const fs::path& dir, const std::string& name, const std::string& as) {
+  fs::copy_file(fs::path(LOOM_SOURCE_DIR) / "tests/fuzz/findings" / name, dir / as);
+}
+
 /// Writes `bytes` as `dir`/`file`, the one part of a scene, and expects `loom info` to refuse
 /// it (exit 2) with `expected` in its message.
 void expect_part_refused(const fs::path& dir, const std::string& file, const std::string& bytes,
@@ -284,8 +289,7 @@ const std::string kStlFacet =
 // of memory. Each facet's grammar is now checked before Assimp reads the file.
 TEST(FuzzRegression, StlAsciiFacetAssimpRejectedLeakedItsSolid) {
   const fs::path d = scratch();
-  fs::copy_file(fs::path(LOOM_SOURCE_DIR) / "tests/fuzz/findings/mesh_stl/facet-without-vertices-leak.stl",
-                d / "found.stl");
+  kept_finding(d, "mesh_stl/facet-without-vertices-leak.stl", "found.stl");
   auto r = bounded_info_of_part(d, "found.stl");
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_NE(r.out.find("found.stl:16: facet 3: the facet has 0 vertices"), std::string::npos) << r.out;
@@ -394,8 +398,7 @@ TEST(FuzzRegression, PointCloudCountsJudgedBeforeUse) {
 // whose JSON does not parse to an object is refused before Assimp sees it.
 TEST(FuzzRegression, GltfThatIsNotJsonWentToAnotherImporter) {
   const fs::path d = scratch();
-  fs::copy_file(fs::path(LOOM_SOURCE_DIR) / "tests/fuzz/findings/mesh_gltf/not-json-other-importer-overread.gltf",
-                d / "other.gltf");
+  kept_finding(d, "mesh_gltf/not-json-other-importer-overread.gltf", "other.gltf");
   const std::string e = input_error([&] { loom::read_mesh_file(d / "other.gltf"); });
   EXPECT_NE(e.find("other.gltf: glTF: the JSON does not parse (not a glTF file)"), std::string::npos) << e;
   write(d / "array.gltf", "[1, 2]");
@@ -409,8 +412,7 @@ TEST(FuzzRegression, GltfThatIsNotJsonWentToAnotherImporter) {
 // Other first bytes are read as written.
 TEST(FuzzRegression, PlyBinaryDataStartingWithANewlineAborted) {
   const fs::path d = scratch();
-  fs::copy_file(fs::path(LOOM_SOURCE_DIR) / "tests/fuzz/findings/mesh_ply/binary-data-starts-with-newline-abort.ply",
-                d / "nl.ply");
+  kept_finding(d, "mesh_ply/binary-data-starts-with-newline-abort.ply", "nl.ply");
   const auto r = bounded_info_of_part(d, "nl.ply");
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_NE(r.out.find("nl.ply:10: PLY data: the binary data starts with a newline byte"), std::string::npos) << r.out;
@@ -430,8 +432,7 @@ TEST(FuzzRegression, PlyBinaryDataStartingWithANewlineAborted) {
 // Release `loom info`). CRLF files stay readable.
 TEST(FuzzRegression, PlyDataCarriageReturnInsideALineAborted) {
   const fs::path d = scratch();
-  fs::copy_file(fs::path(LOOM_SOURCE_DIR) / "tests/fuzz/findings/mesh_ply/data-carriage-return-abort.ply",
-                d / "cr.ply");
+  kept_finding(d, "mesh_ply/data-carriage-return-abort.ply", "cr.ply");
   const auto r = bounded_info_of_part(d, "cr.ply");
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_NE(r.out.find("cr.ply:13: element vertex instance 2: a carriage return inside the line"), std::string::npos)
@@ -449,8 +450,7 @@ TEST(FuzzRegression, PlyDataCarriageReturnInsideALineAborted) {
 // `loom info`; under ASan a CHECK on a corrupted chunk at a later free, under another input).
 TEST(FuzzRegression, PlyElementDeclaredTwiceCorruptedTheHeap) {
   const fs::path d = scratch();
-  fs::copy_file(fs::path(LOOM_SOURCE_DIR) / "tests/fuzz/findings/mesh_ply/element-declared-twice-heap.ply",
-                d / "twice.ply");
+  kept_finding(d, "mesh_ply/element-declared-twice-heap.ply", "twice.ply");
   const auto r = bounded_info_of_part(d, "twice.ply");
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_NE(r.out.find("twice.ply:10: element vertex: declared again (first at line 4)"), std::string::npos) << r.out;
