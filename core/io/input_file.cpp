@@ -32,4 +32,19 @@ std::string file_bytes(const std::filesystem::path& path, std::size_t limit) {
   return s;
 }
 
+std::string printable(const std::string& t) {
+  static const char* kHex = "0123456789abcdef";
+  std::string out;
+  for (const unsigned char c : t) {
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+    } else {
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    }
+  }
+  return out;
+}
+
 }  // namespace loom

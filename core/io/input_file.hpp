@@ -20,4 +20,8 @@ void require_input_file(const std::filesystem::path& path, const std::string& wh
 std::string file_bytes(const std::filesystem::path& path,
                        std::size_t limit = std::numeric_limits<std::size_t>::max());
 
+/// `t` with every byte outside printable ASCII written as \xNN, for a message that names a
+/// corrupt token (a NUL would end the message where it is printed).
+std::string printable(const std::string& t);
+
 }  // namespace loom

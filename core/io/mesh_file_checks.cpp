@@ -34,23 +34,6 @@ std::vector<std::string> words(const std::string& line) {
   return w;
 }
 
-/// `t` with every byte outside printable ASCII written as \xNN, for a message that names a
-/// corrupt token (a NUL would end the message where it is printed).
-std::string printable(const std::string& t) {
-  static const char* kHex = "0123456789abcdef";
-  std::string out;
-  for (const unsigned char c : t) {
-    if (c >= 0x20 && c < 0x7f) {
-      out += static_cast<char>(c);
-    } else {
-      out += "\\x";
-      out += kHex[c >> 4];
-      out += kHex[c & 15];
-    }
-  }
-  return out;
-}
-
 /// A decimal count; false for anything else. Values beyond 64 bits saturate (they are
 /// refused by the size checks like any other count the file cannot hold).
 bool parse_count(const std::string& t, std::uint64_t& v) {
@@ -125,6 +108,41 @@ struct PlyLayout {
 /// 1-based line of byte `at` of `text`.
 int line_at(const std::string& text, std::size_t at) {
   return static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n')) + 1;
+}
+
+/// How many instances Assimp reads of PLY element `name` declared with `declared`. Assimp
+/// reads the count after the names it knows; for any other name it stores the name but reads
+/// the count from the name's own leading digits (32-bit, wrapping; 0 for a name without
+/// any), and for TextureFile it reads none.
+std::uint64_t assimp_ply_element_count(const std::string& name, std::uint64_t declared) {
+  if (name == "vertex" || name == "face" || name == "tristrips" || name == "edge" || name == "material")
+    return declared;
+  std::uint32_t digits = 0;
+  for (std::size_t i = 0; i < name.size() && name[i] >= '0' && name[i] <= '9'; ++i)
+    digits = digits * 10u + static_cast<std::uint32_t>(name[i] - '0');
+  return name == "TextureFile" ? 0 : digits;
+}
+
+/// Throws InputError where Assimp would read a different number of instances of an element
+/// than its header line declares, unless that element and every one after it are read as
+/// empty (their data then goes unread, as loom needs none of it). Why: "element 5555…5face 4"
+/// made Assimp reserve 3.8·10⁹ instances (91 GB), and an unknown element with instances
+/// before the faces had its data read as faces.
+void check_ply_element_counts(const std::vector<PlyElementExtent>& extents, const std::filesystem::path& path) {
+  for (std::size_t i = 0; i < extents.size(); ++i) {
+    const PlyElementExtent& e = extents[i];
+    const std::uint64_t read = assimp_ply_element_count(e.name, e.count);
+    if (read == e.count) continue;
+    bool rest_unread = read == 0;
+    for (std::size_t j = i + 1; rest_unread && j < extents.size(); ++j)
+      rest_unread = assimp_ply_element_count(extents[j].name, extents[j].count) == 0;
+    if (rest_unread) continue;
+    throw InputError({path.string(), e.line, "element " + printable(e.name)},
+                     "declares " + std::to_string(e.count) + " instance(s), but Assimp, which reads PLY meshes for "
+                     "loom, would read " + std::to_string(read) + " (it takes the count of an element other than "
+                     "vertex, face, tristrips, edge and material from the start of its name); rename the element "
+                     "or move it after the mesh's elements");
+  }
 }
 
 /// Throws InputError unless the PLY header in `head` (the file's first bytes, `whole` if
@@ -271,6 +289,7 @@ void read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
     }
   }
   if (!has_format) throw InputError({path.string(), 1, "format"}, "the PLY header has no format line");
+  check_ply_element_counts(out.extents, path);
 }
 
 /// Sequential reads over a file in blocks, so that walking a large PLY body costs one pass

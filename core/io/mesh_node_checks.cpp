@@ -211,20 +211,25 @@ class Dae {
     nodes_.push_back(n);
   }
 
-  /// A <p> or <vcount> list: unsigned decimal integers, at least one. Why: Assimp's reader does not move
-  /// past a token it cannot read as one and appended indices until memory ran out.
+  /// A <p> or <vcount> list: unsigned decimal integers separated by spaces, tabs and line ends,
+  /// at least one. Why: Assimp's reader does not move past a byte it cannot read as part of
+  /// one and appended indices until memory ran out — a word that is not a number, and also a
+  /// form feed or vertical tab between two numbers (3 GB for "1\f2").
   void check_indices(const pugi::xml_node& n) {
     const char* s = n.child_value();
+    const auto separator = [](char ch) { return ch == ' ' || ch == '\t' || ch == '\r' || ch == '\n'; };
     std::size_t values = 0;
     for (const char* c = s; *c;) {
-      while (*c && std::isspace(static_cast<unsigned char>(*c))) ++c;
+      while (*c && separator(*c)) ++c;
       if (!*c) break;
       const char* from = c;
-      while (*c && !std::isspace(static_cast<unsigned char>(*c))) ++c;
+      while (*c && !separator(*c)) ++c;
       if (!std::all_of(from, c, [](char ch) { return std::isdigit(static_cast<unsigned char>(ch)); })) {
         constexpr std::ptrdiff_t kShown = 20;
-        fail(n, "'" + std::string(from, std::min(c - from, kShown)) + "' is not an index (value " +
-                    std::to_string(values) + " of the list)");
+        const std::string word(from, std::min(c - from, kShown));
+        const bool odd_blank = word.find_first_of("\f\v") != std::string::npos;
+        fail(n, "'" + printable(word) + "' is not an index (value " + std::to_string(values) + " of the list)" +
+                    (odd_blank ? ": only spaces, tabs and line ends separate indices" : ""));
       }
       ++values;
     }

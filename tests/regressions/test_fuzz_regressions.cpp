@@ -176,6 +176,26 @@ TEST(FuzzRegression, DaeNonIntegerIndexHung) {
   }
 }
 
+// `<p>1\f2 3</p>` in a polylist (libFuzzer, 175,168 executions): Assimp's COLLADA reader
+// does not skip a form feed or vertical tab between two indices and appended indices without
+// end (malloc of 3 GB under the fuzzer; std::bad_alloc, no line named, in Release).
+TEST(FuzzRegression, DaeIndexListFormFeedGrewWithoutEnd) {
+  const fs::path d = scratch();
+  kept_finding(d, "mesh_dae/index-list-form-feed-oom.dae", "ff.dae");
+  const auto r = bounded_info_of_part(d, "ff.dae");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("ff.dae:21: <p>: '1\\x0c2' is not an index (value 0 of the list): only spaces, tabs and "
+                       "line ends separate indices"),
+            std::string::npos)
+      << r.out;
+  for (const std::string blank : {"\v", "\f"}) {
+    write(d / "bad.dae", kDaeHead + dae_triangle_geometry("3", "0" + blank + "1 2") + kDaeSceneOfG);
+    EXPECT_EQ(bounded_info_of_part(d, "bad.dae").status, 2);
+  }
+  write(d / "good.dae", kDaeHead + dae_triangle_geometry("3", "\r\n0\t1\n 2 ") + kDaeSceneOfG);
+  EXPECT_EQ(loom::read_mesh_file(d / "good.dae").triangle_count(), 1u);
+}
+
 /// A DAE of one triangle instanced through `levels` library nodes, each instancing the one
 /// below twice, under one scene node.
 std::string dae_fan(int levels) {
@@ -424,6 +444,40 @@ TEST(FuzzRegression, PlyBinaryDataStartingWithANewlineAborted) {
   } catch (const InputError& e) {  // its first vertex is far out; only the newline rule is under test
     EXPECT_EQ(std::string(e.what()).find("newline byte"), std::string::npos) << e.what();
   }
+}
+
+// `element 5555…5555face 4` (75 fives) in a binary header (libFuzzer, seed 7, 261,673
+// executions): Assimp reads the count of an element whose name it does not know from the
+// name itself — its leading digits, wrapping at 32 bits: 3,817,748,707 instances, 91 GB
+// reserved. The same rule read no instances of an unknown element with data before the
+// faces, and took its data for faces.
+TEST(FuzzRegression, PlyElementCountReadFromTheNameAllocated) {
+  const fs::path d = scratch();
+  kept_finding(d, "mesh_ply/element-name-digits-count-oom.ply", "digits.ply");
+  const auto r = bounded_info_of_part(d, "digits.ply");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("digits.ply:8: element 5555"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("declares 4 instance(s), but Assimp, which reads PLY meshes for loom, would read 3817748707"),
+            std::string::npos)
+      << r.out;
+  const std::string vertices = "0 0 0\n1 0 0\n0 1 0\n1 1 1\n";
+  const std::string faces = "3 0 1 2\n3 1 2 3\n";
+  const std::string extra = "element normal_cone 2\nproperty float a\n";
+  const std::string head = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                           "property float z\n";
+  const std::string face_head = "element face 2\nproperty list uchar int vertex_indices\n";
+  // Before the faces: Assimp would read none of its two lines and take them for faces.
+  expect_part_refused(d, "before.ply", head + extra + face_head + "end_header\n" + vertices + "7\n8\n" + faces,
+                      "before.ply:7: element normal_cone: declares 2 instance(s), but Assimp");
+  // After them its data goes unread: the mesh reads as written.
+  write(d / "after.ply", head + face_head + extra + "end_header\n" + vertices + faces + "7\n8\n");
+  EXPECT_EQ(loom::read_mesh_file(d / "after.ply").triangle_count(), 2u);
+  // A name starting with a digit is read as that count even at the end.
+  expect_part_refused(d, "five.ply",
+                      head + face_head + "element 5cones 2\nproperty float a\nend_header\n" + vertices + faces +
+                          "7\n8\n",
+                      "five.ply:9: element 5cones: declares 2 instance(s), but Assimp, which reads PLY meshes for loom, "
+                      "would read 5");
 }
 
 // An ASCII vertex line "0 1\r 1" (libFuzzer, seed 7, after the element fix): Assimp ends a
