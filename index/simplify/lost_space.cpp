@@ -52,14 +52,18 @@ LostSpace probe_lost_space(const std::vector<const AlphaSimSolid*>& solids, cons
         for (std::size_t i = rg.begin(); i != rg.end(); ++i) {
           const Vec3 p = point(i);
           // Outside every solid (or on one) the depth is ≤ 0 ≤ acc: skip the distances.
+          if (std::none_of(solids.begin(), solids.end(), [&](const AlphaSimSolid* s) { return s->contains(p); }))
+            continue;
+          // Inside the original's material no free space is hidden. Why first: most points
+          // inside a solid are in material, and the parity test costs less than the depth
+          // (a search of the prisms' boundaries out to the point's distance from them).
+          if (original.inside(p)) continue;
           double depth = 0.0;
           for (const AlphaSimSolid* s : solids)
             if (s->contains(p)) depth = std::max(depth, -s->distance_bound(p));  // exact inside one solid
-          if (depth <= 0.0) continue;
-          if (depth < acc.radius) continue;
+          if (depth <= 0.0 || depth < acc.radius) continue;
           const Ball ball{std::min(depth, original.closest(p).distance), i};
-          if (larger(acc, ball).index != i) continue;
-          if (!original.inside(p)) acc = ball;
+          if (larger(acc, ball).index == i) acc = ball;
         }
         return acc;
       },
