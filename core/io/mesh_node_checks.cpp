@@ -158,6 +158,7 @@ class Dae {
       if (const char* id = node.attribute("id").value(); *id) ids_.emplace(id, node);
       const std::string name = node.name();
       if (name == "p" || name == "vcount") check_indices(node);
+      else if (is_primitive(node)) check_primitive(node);
       else if (name == "accessor") accessors.push_back(node);
       else if (name == "node") node_of(node);
       else if (name == "visual_scene") visual_scenes_.push_back(node);
@@ -209,6 +210,31 @@ class Dae {
   void node_of(const pugi::xml_node& n) {
     node_index_.emplace(n, nodes_.size());
     nodes_.push_back(n);
+  }
+
+  /// Whether `n` is a primitive of a <mesh>: Assimp reads those (and nothing of a
+  /// <convex_mesh> or other holder).
+  static bool is_primitive(const pugi::xml_node& n) {
+    static const char* const kPrimitives[] = {"triangles", "polylist", "polygons", "lines",
+                                              "linestrips", "trifans", "tristrips"};
+    const std::string name = n.name();
+    return std::string(n.parent().name()) == "mesh" &&
+           std::any_of(std::begin(kPrimitives), std::end(kPrimitives), [&](const char* k) { return name == k; });
+  }
+
+  /// A primitive with a count above 0 holds a <p>, and a <polylist> its <vcount> before
+  /// the first <p>. Why: Assimp 5.2's COLLADA reader aborted on a primitive with a count
+  /// but no index list, and dereferenced null for a polylist whose <vcount> was missing or
+  /// came after its <p> (SIGSEGV).
+  void check_primitive(const pugi::xml_node& n) {
+    const long long count = n.attribute("count").as_llong(0);
+    if (count <= 0) return;
+    const pugi::xml_node p = n.child("p");
+    if (!p) fail(n, "declares " + std::to_string(count) + " primitive(s) but holds no <p> index list");
+    if (std::string(n.name()) != "polylist") return;
+    for (pugi::xml_node c = n.first_child(); c && c != p; c = c.next_sibling())
+      if (std::string(c.name()) == "vcount") return;
+    fail(n, "a <polylist> needs its <vcount> (the vertices of each polygon) before its <p>");
   }
 
   /// A <p> or <vcount> list: unsigned decimal integers separated by spaces, tabs and line ends,

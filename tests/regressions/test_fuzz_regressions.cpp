@@ -196,6 +196,34 @@ TEST(FuzzRegression, DaeIndexListFormFeedGrewWithoutEnd) {
   EXPECT_EQ(loom::read_mesh_file(d / "good.dae").triangle_count(), 1u);
 }
 
+// A <polylist> whose <vcount> a mutation had turned into text ("vcount>") (libFuzzer, seed
+// 21, 437,246 executions after the form-feed fix): Assimp's COLLADA reader dereferenced null
+// (SIGSEGV); a <vcount> after the <p> did the same, and a primitive with a count but no
+// <p> aborted it.
+TEST(FuzzRegression, DaePolylistWithoutVcountCrashed) {
+  const fs::path d = scratch();
+  kept_finding(d, "mesh_dae/polylist-without-vcount-segv.dae", "novc.dae");
+  const auto r = bounded_info_of_part(d, "novc.dae");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("novc.dae:17: <polylist>: a <polylist> needs its <vcount>"), std::string::npos) << r.out;
+  const std::string triangle = R"(<triangles count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1 2</p></triangles>)";
+  const std::string input = R"(<input semantic="VERTEX" source="#v" offset="0"/>)";
+  const auto with_primitive = [&](const std::string& primitive) {
+    std::string g = dae_triangle_geometry("3", "0 1 2");
+    g.replace(g.find(triangle), triangle.size(), primitive);
+    return kDaeHead + g + kDaeSceneOfG;
+  };
+  expect_part_refused(d, "after.dae",
+                      with_primitive(R"(<polylist count="1">)" + input + "<p>0 1 2</p><vcount>3</vcount></polylist>"),
+                      "<polylist>: a <polylist> needs its <vcount> (the vertices of each polygon) before its <p>");
+  expect_part_refused(d, "nop.dae", with_primitive(R"(<triangles count="1">)" + input + "</triangles>"),
+                      "<triangles>: declares 1 primitive(s) but holds no <p> index list");
+  write(d / "good.dae", with_primitive(R"(<polylist count="1">)" + input + "<vcount>3</vcount><p>0 1 2</p></polylist>"));
+  EXPECT_EQ(loom::read_mesh_file(d / "good.dae").triangle_count(), 1u);
+  write(d / "none.dae", with_primitive(R"(<triangles count="0">)" + input + "</triangles>" + triangle));
+  EXPECT_EQ(loom::read_mesh_file(d / "none.dae").triangle_count(), 1u);
+}
+
 /// A DAE of one triangle instanced through `levels` library nodes, each instancing the one
 /// below twice, under one scene node.
 std::string dae_fan(int levels) {
