@@ -1,6 +1,7 @@
 // α-SIM with and without splitting blocked parts, on scenes nobody here modelled for it:
 // the wing section, the real-meshes example (an office, the CAx-IF AS1 assembly, a machined
-// part, a motor), the AS1 assembly and the link-rod assembly alone at dim_pre 2 mm, the
+// part, a motor), the AS1 assembly, the link-rod assembly and the CAx-IF S1 assembly (eleven
+// parts in nine STEP files: hollow body shells with bulkheads) alone at dim_pre 2 mm, the
 // motor housing and the Cesium milk truck (a concave body). For each: triangles kept, parts
 // blocked (and those larger than 20·dim_pre), parts split and their pieces, least
 // containment, time per input triangle, and the bytes of the Embree index over the exact
@@ -92,6 +93,7 @@ int main(int argc, char** argv) {
       {"real-meshes", src / "examples" / "real-meshes" / "scene.toml", {}, "", 0.0, 0.0},
       {"as1-2mm", {}, data / "stepcode" / "as1-oc-214.stp", "mm", 2.0, 0.2},
       {"linkrods-2mm", {}, data / "occt" / "linkrods.step", "mm", 2.0, 0.2},
+      {"s1-assembly-2mm", {}, data / "stepcode" / "s1-c5-214" / "s1-c5-214.stp", "mm", 2.0, 0.2},
       {"motor-2mm", {}, data / "occt" / "motor.stl", "mm", 2.0, 0.0},
       {"milk-truck-20mm", {}, data / "trimesh" / "CesiumMilkTruck.glb", "m", 0.02, 0.0},
   };

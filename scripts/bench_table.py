@@ -277,6 +277,20 @@ def alpha_sim_split_rows():
          f"containment {sig(contained)}", "≤ 10%", status(split / before <= 0.10 and contained >= 1)),
         ("same, on every bench scene: blocked parts over 20·dim_pre; time split / unsplit (wing 2 mm)", f"`{name}`",
          f"{large}; {times(slower)}", "0; ≤ 2×", status(large == 0 and slower <= 2)),
+    ] + real_assembly_split_rows(every, name)
+
+
+def real_assembly_split_rows(every, name):
+    s1 = pick(every, name, case="s1-assembly-2mm")
+    before, split = num(s1, "triangles_before", name), num(s1, "kept_split", name)
+    whole = num(s1, "kept_unsplit", name)
+    slower = num(s1, "seconds_split", name) / num(s1, "seconds_unsplit", name)
+    return [
+        ("same, CAx-IF S1 assembly (11 parts, curved body shells) at dim_pre 2 mm: kept; blocked parts; time "
+         "split / unsplit", f"`{name}`",
+         f"{sig(100 * split / before, 2)}% ({sig(100 * whole / before, 2)}% unsplit); "
+         f"{int(num(s1, 'blocked_unsplit', name))} → {int(num(s1, 'blocked_split', name))}; {times(slower)}",
+         "≤ 10%; 0; ≤ 2×", status(split / before <= 0.10 and num(s1, "blocked_split", name) == 0 and slower <= 2)),
     ]
 
 

@@ -57,8 +57,8 @@ struct AlphaSimOptions {
   /// piece simplified on its own and probed against the whole part, recursively while a
   /// piece is blocked. No piece is cut thinner than dim_pre. false keeps such a part as it is.
   bool split_blocked = true;
-  int split_max_depth = 6;            ///< cut levels at most
-  std::size_t split_max_pieces = 64;  ///< pieces of one part at most
+  int split_max_depth = 16;           ///< cut levels at most
+  std::size_t split_max_pieces = 256;  ///< pieces of one part at most
   /// Dense containment samples of the original surface: about this many per L_max² of area
   /// (at least the vertices, edge midpoints, centroids and two random points per triangle).
   double containment_density = 4.0;

@@ -11,7 +11,9 @@
 
 #include <gtest/gtest.h>
 #include "common/shared_data.hpp"
+#include "common/test_files.hpp"
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -245,4 +247,34 @@ TEST(PartSplit, RealMachinedPartIsSplitNotKept) {
   EXPECT_FALSE(sp.result.pieces.empty());
   EXPECT_LT(sp.result.triangles_after, sp.result.triangles_before);
   expect_contains_original(sp, part.mesh, "featuretype");
+}
+
+// The body's front half of the CAx-IF S1 assembly (a curved shell with a bulkhead, 146 mm
+// across) at dim_pre 2 mm: its arcs hide less than the lost-space radius only in pieces cut
+// 7–8 levels deep, so a fixed limit of 6 levels left it blocked and whole; the stop is the
+// pieces' thickness, the depth limit only a guard. (Its own suite: minutes under the
+// sanitizers.)
+TEST(PartSplitRealShell, CurvedShellOfARealAssemblyIsSplitPastSixLevels) {
+  LOOM_SHARED_DATA_OR_SKIP(loom::testing::shared_data("stepcode/s1-c5-214/MAINBODY_FRONT.stp"));
+  const std::filesystem::path d = loom::testing::scratch_dir("loom-part-split-");
+  loom::testing::write_file(d / "scene.toml",
+                            "[scene]\nunits = 'mm'\n[[part]]\nname = 'body'\nfile = '" +
+                                loom::testing::shared_data("stepcode/s1-c5-214/MAINBODY_FRONT.stp").string() +
+                                "'\n[tessellation]\nlinear_deflection = 0.2\n");
+  const Scene scene = load_scene(d / "scene.toml");
+  ASSERT_EQ(scene.parts.size(), 1u);
+  const Part& part = scene.parts[0];
+  AlphaSimOptions o = options();
+  o.dim_pre = 2.0;
+  o.scene_size = scene.bounds().diagonal();
+  const AlphaSimPart sp = simplify_part_split(part, o);
+  EXPECT_EQ(sp.result.status, AlphaSimStatus::Ok) << sp.result.reason;
+  int deepest = 0;
+  for (const AlphaSimPiece& p : sp.result.pieces)
+    deepest = std::max(deepest, static_cast<int>(std::count(p.id.begin(), p.id.end(), '.')) + 1);
+  EXPECT_GT(deepest, 6);
+  EXPECT_LT(sp.result.triangles_after, sp.result.triangles_before / 2);
+  expect_contains_original(sp, part.mesh, "body");
+  o.split_max_depth = 6;
+  EXPECT_EQ(simplify_part_split(part, o).result.status, AlphaSimStatus::Blocked);
 }
