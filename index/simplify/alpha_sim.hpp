@@ -57,8 +57,10 @@ struct AlphaSimOptions {
   /// piece simplified on its own and probed against the whole part, recursively while a
   /// piece is blocked. No piece is cut thinner than dim_pre. false keeps such a part as it is.
   bool split_blocked = true;
-  int split_max_depth = 16;           ///< cut levels at most
-  std::size_t split_max_pieces = 256;  ///< pieces of one part at most
+  /// Cut levels at most: a guard on the recursion, not the stop (a piece never thinner than
+  /// dim_pre is); a curved shell needs 7–8 levels before each piece's arc hides too little.
+  int split_max_depth = 16;
+  std::size_t split_max_pieces = 256;  ///< pieces of one part at most: bounds the work
   /// Dense containment samples of the original surface: about this many per L_max² of area
   /// (at least the vertices, edge midpoints, centroids and two random points per triangle).
   double containment_density = 4.0;
