@@ -43,6 +43,7 @@ GlbLayout read_glb_layout(const std::filesystem::path& path) {
     if (out.json_length > length - 20)
       refuse("GLB content", "content length " + std::to_string(out.json_length) + " reaches beyond the declared " +
                                 std::to_string(length) + " bytes");
+    out.bin_offset = 20 + out.json_length;
     out.bin_length = length - 20 - out.json_length;
     return out;
   }
@@ -63,6 +64,7 @@ GlbLayout read_glb_layout(const std::filesystem::path& path) {
       out.json_offset = at + 8;
       out.json_length = n;
     } else if (chunk == 1 && type == kChunkBin) {
+      out.bin_offset = at + 8;
       out.bin_length = n;
     }
     at += 8 + n;

@@ -16,6 +16,7 @@ namespace loom {
 struct GlbLayout {
   std::uint64_t json_offset = 0;
   std::uint64_t json_length = 0;
+  std::uint64_t bin_offset = 0;  ///< first byte of the BIN chunk's data / binary body
   std::uint64_t bin_length = 0;  ///< bytes of the BIN chunk / binary body (0: none)
 };
 

@@ -2,6 +2,7 @@
 
 #include "core/error.hpp"
 #include "core/io/glb_container.hpp"
+#include "core/io/gltf_index_checks.hpp"
 #include "core/io/input_file.hpp"
 #include "core/io/line_map.hpp"
 #include "core/io/mesh_file_checks.hpp"
@@ -445,6 +446,7 @@ void check_gltf_file(const std::filesystem::path& path, bool binary) {
                      std::string(doc.is_discarded() ? "the JSON does not parse" : "the JSON is not an object") +
                          " (not a glTF file)");
   check_gltf_buffers(doc, path, binary);
+  check_gltf_indices(doc, path, binary);
   if (!doc.contains("nodes")) return;
   const nlohmann::json& nodes = doc["nodes"];
   NodeGraph g;
