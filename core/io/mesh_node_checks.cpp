@@ -223,19 +223,68 @@ class Dae {
            std::any_of(std::begin(kPrimitives), std::end(kPrimitives), [&](const char* k) { return name == k; });
   }
 
-  /// A primitive with a count above 0 holds a <p>, and a <polylist> its <vcount> before
-  /// the first <p>. Why: Assimp 5.2's COLLADA reader aborted on a primitive with a count
-  /// but no index list, and dereferenced null for a polylist whose <vcount> was missing or
-  /// came after its <p> (SIGSEGV).
+  /// A primitive with a count above 0 holds a <p>; a <polylist> holds its <vcount> before
+  /// the first <p>, and its polygons' vertices (the <vcount> values' sum, each taking one
+  /// index per input offset) no more than the <p> holds. Why: Assimp 5.2's COLLADA reader
+  /// aborted on a primitive with a count but no index list, dereferenced null for a
+  /// polylist whose <vcount> was missing or came after its <p> (SIGSEGV), and allocated by
+  /// the <vcount> values before reading the indices (34 GB for one polygon of 34·10⁹
+  /// vertices). Values that are not numbers are check_indices' to name.
   void check_primitive(const pugi::xml_node& n) {
     const long long count = n.attribute("count").as_llong(0);
     if (count <= 0) return;
     const pugi::xml_node p = n.child("p");
     if (!p) fail(n, "declares " + std::to_string(count) + " primitive(s) but holds no <p> index list");
     if (std::string(n.name()) != "polylist") return;
-    for (pugi::xml_node c = n.first_child(); c && c != p; c = c.next_sibling())
-      if (std::string(c.name()) == "vcount") return;
-    fail(n, "a <polylist> needs its <vcount> (the vertices of each polygon) before its <p>");
+    pugi::xml_node vcount;
+    for (pugi::xml_node c = n.first_child(); c && c != p && !vcount; c = c.next_sibling())
+      if (std::string(c.name()) == "vcount") vcount = c;
+    if (!vcount) fail(n, "a <polylist> needs its <vcount> (the vertices of each polygon) before its <p>");
+    double corners = 0.0, indices = 0.0;
+    bool numbers = true;
+    const auto digits = [](char ch) { return std::isdigit(static_cast<unsigned char>(ch)) != 0; };
+    for_each_word(vcount.child_value(), [&](const char* from, const char* to) {
+      double v = 0.0;
+      for (const char* c = from; c != to && digits(*c); ++c) v = 10.0 * v + (*c - '0');
+      corners += v;
+      numbers = numbers && std::all_of(from, to, digits);
+    });
+    for_each_word(p.child_value(), [&](const char* from, const char* to) {
+      indices += 1.0;
+      numbers = numbers && std::all_of(from, to, digits);
+    });
+    if (!numbers) return;  // check_indices names the word
+    const double stride = static_cast<double>(values_per_vertex(n));
+    if (corners * stride > indices)
+      fail(vcount, "the polygons take " + full_precision(corners) + " vertices, " + full_precision(corners * stride) +
+                       " indices at " + full_precision(stride) + " per vertex, but the <p> holds " +
+                       full_precision(indices));
+  }
+
+  /// Calls f(first, last) for each word of `s`: runs of bytes other than the separators
+  /// Assimp skips between numbers (space, tab, CR, LF).
+  template <class F>
+  static void for_each_word(const char* s, F f) {
+    const auto separator = [](char ch) { return ch == ' ' || ch == '\t' || ch == '\r' || ch == '\n'; };
+    for (const char* c = s; *c;) {
+      while (*c && separator(*c)) ++c;
+      if (!*c) break;
+      const char* from = c;
+      while (*c && !separator(*c)) ++c;
+      f(from, c);
+    }
+  }
+
+  /// Index values per vertex of a primitive: its highest input offset + 1.
+  static std::uint64_t values_per_vertex(const pugi::xml_node& prim) {
+    std::uint64_t stride = 1;
+    for (pugi::xml_node in = prim.child("input"); in; in = in.next_sibling("input")) {
+      std::uint64_t offset = 0;
+      const std::string o = in.attribute("offset").value();
+      if (std::from_chars(o.data(), o.data() + o.size(), offset).ec == std::errc())
+        stride = std::max(stride, offset + 1);
+    }
+    return stride;
   }
 
   /// A <p> or <vcount> list: unsigned decimal integers separated by spaces, tabs and line ends,
@@ -243,23 +292,17 @@ class Dae {
   /// one and appended indices until memory ran out — a word that is not a number, and also a
   /// form feed or vertical tab between two numbers (3 GB for "1\f2").
   void check_indices(const pugi::xml_node& n) {
-    const char* s = n.child_value();
-    const auto separator = [](char ch) { return ch == ' ' || ch == '\t' || ch == '\r' || ch == '\n'; };
     std::size_t values = 0;
-    for (const char* c = s; *c;) {
-      while (*c && separator(*c)) ++c;
-      if (!*c) break;
-      const char* from = c;
-      while (*c && !separator(*c)) ++c;
-      if (!std::all_of(from, c, [](char ch) { return std::isdigit(static_cast<unsigned char>(ch)); })) {
+    for_each_word(n.child_value(), [&](const char* from, const char* to) {
+      if (!std::all_of(from, to, [](char ch) { return std::isdigit(static_cast<unsigned char>(ch)); })) {
         constexpr std::ptrdiff_t kShown = 20;
-        const std::string word(from, std::min(c - from, kShown));
+        const std::string word(from, std::min(to - from, kShown));
         const bool odd_blank = word.find_first_of("\f\v") != std::string::npos;
         fail(n, "'" + printable(word) + "' is not an index (value " + std::to_string(values) + " of the list)" +
                     (odd_blank ? ": only spaces, tabs and line ends separate indices" : ""));
       }
       ++values;
-    }
+    });
     // An empty list (<p/>, <p> </p>) in a primitive made Assimp 5.2's COLLADA reader
     // dereference null (SIGSEGV).
     if (values == 0) fail(n, "holds no values (an empty index list)");
@@ -281,13 +324,7 @@ class Dae {
       for (pugi::xml_node prim = m.first_child(); prim; prim = prim.next_sibling()) {
         const auto it = p_values_.find(prim);
         if (it == p_values_.end()) continue;
-        std::uint64_t stride = 1;
-        for (pugi::xml_node in = prim.child("input"); in; in = in.next_sibling("input")) {
-          std::uint64_t offset = 0;
-          const std::string o = in.attribute("offset").value();
-          if (std::from_chars(o.data(), o.data() + o.size(), offset).ec == std::errc()) stride = std::max(stride, offset + 1);
-        }
-        corners += it->second / static_cast<double>(stride);
+        corners += it->second / static_cast<double>(values_per_vertex(prim));
       }
     corners_[g] = corners;
     return corners;

@@ -225,6 +225,36 @@ TEST(FuzzRegression, DaePolylistWithoutVcountCrashed) {
   EXPECT_EQ(loom::read_mesh_file(d / "none.dae").triangle_count(), 1u);
 }
 
+// `<vcount>34294967295</vcount>` over a `<p>` of three indices (libFuzzer, seed 22, 392,281
+// executions after the vcount-order fix): Assimp allocated by the polygon's vertex count
+// before it read the indices (34 GB under the fuzzer; std::bad_alloc in Release).
+TEST(FuzzRegression, DaePolylistVcountBeyondItsIndicesAllocated) {
+  const fs::path d = scratch();
+  kept_finding(d, "mesh_dae/polylist-vcount-beyond-indices-oom.dae", "big.dae");
+  const auto r = bounded_info_of_part(d, "big.dae");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("big.dae:17: <vcount>: the polygons take 34294967295 vertices, 34294967295 indices at 1 per "
+                       "vertex, but the <p> holds 3"),
+            std::string::npos)
+      << r.out;
+  const std::string triangle = R"(<triangles count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1 2</p></triangles>)";
+  const auto polylist = [&](const std::string& inputs, const std::string& vcount, const std::string& p) {
+    std::string g = dae_triangle_geometry("3", "0 1 2");
+    g.replace(g.find(triangle), triangle.size(),
+              R"(<polylist count="1">)" + inputs + "<vcount>" + vcount + "</vcount><p>" + p + "</p></polylist>");
+    return kDaeHead + g + kDaeSceneOfG;
+  };
+  const std::string vertex = R"(<input semantic="VERTEX" source="#v" offset="0"/>)";
+  expect_part_refused(d, "two.dae", polylist(vertex, "3 3", "0 1 2"),
+                      "<vcount>: the polygons take 6 vertices, 6 indices at 1 per vertex, but the <p> holds 3");
+  // Two values per vertex (a second input at offset 1): six indices make one triangle.
+  const std::string two_inputs = vertex + R"(<input semantic="TEXCOORD" source="#p" offset="1"/>)";
+  expect_part_refused(d, "short.dae", polylist(two_inputs, "3", "0 0 1 1 2"),
+                      "the polygons take 3 vertices, 6 indices at 2 per vertex, but the <p> holds 5");
+  write(d / "ok.dae", polylist(two_inputs, "3", "0 0 1 1 2 2"));
+  EXPECT_EQ(loom::read_mesh_file(d / "ok.dae").triangle_count(), 1u);
+}
+
 /// A DAE of one triangle instanced through `levels` library nodes, each instancing the one
 /// below twice, under one scene node.
 std::string dae_fan(int levels) {
