@@ -2,7 +2,7 @@
 
 #include "core/error.hpp"
 #include "core/io/glb_container.hpp"
-#include "core/io/gltf_index_checks.hpp"
+#include "core/io/gltf_primitive_checks.hpp"
 #include "core/io/input_file.hpp"
 #include "core/io/line_map.hpp"
 #include "core/io/mesh_file_checks.hpp"
@@ -224,41 +224,83 @@ class Dae {
   }
 
   /// A primitive with a count above 0 holds a <p>; a <polylist> holds its <vcount> before
-  /// the first <p>, and its polygons' vertices (the <vcount> values' sum, each taking one
-  /// index per input offset) no more than the <p> holds. Why: Assimp 5.2's COLLADA reader
-  /// aborted on a primitive with a count but no index list, dereferenced null for a
-  /// polylist whose <vcount> was missing or came after its <p> (SIGSEGV), and allocated by
-  /// the <vcount> values before reading the indices (34 GB for one polygon of 34·10⁹
-  /// vertices). Values that are not numbers are check_indices' to name.
+  /// the first <p>. Every input offset names a value the <p> lists hold, and the count
+  /// and <vcount> ask for no more indices than they hold: triangles 3 and lines 2 per
+  /// primitive, a polylist's polygons the <vcount> values' sum, each vertex one index per
+  /// offset; polygons, strips and fans one <p> per primitive. Why: Assimp 5.2's COLLADA
+  /// reader aborted on a primitive with a count but no index list, dereferenced null for
+  /// a polylist whose <vcount> was missing or came after its <p> (SIGSEGV), and allocated
+  /// by the count, the <vcount> values and the highest offset before it read the indices
+  /// (34 GB for one polygon of 34·10⁹ vertices, 412 GB for an offset of 10³⁴). Values
+  /// that are not numbers are check_indices' to name.
   void check_primitive(const pugi::xml_node& n) {
     const long long count = n.attribute("count").as_llong(0);
     if (count <= 0) return;
     const pugi::xml_node p = n.child("p");
     if (!p) fail(n, "declares " + std::to_string(count) + " primitive(s) but holds no <p> index list");
-    if (std::string(n.name()) != "polylist") return;
+    const std::string kind = n.name();
     pugi::xml_node vcount;
     for (pugi::xml_node c = n.first_child(); c && c != p && !vcount; c = c.next_sibling())
       if (std::string(c.name()) == "vcount") vcount = c;
-    if (!vcount) fail(n, "a <polylist> needs its <vcount> (the vertices of each polygon) before its <p>");
-    double corners = 0.0, indices = 0.0;
+    if (kind == "polylist" && !vcount)
+      fail(n, "a <polylist> needs its <vcount> (the vertices of each polygon) before its <p>");
+    double indices = 0.0, lists = 0.0, corners = 0.0, polygons = 0.0;
     bool numbers = true;
-    const auto digits = [](char ch) { return std::isdigit(static_cast<unsigned char>(ch)) != 0; };
-    for_each_word(vcount.child_value(), [&](const char* from, const char* to) {
-      double v = 0.0;
-      for (const char* c = from; c != to && digits(*c); ++c) v = 10.0 * v + (*c - '0');
-      corners += v;
-      numbers = numbers && std::all_of(from, to, digits);
-    });
-    for_each_word(p.child_value(), [&](const char* from, const char* to) {
-      indices += 1.0;
-      numbers = numbers && std::all_of(from, to, digits);
-    });
-    if (!numbers) return;  // check_indices names the word
-    const double stride = static_cast<double>(values_per_vertex(n));
-    if (corners * stride > indices)
-      fail(vcount, "the polygons take " + full_precision(corners) + " vertices, " + full_precision(corners * stride) +
-                       " indices at " + full_precision(stride) + " per vertex, but the <p> holds " +
-                       full_precision(indices));
+    for (pugi::xml_node c = p; c; c = c.next_sibling("p")) {
+      lists += 1.0;
+      for_each_word(c.child_value(), [&](const char* from, const char* to) {
+        indices += 1.0;
+        numbers = numbers && whole_word(from, to);
+      });
+    }
+    if (vcount)
+      for_each_word(vcount.child_value(), [&](const char* from, const char* to) {
+        polygons += 1.0;
+        corners += word_value(from, to);
+        numbers = numbers && whole_word(from, to);
+      });
+    if (!numbers || indices == 0.0) return;  // check_indices names the word or the empty list
+    check_offsets(n, indices);
+    const double stride = static_cast<double>(values_per_vertex(n)), c = static_cast<double>(count);
+    const auto too_many = [&](const pugi::xml_node& at, double need, const std::string& what) {
+      fail(at, what + " take " + full_precision(need) + " indices at " + full_precision(stride) +
+                   " per vertex, but the <p> holds " + full_precision(indices));
+    };
+    if (kind == "triangles" && 3.0 * c * stride > indices) too_many(n, 3.0 * c * stride, "count " + std::to_string(count) + " triangles");
+    if (kind == "lines" && 2.0 * c * stride > indices) too_many(n, 2.0 * c * stride, "count " + std::to_string(count) + " lines");
+    if (kind == "polylist" && corners * stride > indices)
+      too_many(vcount, corners * stride, "the polygons' " + full_precision(corners) + " vertices");
+    if (kind == "polylist" && c > polygons)
+      fail(n, "count " + std::to_string(count) + " polygons, but the <vcount> lists " + full_precision(polygons));
+    if ((kind == "polygons" || kind == "tristrips" || kind == "trifans" || kind == "linestrips") && c > lists)
+      fail(n, "count " + std::to_string(count) + " primitives, but it holds " + full_precision(lists) + " <p> lists");
+  }
+
+  /// Every <input> offset of primitive `n` is a whole number below `indices`, the values
+  /// its <p> lists hold (no vertex could use a larger one).
+  void check_offsets(const pugi::xml_node& n, double indices) const {
+    for (pugi::xml_node in = n.child("input"); in; in = in.next_sibling("input")) {
+      const pugi::xml_attribute a = in.attribute("offset");
+      if (!a) continue;
+      const std::string o = a.value();
+      std::uint64_t offset = 0;
+      const auto [end, ec] = std::from_chars(o.data(), o.data() + o.size(), offset);
+      if (ec != std::errc() || end != o.data() + o.size() || static_cast<double>(offset) >= indices)
+        fail(in, "offset '" + printable(o.substr(0, 40)) + "' is not an index into the " + full_precision(indices) +
+                     " values of the <p>");
+    }
+  }
+
+  /// Whether [from, to) is all decimal digits.
+  static bool whole_word(const char* from, const char* to) {
+    return std::all_of(from, to, [](char ch) { return std::isdigit(static_cast<unsigned char>(ch)) != 0; });
+  }
+
+  /// The decimal value of the leading digits of [from, to), as a double (no overflow).
+  static double word_value(const char* from, const char* to) {
+    double v = 0.0;
+    for (const char* c = from; c != to && std::isdigit(static_cast<unsigned char>(*c)); ++c) v = 10.0 * v + (*c - '0');
+    return v;
   }
 
   /// Calls f(first, last) for each word of `s`: runs of bytes other than the separators
@@ -294,7 +336,7 @@ class Dae {
   void check_indices(const pugi::xml_node& n) {
     std::size_t values = 0;
     for_each_word(n.child_value(), [&](const char* from, const char* to) {
-      if (!std::all_of(from, to, [](char ch) { return std::isdigit(static_cast<unsigned char>(ch)); })) {
+      if (!whole_word(from, to)) {
         constexpr std::ptrdiff_t kShown = 20;
         const std::string word(from, std::min(to - from, kShown));
         const bool odd_blank = word.find_first_of("\f\v") != std::string::npos;
@@ -483,7 +525,7 @@ void check_gltf_file(const std::filesystem::path& path, bool binary) {
                      std::string(doc.is_discarded() ? "the JSON does not parse" : "the JSON is not an object") +
                          " (not a glTF file)");
   check_gltf_buffers(doc, path, binary);
-  check_gltf_indices(doc, path, binary);
+  check_gltf_primitives(doc, path, binary);
   if (!doc.contains("nodes")) return;
   const nlohmann::json& nodes = doc["nodes"];
   NodeGraph g;

@@ -235,7 +235,7 @@ TEST(FuzzRegression, DaePolylistWithoutVcountCrashed) {
 TEST(FuzzRegression, DaePolylistVcountBeyondItsIndicesAllocated) {
   const fs::path d = scratch();
   expect_finding_refused(d, "mesh_dae/polylist-vcount-beyond-indices-oom.dae", "big.dae",
-                         "big.dae:17: <vcount>: the polygons take 34294967295 vertices, 34294967295 indices at 1 "
+                         "big.dae:17: <vcount>: the polygons' 34294967295 vertices take 34294967295 indices at 1 "
                          "per vertex, but the <p> holds 3");
   const std::string triangle = R"(<triangles count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1 2</p></triangles>)";
   const auto polylist = [&](const std::string& inputs, const std::string& vcount, const std::string& p) {
@@ -246,13 +246,29 @@ TEST(FuzzRegression, DaePolylistVcountBeyondItsIndicesAllocated) {
   };
   const std::string vertex = R"(<input semantic="VERTEX" source="#v" offset="0"/>)";
   expect_part_refused(d, "two.dae", polylist(vertex, "3 3", "0 1 2"),
-                      "<vcount>: the polygons take 6 vertices, 6 indices at 1 per vertex, but the <p> holds 3");
+                      "<vcount>: the polygons' 6 vertices take 6 indices at 1 per vertex, but the <p> holds 3");
   // Two values per vertex (a second input at offset 1): six indices make one triangle.
   const std::string two_inputs = vertex + R"(<input semantic="TEXCOORD" source="#p" offset="1"/>)";
   expect_part_refused(d, "short.dae", polylist(two_inputs, "3", "0 0 1 1 2"),
-                      "the polygons take 3 vertices, 6 indices at 2 per vertex, but the <p> holds 5");
+                      "the polygons' 3 vertices take 6 indices at 2 per vertex, but the <p> holds 5");
   write(d / "ok.dae", polylist(two_inputs, "3", "0 0 1 1 2 2"));
   EXPECT_EQ(loom::read_mesh_file(d / "ok.dae").triangle_count(), 1u);
+}
+
+// An <input offset="9999999999999999999999999999999990"> of a <triangles> (libFuzzer, seed
+// 23, 70,672 executions after the vcount fix): Assimp sized the index list by the highest
+// offset + 1, wrapped, and allocated 412 GB; a count of 10⁹ triangles over twelve indices
+// went the same way.
+TEST(FuzzRegression, DaeInputOffsetBeyondItsIndicesAllocated) {
+  const fs::path d = scratch();
+  expect_finding_refused(d, "mesh_dae/input-offset-beyond-indices-oom.dae", "offset.dae",
+                         "offset.dae:16: <input>: offset '9999999999999999999999999999999990' is not an index into "
+                         "the 12 values of the <p>");
+  std::string many = kDaeHead + dae_triangle_geometry("3", "0 1 2") + kDaeSceneOfG;
+  many.replace(many.find(R"(<triangles count="1">)"), 21, R"(<triangles count="1000000000">)");
+  expect_part_refused(d, "many.dae", many,
+                      "<triangles>: count 1000000000 triangles take 3000000000 indices at 1 per vertex, but the <p> "
+                      "holds 3");
 }
 
 /// A DAE of one triangle instanced through `levels` library nodes, each instancing the one
@@ -523,6 +539,25 @@ TEST(FuzzRegression, GlbLineLoopIndexOutOfRangeCrashed) {
   EXPECT_NE(l.find("index accessor 1 (13 indices of 2 bytes from byte 0) reaches beyond its bufferView's 24 bytes"),
             std::string::npos)
       << l;
+}
+
+// The GLB tetrahedron with its POSITION attribute and its indices misspelt and mode 5
+// (libFuzzer, seed 22, 119,073 executions after the index fix): Assimp sized a triangle
+// strip's faces as its 0 vertices − 2, unsigned — 2³² faces, 69 GB.
+TEST(FuzzRegression, GlbStripWithoutVerticesAllocated) {
+  const fs::path d = scratch();
+  expect_finding_refused(d, "mesh_glb/strip-without-vertices-oom.glb", "strip.glb",
+                         "strip.glb: mesh 0 primitive 0: mode 5 needs at least 3 vertices; it has 0 (no POSITION "
+                         "attribute, no indices)");
+  const std::string seed = slurp(fs::path(LOOM_SOURCE_DIR) / "tests/fuzz/seeds/gltf/tetra.gltf");
+  std::string fan = seed;
+  fan.replace(fan.find("\"mode\": 4"), 9, "\"mode\": 6");
+  write(d / "fan.gltf", fan);
+  EXPECT_GT(loom::read_mesh_file(d / "fan.gltf").triangle_count(), 0u);
+  fan.replace(fan.find("\"count\": 12"), 11, "\"count\": 2");
+  write(d / "short.gltf", fan);
+  const std::string e = input_error([&] { loom::read_mesh_file(d / "short.gltf"); });
+  EXPECT_NE(e.find("mesh 0 primitive 0: mode 6 needs at least 3 vertices; it has 2 indices"), std::string::npos) << e;
 }
 
 // A binary tetrahedron whose first vertex begins with the byte 0x0a (libFuzzer, seed 7, after

@@ -1,4 +1,4 @@
-#include "core/io/gltf_index_checks.hpp"
+#include "core/io/gltf_primitive_checks.hpp"
 
 #include "core/error.hpp"
 #include "core/io/glb_container.hpp"
@@ -105,11 +105,47 @@ class BufferBytes {
 /// Bytes of one index of glTF component type `t` (unsigned byte, short, int), 0 for others.
 std::uint64_t index_bytes(std::uint64_t t) { return t == 5121 ? 1 : t == 5123 ? 2 : t == 5125 ? 4 : 0; }
 
-/// Checks the indices of one primitive (`where` names it) against its vertex count.
+/// The vertices a primitive's mode needs for one face, 0 for modes without such a need.
+std::uint64_t least_vertices(std::uint64_t mode) {
+  if (mode == 2 || mode == 3) return 2;  // line loop, line strip
+  if (mode == 5 || mode == 6) return 3;  // triangle strip, triangle fan
+  return 0;
+}
+
+/// The count of accessor `id` of `doc`, 0 when there is none to read.
+std::uint64_t accessor_count(const nlohmann::json& doc, const nlohmann::json& id) {
+  const nlohmann::json* a = element(doc, "accessors", id);
+  const std::optional<std::uint64_t> n = a ? whole(*a, "count", 0) : std::nullopt;
+  return n ? *n : 0;
+}
+
+/// A strip, fan or loop has the vertices its mode needs for one face (`where` names it).
+void check_mode_vertices(const nlohmann::json& doc, const nlohmann::json& prim, const std::filesystem::path& path,
+                         const std::string& where) {
+  const std::optional<std::uint64_t> mode = whole(prim, "mode", 4);
+  const std::uint64_t least = mode ? least_vertices(*mode) : 0;
+  if (least == 0) return;
+  const bool indexed = prim.contains("indices");
+  const bool positioned = prim.contains("attributes") && prim["attributes"].is_object() &&
+                          prim["attributes"].contains("POSITION");
+  const std::uint64_t n = indexed      ? accessor_count(doc, prim["indices"])
+                          : positioned ? accessor_count(doc, prim["attributes"]["POSITION"])
+                                       : 0;
+  if (n < least)
+    throw InputError({path.string(), 0, where},
+                     "mode " + std::to_string(*mode) + " needs at least " + std::to_string(least) + " vertices; it has " +
+                         std::to_string(n) +
+                         (indexed ? " indices" : positioned ? " positions" : " (no POSITION attribute, no indices)"));
+}
+
+/// Checks one primitive (`where` names it): its mode's vertices, and its indices against
+/// its vertex count.
 void check_primitive(const nlohmann::json& doc, const nlohmann::json& prim, BufferBytes& buffers,
                      const std::filesystem::path& path, const std::string& where) {
-  if (!prim.is_object() || !prim.contains("indices") || !prim.contains("attributes") ||
-      !prim["attributes"].is_object() || !prim["attributes"].contains("POSITION"))
+  if (!prim.is_object()) return;
+  check_mode_vertices(doc, prim, path, where);
+  if (!prim.contains("indices") || !prim.contains("attributes") || !prim["attributes"].is_object() ||
+      !prim["attributes"].contains("POSITION"))
     return;
   const nlohmann::json* positions = element(doc, "accessors", prim["attributes"]["POSITION"]);
   const nlohmann::json* indices = element(doc, "accessors", prim["indices"]);
@@ -153,7 +189,7 @@ void check_primitive(const nlohmann::json& doc, const nlohmann::json& prim, Buff
 
 }  // namespace
 
-void check_gltf_indices(const nlohmann::json& doc, const std::filesystem::path& path, bool binary) {
+void check_gltf_primitives(const nlohmann::json& doc, const std::filesystem::path& path, bool binary) {
   if (!doc.contains("meshes") || !doc["meshes"].is_array()) return;  // glTF 1.0 names its meshes
   BufferBytes buffers(doc, path, binary);
   const nlohmann::json& meshes = doc["meshes"];
