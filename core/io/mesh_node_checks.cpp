@@ -156,8 +156,17 @@ class Dae {
       const auto [node, depth] = stack.back();
       stack.pop_back();
       if (depth > kMaxMeshNesting) too_deep(path_, line(node), "<" + std::string(node.name()) + ">");
-      if (const char* id = node.attribute("id").value(); *id) ids_.emplace(id, node);
       const std::string name = node.name();
+      if (const char* id = node.attribute("id").value(); *id) {
+        const auto [other, fresh] = ids_.emplace(id, node);
+        if (!fresh && is_data_array(name) && is_data_array(other->second.name())) {
+          // The walk is not in file order: name the later of the two.
+          const bool later = node.offset_debug() > other->second.offset_debug();
+          fail(later ? node : other->second, "id '" + printable(id) + "' is given to an array again (first at line " +
+                                                 std::to_string(line(later ? other->second : node)) +
+                                                 "): each array needs an id of its own");
+        }
+      }
       if (name == "p" || name == "vcount") check_indices(node);
       else if (is_primitive(node)) check_primitive(node);
       else if (name == "accessor") accessors.push_back(node);
@@ -211,6 +220,14 @@ class Dae {
   void node_of(const pugi::xml_node& n) {
     node_index_.emplace(n, nodes_.size());
     nodes_.push_back(n);
+  }
+
+  /// Whether an element named `name` is a COLLADA data array (<float_array>, <int_array>,
+  /// ...). Why their ids matter: Assimp keeps one array per id, and a second array under
+  /// the id of one a source already reads made it dereference null (SIGSEGV).
+  static bool is_data_array(const std::string& name) {
+    return name == "float_array" || name == "int_array" || name == "bool_array" || name == "Name_array" ||
+           name == "IDREF_array" || name == "SIDREF_array" || name == "token_array";
   }
 
   /// Whether `n` is a primitive of a <mesh>: Assimp reads those (and nothing of a

@@ -271,6 +271,22 @@ TEST(FuzzRegression, DaeInputOffsetBeyondItsIndicesAllocated) {
                       "holds 3");
 }
 
+// A second COLLADA document pasted inside a <geometry> (libFuzzer, seed 24, 437,329
+// executions after the offset fix), so that two <float_array> share the id
+// "tetra-pos-array": Assimp keeps one array per id and dereferenced null (SIGSEGV). Two
+// sibling geometries whose arrays share an id do the same.
+TEST(FuzzRegression, DaeArrayIdGivenTwiceCrashed) {
+  const fs::path d = scratch();
+  expect_finding_refused(d, "mesh_dae/array-id-given-twice-segv.dae", "twice.dae",
+                         "twice.dae:26: <float_array>: id 'tetra-pos-array' is given to an array again (first at "
+                         "line 8)");
+  std::string two = kDaeHead + dae_triangle_geometry("3", "0 1 2") + kDaeSceneOfG;
+  const std::string array = R"(<float_array id="pa" count="9">0 0 0 1 0 0 0 1 0</float_array>)";
+  two.insert(two.find("</library_geometries>"),
+             R"(<geometry id="g2"><mesh><source id="p2">)" + array + "</source></mesh></geometry>\n");
+  expect_part_refused(d, "sibling.dae", two, "<float_array>: id 'pa' is given to an array again (first at line 4)");
+}
+
 /// A DAE of one triangle instanced through `levels` library nodes, each instancing the one
 /// below twice, under one scene node.
 std::string dae_fan(int levels) {
