@@ -235,6 +235,8 @@ void read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
   std::istringstream is(head.substr(0, end));
   int line_no = 0;
   bool has_format = false;
+  int comment_in_element = 0;  // line of a comment or obj_info since the last element line
+  std::string comment_word;
   for (std::string line; std::getline(is, line);) {
     ++line_no;
     const auto w = words(line);
@@ -256,6 +258,13 @@ void read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
     if (const std::size_t cr = line.find('\r'); cr != std::string::npos && cr + 1 < line.size())
       refuse("PLY header", "a carriage return inside the line (byte 13 at column " + std::to_string(cr + 1) +
                                "): only line ends may hold one");
+    // Assimp ends an element's properties at a comment: "property float x / comment /
+    // property float y" was an element of x alone to it, three floats to this check (its
+    // data read apart, the triangulation aborted; in ASCII, a mesh of no triangles).
+    if (!w.empty() && (w[0] == "comment" || w[0] == "obj_info") && !out.extents.empty() && comment_in_element == 0) {
+      comment_in_element = line_no;
+      comment_word = w[0];
+    }
     if (w.empty() || w[0] == "comment" || w[0] == "obj_info" || (line_no == 1 && w[0] == "ply")) continue;
     if (w[0] == "format") {
       const std::string name = w.size() >= 2 ? w[1] : std::string();
@@ -267,6 +276,7 @@ void read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
       has_format = true;
     } else if (w[0] == "element") {
       PlyElementExtent e;
+      comment_in_element = 0;
       if (w.size() != 3 || !parse_count(w[2], e.count)) refuse("element", "expected 'element NAME COUNT' with a whole COUNT");
       // Assimp keeps one list per element name: a second "element vertex 9" after "element
       // vertex 8" had its values written past the end of the first one's (heap corruption).
@@ -280,6 +290,11 @@ void read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
       out.properties.emplace_back();
     } else if (w[0] == "property") {
       if (out.extents.empty()) refuse("property", "a property before any element");
+      if (comment_in_element != 0)
+        refuse("property", "a property after the " + comment_word + " line " +
+                               std::to_string(comment_in_element) + ", inside element " +
+                               printable(out.extents.back().name) +
+                               ": Assimp ends an element's properties at such a line (move it before the element)");
       const PlyProperty p = read_ply_property(w, line_no, path);
       out.extents.back().min_bytes += p.list ? p.count_bytes : p.bytes;
       out.properties.back().push_back(p);

@@ -625,6 +625,26 @@ TEST(FuzzRegression, PlyElementCountReadFromTheNameAllocated) {
                       "would read 5");
 }
 
+// A binary big-endian tetrahedron with a comment line between its vertex properties
+// (libFuzzer, seed 23, 1,154,918 executions after the element-count fix): Assimp ends an
+// element's properties at a comment, so its vertices were one float to it and three to
+// the pre-check; the data was read apart and Assimp's triangulation aborted (SIGABRT). In
+// ASCII the same header gave a mesh of no triangles. A comment after the last property
+// stays readable.
+TEST(FuzzRegression, PlyCommentBetweenPropertiesAborted) {
+  const fs::path d = scratch();
+  expect_finding_refused(d, "mesh_ply/comment-between-properties-abort.ply", "comment.ply",
+                         "comment.ply:8: property: a property after the comment line 7, inside element vertex");
+  const std::string body = "0 0 0\n1 0 0\n0 1 0\n1 1 1\n3 0 1 2\n3 1 2 3\n";
+  std::string header = kPlyQuadHeader;
+  header.insert(header.find("property float y"), "obj_info scanned\n");
+  expect_part_refused(d, "info.ply", header + body, "info.ply:6: property: a property after the obj_info line 5");
+  std::string after = kPlyQuadHeader;
+  after.insert(after.find("element face"), "comment after the vertex properties\n");
+  write(d / "after.ply", after + body);
+  EXPECT_EQ(loom::read_mesh_file(d / "after.ply").triangle_count(), 2u);
+}
+
 // An ASCII vertex line "0 1\r 1" (libFuzzer, seed 7, after the element fix): Assimp ends a
 // data line at a carriage return, read a vertex of two values and a line of one, laid the
 // instances out apart from the pre-check and aborted in its triangulation (SIGABRT in a
