@@ -250,6 +250,12 @@ void read_ply_layout(const std::filesystem::path& path, PlyLayout& out) {
         w[0] != "comment" && w[0] != "obj_info")
       refuse("PLY header", "words separated by a form feed or vertical tab (byte " + std::to_string(int(line[odd])) +
                                "): only spaces and tabs separate them");
+    // A form feed ends a header line for Assimp, comments included: "comment xelement
+    // face 0000…1557 ..." was a comment to this check and an element of 2³²-wrapped count
+    // to Assimp, which read it for minutes.
+    if (const std::size_t ff = line.find('\f'); ff != std::string::npos)
+      refuse("PLY header", "a form feed inside the line (column " + std::to_string(ff + 1) +
+                               "): Assimp ends a line there, even a comment");
     // Assimp also ends a header line at a carriage return: "property float \rz" was a
     // property without a name to it and a line "z", while this check read "property float
     // z" (the data laid out apart; Assimp's triangulation aborted). A comment is no
