@@ -13,6 +13,8 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
+#include <cstdlib>
 #include <cstdint>
 #include <sstream>
 #include <string>
@@ -173,6 +175,7 @@ class Dae {
       else if (name == "node") node_of(node);
       else if (name == "visual_scene") visual_scenes_.push_back(node);
       else if (name == "geometry") geometries_.push_back(node);
+      if (std::string(node.parent().name()) == "node") check_transform(node, name);
       for (pugi::xml_node c = node.first_child(); c; c = c.next_sibling())
         if (c.type() == pugi::node_element) stack.push_back({c, depth + 1});
     }
@@ -203,7 +206,12 @@ class Dae {
     }
     // The scene Assimp builds: the one <scene> instantiates, else every visual scene.
     std::vector<pugi::xml_node> scenes;
-    const pugi::xml_node chosen = target(doc.document_element().child("scene").child("instance_visual_scene"), "url");
+    const pugi::xml_node instance = doc.document_element().child("scene").child("instance_visual_scene");
+    const pugi::xml_node chosen = target(instance, "url");
+    // An instance naming no visual scene of the file: Assimp threw after building the
+    // scene's nodes and leaked them.
+    if (instance && (!chosen || std::string(chosen.name()) != "visual_scene"))
+      fail(instance, "url '" + printable(instance.attribute("url").value()) + "' names no <visual_scene> of the file");
     if (chosen) scenes.push_back(chosen);
     else scenes = visual_scenes_;
     std::vector<std::size_t> roots;
@@ -228,6 +236,30 @@ class Dae {
   static bool is_data_array(const std::string& name) {
     return name == "float_array" || name == "int_array" || name == "bool_array" || name == "Name_array" ||
            name == "IDREF_array" || name == "SIDREF_array" || name == "token_array";
+  }
+
+  /// A node's transform (<matrix>, <translate>, <rotate>, <scale>, <lookat>, <skew>) holds
+  /// its number of values, each a finite number. Why: Assimp read a <matrix> of 14 values
+  /// past its end, or a rotate of "? 1 90", threw ("Cannot parse string ... as a real
+  /// number") and leaked the nodes it had built (a kilobyte per file, which grew the
+  /// fuzzer past its memory limit).
+  void check_transform(const pugi::xml_node& n, const std::string& name) const {
+    static const std::pair<const char*, int> kValues[] = {{"matrix", 16}, {"translate", 3}, {"rotate", 4},
+                                                          {"scale", 3},   {"lookat", 9},    {"skew", 7}};
+    for (const auto& [kind, values] : kValues) {
+      if (name != kind) continue;
+      int words = 0;
+      for_each_word(n.child_value(), [&](const char* from, const char* to) {
+        const std::string word(from, to);
+        char* end = nullptr;
+        const double v = std::strtod(word.c_str(), &end);
+        if (end != word.c_str() + word.size() || !std::isfinite(v))
+          fail(n, "'" + printable(word.substr(0, 20)) + "' (value " + std::to_string(words) + ") is not a number");
+        ++words;
+      });
+      if (words != values)
+        fail(n, "holds " + std::to_string(words) + " values; a <" + name + "> takes " + std::to_string(values));
+    }
   }
 
   /// Whether `n` is a primitive of a <mesh>: Assimp reads those (and nothing of a

@@ -287,6 +287,33 @@ TEST(FuzzRegression, DaeArrayIdGivenTwiceCrashed) {
   expect_part_refused(d, "sibling.dae", two, "<float_array>: id 'pa' is given to an array again (first at line 4)");
 }
 
+// A <matrix> of 14 values (libFuzzer, seed 25: fuzz_mesh_dae grew past its 2 GB after
+// 375,510 executions; the corpus replayed with leak detection named the inputs): Assimp
+// read past the values, threw and leaked the nodes it had built, a kilobyte per file. A
+// rotate of "? 1 90" and a <scene> naming no visual scene did the same. A node nested in
+// a node with its own matrix reads.
+TEST(FuzzRegression, DaeTransformShortOfValuesLeaked) {
+  const fs::path d = scratch();
+  expect_finding_refused(d, "mesh_dae/matrix-of-14-values-leak.dae", "matrix.dae",
+                         "matrix.dae:10: <matrix>: holds 14 values; a <matrix> takes 16");
+  const std::string geometry = dae_triangle_geometry("3", "0 1 2");
+  const auto scene = [&](const std::string& nodes, const std::string& url) {
+    return kDaeHead + geometry + "<library_visual_scenes><visual_scene id=\"S\">" + nodes +
+           "</visual_scene></library_visual_scenes>\n<scene><instance_visual_scene url=\"" + url +
+           "\"/></scene>\n</COLLADA>\n";
+  };
+  const std::string leaf = R"(<instance_geometry url="#g"/>)";
+  expect_part_refused(d, "rotate.dae", scene("<node id=\"n\"><rotate>? 1 90 0</rotate>" + leaf + "</node>", "#S"),
+                      "<rotate>: '?' (value 0) is not a number");
+  expect_part_refused(d, "url.dae", scene("<node id=\"n\">" + leaf + "</node>", "#T"),
+                      "<instance_visual_scene>: url '#T' names no <visual_scene> of the file");
+  write(d / "nested.dae",
+        scene("<node id=\"a\"><translate>1 2 3</translate><node id=\"b\"><matrix>1 0 0 5 0 1 0 0 0 0 1 0 0 0 0 "
+              "1</matrix>" + leaf + "</node></node>",
+              "#S"));
+  EXPECT_EQ(loom::read_mesh_file(d / "nested.dae").triangle_count(), 1u);
+}
+
 /// A DAE of one triangle instanced through `levels` library nodes, each instancing the one
 /// below twice, under one scene node.
 std::string dae_fan(int levels) {
