@@ -314,6 +314,18 @@ TEST(FuzzRegression, DaeTransformShortOfValuesLeaked) {
   EXPECT_EQ(loom::read_mesh_file(d / "nested.dae").triangle_count(), 1u);
 }
 
+// `<float_array count="3333…312">` over 12 values (libFuzzer, seed 26, 10,714 executions
+// after the transform fix): Assimp reserved the declared count, wrapped, before it read the
+// values (the fuzzer past its 2 GB), then reported the values missing.
+TEST(FuzzRegression, DaeArrayCountBeyondItsValuesAllocated) {
+  const fs::path d = scratch();
+  expect_finding_refused(d, "mesh_dae/array-count-beyond-values-oom.dae", "count.dae",
+                         "count.dae:8: <float_array>: attribute 'count' = '3333");
+  std::string more = kDaeHead + dae_triangle_geometry("3", "0 1 2") + kDaeSceneOfG;
+  more.replace(more.find(R"(count="9")"), 9, R"(count="10")");
+  expect_part_refused(d, "more.dae", more, "<float_array>: count 10 but it holds 9 values");
+}
+
 /// A DAE of one triangle instanced through `levels` library nodes, each instancing the one
 /// below twice, under one scene node.
 std::string dae_fan(int levels) {
