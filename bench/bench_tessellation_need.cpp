@@ -1,5 +1,5 @@
-// Tessellation by need on real STEP assemblies (stepcode's AS1, OpenCASCADE's link rods)
-// and the wing section's 14 STEP parts:
+// Tessellation by need on real STEP assemblies (stepcode's AS1 and S1 — eleven parts in nine
+// files, curved body shells —, OpenCASCADE's link rods) and the wing section's 14 STEP parts:
 // 2 mm cables (fine deflection r / 10 = 0.1 mm) drawn straight through the three largest
 // parts' boxes along their longest axis, and one past the assembly. For each policy —
 // uniform at the fine deflection (the reference), by need (coarse 20×, refined near the
@@ -7,7 +7,7 @@
 // would give) — the first load (an empty tessellation cache), triangles, parts refined,
 // audit time and whether the findings are the reference's. Writes
 // bench/results/tessellation_need.csv and tessellation_need.png.
-//   bench_tessellation_need [ASSEMBLY...]   (as1, linkrods, wing; default all)
+//   bench_tessellation_need [ASSEMBLY...]   (as1, linkrods, s1, wing; default all)
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -131,7 +131,10 @@ std::set<std::string> finding_keys(const AuditReport& r) {
 int main(int argc, char** argv) {
   const fs::path data = LOOM_SHARED_DATA;
   std::vector<Assembly> all = {
-      {"as1", data / "stepcode" / "as1-oc-214.stp"}, {"linkrods", data / "occt" / "linkrods.step"}, {"wing", {}}};
+      {"as1", data / "stepcode" / "as1-oc-214.stp"},
+      {"linkrods", data / "occt" / "linkrods.step"},
+      {"s1", data / "stepcode" / "s1-c5-214" / "s1-c5-214.stp"},
+      {"wing", {}}};
   std::vector<Assembly> chosen;
   for (int i = 1; i < argc; ++i)
     for (const Assembly& a : all)
