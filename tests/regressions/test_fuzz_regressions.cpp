@@ -88,6 +88,17 @@ void expect_finding_refused(const fs::path& dir, const std::string& name, const 
   EXPECT_NE(r.out.find(expected), std::string::npos) << expected << "\n" << r.out;
 }
 
+/// Writes `text` as `file` and expects read_mesh_file to refuse it with `expected` in its
+/// message.
+void expect_read_refused(const fs::path& file, const std::string& text, const std::string& expected) {
+  write(file, text);
+  const std::string e = input_error([&] { loom::read_mesh_file(file); });
+  EXPECT_NE(e.find(expected), std::string::npos) << expected << "\n" << e;
+}
+
+/// The tetrahedron glTF seed of the fuzz corpus (its buffer a base64 data URI).
+std::string tetra_gltf() { return slurp(fs::path(LOOM_SOURCE_DIR) / "tests/fuzz/seeds/gltf/tetra.gltf"); }
+
 // --- DAE -------------------------------------------------------------------------------------
 
 const char* kDaeHead =
@@ -113,6 +124,10 @@ const char* kDaeSceneOfG =
 <scene><instance_visual_scene url="#S"/></scene>
 </COLLADA>
 )";
+
+/// dae_triangle_geometry's primitive for p = "0 1 2", for tests that put another in its place.
+const std::string kDaeTriangle =
+    R"(<triangles count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1 2</p></triangles>)";
 
 // An accessor stride of 2^31 - 1 on a 9-value array: Assimp read element k at k·stride
 // unchecked (SIGSEGV in `loom info`).
@@ -211,11 +226,10 @@ TEST(FuzzRegression, DaePolylistWithoutVcountCrashed) {
   const fs::path d = scratch();
   expect_finding_refused(d, "mesh_dae/polylist-without-vcount-segv.dae", "novc.dae",
                          "novc.dae:17: <polylist>: a <polylist> needs its <vcount>");
-  const std::string triangle = R"(<triangles count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1 2</p></triangles>)";
   const std::string input = R"(<input semantic="VERTEX" source="#v" offset="0"/>)";
   const auto with_primitive = [&](const std::string& primitive) {
     std::string g = dae_triangle_geometry("3", "0 1 2");
-    g.replace(g.find(triangle), triangle.size(), primitive);
+    g.replace(g.find(kDaeTriangle), kDaeTriangle.size(), primitive);
     return kDaeHead + g + kDaeSceneOfG;
   };
   expect_part_refused(d, "after.dae",
@@ -225,7 +239,7 @@ TEST(FuzzRegression, DaePolylistWithoutVcountCrashed) {
                       "<triangles>: declares 1 primitive(s) but holds no <p> index list");
   write(d / "good.dae", with_primitive(R"(<polylist count="1">)" + input + "<vcount>3</vcount><p>0 1 2</p></polylist>"));
   EXPECT_EQ(loom::read_mesh_file(d / "good.dae").triangle_count(), 1u);
-  write(d / "none.dae", with_primitive(R"(<triangles count="0">)" + input + "</triangles>" + triangle));
+  write(d / "none.dae", with_primitive(R"(<triangles count="0">)" + input + "</triangles>" + kDaeTriangle));
   EXPECT_EQ(loom::read_mesh_file(d / "none.dae").triangle_count(), 1u);
 }
 
@@ -237,10 +251,9 @@ TEST(FuzzRegression, DaePolylistVcountBeyondItsIndicesAllocated) {
   expect_finding_refused(d, "mesh_dae/polylist-vcount-beyond-indices-oom.dae", "big.dae",
                          "big.dae:17: <vcount>: the polygons' 34294967295 vertices take 34294967295 indices at 1 "
                          "per vertex, but the <p> holds 3");
-  const std::string triangle = R"(<triangles count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1 2</p></triangles>)";
   const auto polylist = [&](const std::string& inputs, const std::string& vcount, const std::string& p) {
     std::string g = dae_triangle_geometry("3", "0 1 2");
-    g.replace(g.find(triangle), triangle.size(),
+    g.replace(g.find(kDaeTriangle), kDaeTriangle.size(),
               R"(<polylist count="1">)" + inputs + "<vcount>" + vcount + "</vcount><p>" + p + "</p></polylist>");
     return kDaeHead + g + kDaeSceneOfG;
   };
@@ -566,7 +579,7 @@ TEST(FuzzRegression, GlbLineLoopIndexOutOfRangeCrashed) {
   expect_finding_refused(d, "mesh_glb/line-loop-index-out-of-range-segv.glb", "loop.glb",
                          "loop.glb: mesh 0 primitive 0: index 0 of accessor 1 names vertex 65; the primitive has 4");
   // The seed tetrahedron (a base64 data URI) reads; its buffer as a file beside it too.
-  const std::string seed = slurp(fs::path(LOOM_SOURCE_DIR) / "tests/fuzz/seeds/gltf/tetra.gltf");
+  const std::string seed = tetra_gltf();
   write(d / "uri.gltf", seed);
   EXPECT_EQ(loom::read_mesh_file(d / "uri.gltf").triangle_count(), 4u);
   std::string text = seed;
@@ -584,16 +597,11 @@ TEST(FuzzRegression, GlbLineLoopIndexOutOfRangeCrashed) {
   EXPECT_EQ(loom::read_mesh_file(d / "file.gltf").triangle_count(), 4u);
   bin[48 + 22] = 9;
   write(d / "tetra.bin", bin);
-  const std::string e = input_error([&] { loom::read_mesh_file(d / "file.gltf"); });
-  EXPECT_NE(e.find("mesh 0 primitive 0: index 11 of accessor 1 names vertex 9; the primitive has 4"),
-            std::string::npos)
-      << e;
+  expect_read_refused(d / "file.gltf", text,
+                      "mesh 0 primitive 0: index 11 of accessor 1 names vertex 9; the primitive has 4");
   text.replace(text.find("\"count\": 12"), 11, "\"count\": 13");
-  write(d / "long.gltf", text);
-  const std::string l = input_error([&] { loom::read_mesh_file(d / "long.gltf"); });
-  EXPECT_NE(l.find("index accessor 1 (13 indices of 2 bytes from byte 0) reaches beyond its bufferView's 24 bytes"),
-            std::string::npos)
-      << l;
+  expect_read_refused(d / "long.gltf", text,
+                      "index accessor 1 (13 indices of 2 bytes from byte 0) reaches beyond its bufferView's 24 bytes");
 }
 
 // The GLB tetrahedron with its POSITION attribute and its indices misspelt and mode 5
@@ -604,15 +612,13 @@ TEST(FuzzRegression, GlbStripWithoutVerticesAllocated) {
   expect_finding_refused(d, "mesh_glb/strip-without-vertices-oom.glb", "strip.glb",
                          "strip.glb: mesh 0 primitive 0: mode 5 needs at least 3 vertices; it has 0 (no POSITION "
                          "attribute, no indices)");
-  const std::string seed = slurp(fs::path(LOOM_SOURCE_DIR) / "tests/fuzz/seeds/gltf/tetra.gltf");
+  const std::string seed = tetra_gltf();
   std::string fan = seed;
   fan.replace(fan.find("\"mode\": 4"), 9, "\"mode\": 6");
   write(d / "fan.gltf", fan);
   EXPECT_GT(loom::read_mesh_file(d / "fan.gltf").triangle_count(), 0u);
   fan.replace(fan.find("\"count\": 12"), 11, "\"count\": 2");
-  write(d / "short.gltf", fan);
-  const std::string e = input_error([&] { loom::read_mesh_file(d / "short.gltf"); });
-  EXPECT_NE(e.find("mesh 0 primitive 0: mode 6 needs at least 3 vertices; it has 2 indices"), std::string::npos) << e;
+  expect_read_refused(d / "short.gltf", fan, "mesh 0 primitive 0: mode 6 needs at least 3 vertices; it has 2 indices");
 }
 
 // A binary tetrahedron whose first vertex begins with the byte 0x0a (libFuzzer, seed 7, after
