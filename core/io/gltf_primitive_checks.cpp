@@ -144,12 +144,20 @@ void check_primitive(const nlohmann::json& doc, const nlohmann::json& prim, Buff
                      const std::filesystem::path& path, const std::string& where) {
   if (!prim.is_object()) return;
   check_mode_vertices(doc, prim, path, where);
-  if (!prim.contains("indices") || !prim.contains("attributes") || !prim["attributes"].is_object() ||
-      !prim["attributes"].contains("POSITION"))
-    return;
-  const nlohmann::json* positions = element(doc, "accessors", prim["attributes"]["POSITION"]);
+  if (!prim.contains("indices")) return;
+  // Indices name vertices: without a POSITION accessor Assimp builds faces over no vertices
+  // and dereferences null.
+  const bool positioned = prim.contains("attributes") && prim["attributes"].is_object() &&
+                          prim["attributes"].contains("POSITION");
+  const nlohmann::json* positions = positioned ? element(doc, "accessors", prim["attributes"]["POSITION"]) : nullptr;
+  if (!positions)
+    throw InputError({path.string(), 0, where},
+                     "indices (accessor " + prim["indices"].dump() + ") name vertices, but " +
+                         (positioned ? "the POSITION attribute " + prim["attributes"]["POSITION"].dump() +
+                                           " names no accessor of the file"
+                                     : std::string("the primitive has no POSITION attribute")));
   const nlohmann::json* indices = element(doc, "accessors", prim["indices"]);
-  if (!positions || !indices || indices->contains("sparse") || !indices->contains("bufferView")) return;
+  if (!indices || indices->contains("sparse") || !indices->contains("bufferView")) return;
   const std::optional<std::uint64_t> vertices = whole(*positions, "count", 0), count = whole(*indices, "count", 0),
                                      type = whole(*indices, "componentType", 0),
                                      offset = whole(*indices, "byteOffset", 0);

@@ -175,6 +175,7 @@ class Dae {
       else if (name == "node") node_of(node);
       else if (name == "visual_scene") visual_scenes_.push_back(node);
       else if (name == "geometry") geometries_.push_back(node);
+      else if (name == "mesh") check_mesh_layout(node);
       if (std::string(node.parent().name()) == "node") check_transform(node, name);
       if (is_data_array(name)) check_array_count(node);
       for (pugi::xml_node c = node.first_child(); c; c = c.next_sibling())
@@ -260,6 +261,27 @@ class Dae {
       });
       if (words != values)
         fail(n, "holds " + std::to_string(words) + " values; a <" + name + "> takes " + std::to_string(values));
+    }
+  }
+
+  /// A <mesh> holds one <vertices>, before its primitives (COLLADA 1.4 §5, <mesh>). Why:
+  /// Assimp 5.2 reads a primitive before the <vertices> without positions but with its
+  /// faces, so the faces of the next primitive named vertices past the mesh's (a
+  /// heap-buffer overflow in its sub-mesh copy).
+  void check_mesh_layout(const pugi::xml_node& mesh) const {
+    pugi::xml_node vertices;
+    for (pugi::xml_node c = mesh.first_child(); c; c = c.next_sibling()) {
+      if (std::string(c.name()) == "vertices") {
+        if (vertices)
+          fail(c, "a second <vertices> in the mesh (the first at line " + std::to_string(line(vertices)) +
+                      "): a mesh has one");
+        vertices = c;
+      } else if (is_primitive(c) && !vertices) {
+        fail(c, "comes before the mesh's <vertices>" +
+                    (mesh.child("vertices") ? " (line " + std::to_string(line(mesh.child("vertices"))) + ")"
+                                            : std::string(" (the mesh has none)")) +
+                    ": a mesh's primitives follow its <vertices>");
+      }
     }
   }
 
@@ -570,7 +592,11 @@ double gltf_node_corners(const nlohmann::json& doc, const nlohmann::json& node) 
 void check_dae_file(const std::filesystem::path& path) {
   const std::string text = file_bytes(path);
   pugi::xml_document doc;
-  if (!doc.load_buffer(text.data(), text.size(), pugi::parse_minimal)) return;  // Assimp reports it
+  // Not left to Assimp: it reads the part of a malformed document parsed before the error,
+  // and a primitive cut off there was read over vertices that are not there.
+  if (const pugi::xml_parse_result parsed = doc.load_buffer(text.data(), text.size(), pugi::parse_minimal); !parsed)
+    throw InputError({path.string(), LineMap(text).line(parsed.offset), "XML"},
+                     std::string("the XML does not parse: ") + parsed.description());
   Dae dae(path, text);
   dae.scan(doc);
   dae.check_instancing(doc);

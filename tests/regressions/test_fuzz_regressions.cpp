@@ -327,6 +327,41 @@ TEST(FuzzRegression, DaeTransformShortOfValuesLeaked) {
   EXPECT_EQ(loom::read_mesh_file(d / "nested.dae").triangle_count(), 1u);
 }
 
+// A COLLADA tetrahedron mutated into a polylist without inputs ahead of the mesh's
+// <vertices> and a second polylist after it (libFuzzer, seed 27, 1,201,733 executions;
+// minimised): Assimp read the first primitive's faces without positions, so the second's
+// faces named vertices past the mesh's, and its sub-mesh copy read 36 bytes beyond the
+// positions (ASan heap-buffer-overflow). A mesh now holds one <vertices>, before its
+// primitives.
+TEST(FuzzRegression, DaePrimitiveBeforeVerticesOverflowed) {
+  const fs::path d = scratch();
+  expect_finding_refused(d, "mesh_dae/primitive-before-vertices-hbo.dae", "early.dae",
+                         "early.dae:1: <polylist>: comes before the mesh's <vertices> (line 1): a mesh's primitives "
+                         "follow its <vertices>");
+  const std::string one = kDaeHead + dae_triangle_geometry("3", "0 1 2") + kDaeSceneOfG;
+  write(d / "one.dae", one);
+  EXPECT_EQ(loom::read_mesh_file(d / "one.dae").triangle_count(), 1u);
+  std::string none = one;
+  none.erase(none.find("<vertices"), none.find("</vertices>") + 11 - none.find("<vertices"));
+  expect_part_refused(d, "none.dae", none, "<triangles>: comes before the mesh's <vertices> (the mesh has none)");
+  std::string two = one;
+  two.insert(two.find("<triangles"), R"(<vertices id="v2"><input semantic="POSITION" source="#p"/></vertices>)");
+  expect_part_refused(d, "two.dae", two, "two.dae:7: <vertices>: a second <vertices> in the mesh (the first at line 6)");
+}
+
+// The same input cut by a mutation inside a start tag (`<node  <instance_geometry`): the
+// XML does not parse, yet Assimp read the part before the error and overflowed the same
+// way, while the pre-check had left malformed XML to Assimp. Malformed XML is refused,
+// naming the line of the error.
+TEST(FuzzRegression, DaeMalformedXmlReadInPartOverflowed) {
+  const fs::path d = scratch();
+  expect_finding_refused(d, "mesh_dae/malformed-xml-read-in-part-hbo.dae", "cut.dae",
+                         "cut.dae:1: XML: the XML does not parse: Error parsing start element tag");
+  std::string cut = kDaeHead + dae_triangle_geometry("3", "0 1 2") + kDaeSceneOfG;
+  cut.resize(cut.find("</mesh>") + 3);
+  expect_part_refused(d, "end.dae", cut, "end.dae:8: XML: the XML does not parse: Start-end tags mismatch");
+}
+
 // `<float_array count="3333…312">` over 12 values (libFuzzer, seed 26, 10,714 executions
 // after the transform fix): Assimp reserved the declared count, wrapped, before it read the
 // values (the fuzzer past its 2 GB), then reported the values missing.
@@ -619,6 +654,21 @@ TEST(FuzzRegression, GlbStripWithoutVerticesAllocated) {
   EXPECT_GT(loom::read_mesh_file(d / "fan.gltf").triangle_count(), 0u);
   fan.replace(fan.find("\"count\": 12"), 11, "\"count\": 2");
   expect_read_refused(d / "short.gltf", fan, "mesh 0 primitive 0: mode 6 needs at least 3 vertices; it has 2 indices");
+}
+
+// The GLB tetrahedron as a LINE_LOOP whose `attributes` key a mutation had spoilt (CI's
+// libFuzzer run, seed 1, 21,509 executions): twelve indices over no POSITION accessor;
+// Assimp built the lines over no vertices and dereferenced null (SIGSEGV).
+TEST(FuzzRegression, GlbIndicesWithoutPositionsCrashed) {
+  const fs::path d = scratch();
+  expect_finding_refused(d, "mesh_glb/indices-without-positions-segv.glb", "nopos.glb",
+                         "nopos.glb: mesh 0 primitive 0: indices (accessor 1) name vertices, but the primitive has no "
+                         "POSITION attribute");
+  std::string text = tetra_gltf();
+  text.replace(text.find("\"POSITION\": 0"), 13, "\"POSITION\": 7");
+  expect_read_refused(d / "far.gltf", text,
+                      "mesh 0 primitive 0: indices (accessor 1) name vertices, but the POSITION attribute 7 names no "
+                      "accessor of the file");
 }
 
 // A binary tetrahedron whose first vertex begins with the byte 0x0a (libFuzzer, seed 7, after
