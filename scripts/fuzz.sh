@@ -16,7 +16,11 @@
 # repository's seeds explores the same inputs in the same order; a shorter run (a slower
 # machine) explores a prefix of a longer one.
 #
-# Environment: LOOM_FUZZ_BUILD_DIR (default build-fuzz), LOOM_JOBS (default nproc),
+# CI's run is replayed by starting from the seeds alone: with LOOM_FUZZ_CORPUS_DIR=$(mktemp -d)
+# and the default seed a run tries the inputs CI's did, in order, until it has run as many.
+#
+# Environment: LOOM_FUZZ_BUILD_DIR (default build-fuzz), LOOM_FUZZ_CORPUS_DIR (default
+# fuzz-corpus in the build), LOOM_JOBS (default nproc),
 # LOOM_FUZZ_TIMEOUT (seconds one input may take, default 30; six times that for routes),
 # LOOM_FUZZ_RSS_MB (default 2048), LOOM_FUZZ_MAX_SEED (bytes, default 65536),
 # LOOM_SHARED_DATA (default ../shared/data beside the repository), LOOM_FUZZ_KEEP_RECENT and LOOM_FUZZ_KEEP_DIR (mesh
@@ -30,6 +34,7 @@ per_input="${LOOM_FUZZ_TIMEOUT:-30}"
 rss_mb="${LOOM_FUZZ_RSS_MB:-2048}"
 max_seed="${LOOM_FUZZ_MAX_SEED:-65536}"
 seed="${LOOM_FUZZ_SEED:-1}"
+corpora="${LOOM_FUZZ_CORPUS_DIR:-$build/fuzz-corpus}"
 shared="${LOOM_SHARED_DATA:-$root/../shared/data}"
 
 # The tests run under the sanitizers (--unit-tests): the suites that feed loom hostile or
@@ -85,6 +90,13 @@ done <"$root/tests/fuzz/corpus.txt"
 for t in "${targets[@]}"; do
   [[ " ${all_targets[*]} " == *" $t "* ]] || { echo "fuzz.sh: unknown target '$t' (${all_targets[*]})" >&2; exit 2; }
 done
+# One run of a target per build at a time: two would share its log, artifacts and scratch
+# directory, and each would delete the other's. The locks go with this shell.
+mkdir -p "$build/fuzz-logs"
+for t in "${targets[@]}"; do
+  exec {lock}>"$build/fuzz-logs/$t.lock"
+  flock -n "$lock" || { echo "fuzz.sh: fuzz_$t is already running in $build" >&2; exit 2; }
+done
 cmake --build "$build" -j "$jobs" --target $(printf 'fuzz_%s ' "${targets[@]}")
 
 # seed_corpus TARGET DIR: copies the target's seeds into DIR; prints its dictionary option.
@@ -122,7 +134,7 @@ report_finding() {
 failed=()
 summary=()
 for t in "${targets[@]}"; do
-  corpus="$build/fuzz-corpus/$t"
+  corpus="$corpora/$t"
   art="$build/fuzz-artifacts/$t"
   log="$build/fuzz-logs/$t.log"
   rm -rf "$art" && mkdir -p "$art" "$(dirname "$log")"
