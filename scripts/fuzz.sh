@@ -44,7 +44,7 @@ shared="${LOOM_SHARED_DATA:-$root/../shared/data}"
 # slower under ASan at -O1 — about an hour on two cores — and its inputs are generated, not
 # hostile; it runs in the Release suite of the README's test command.
 unit_test_select='^(HarnessXml|HarnessXmlProps|HarnessTopology|SceneDir|TempDir|RealCad|Mesh|MeshProps|'
-unit_test_select+='InputAdversarial|FuzzRegression|LimitRegression|ScanRegression|'
+unit_test_select+='InputAdversarial|FuzzRegression|GltfGeometry|DaeGeometry|LimitRegression|ScanRegression|'
 unit_test_select+='Kbl[A-Za-z]*|PointCloudIo|PointCloudIoProperty|FileStems|OutputSet|AuditCli|CliOutputs|'
 unit_test_select+='ClashCheck|ClashAdversarial|ClashLimits|Centerline|BSplineOps|MeshCut|PartSplit|AuditShard|ShardPlan|TessellationNeed|ArcLine|BendPlanner|regressions)\.'
 

@@ -73,4 +73,11 @@ GlbLayout read_glb_layout(const std::filesystem::path& path) {
   return out;
 }
 
+std::string gltf_json(const std::filesystem::path& path, bool binary) {
+  if (!binary) return file_bytes(path);
+  const GlbLayout glb = read_glb_layout(path);
+  return file_bytes(path, static_cast<std::size_t>(glb.json_offset + glb.json_length))
+      .substr(static_cast<std::size_t>(glb.json_offset));
+}
+
 }  // namespace loom

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 
 namespace loom {
 
@@ -24,5 +25,8 @@ struct GlbLayout {
 /// 1 or 2, a total length no larger than the file, every chunk inside it, a JSON chunk
 /// first. Throws InputError naming the file and the header field or chunk otherwise.
 GlbLayout read_glb_layout(const std::filesystem::path& path);
+
+/// The JSON of a glTF file, or of a GLB file's JSON chunk (its container checked first).
+std::string gltf_json(const std::filesystem::path& path, bool binary);
 
 }  // namespace loom

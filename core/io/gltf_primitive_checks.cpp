@@ -62,33 +62,43 @@ class BufferBytes {
   BufferBytes(const nlohmann::json& doc, const std::filesystem::path& path, bool binary)
       : doc_(doc), path_(path), binary_(binary) {}
 
-  /// Buffer `id`'s bytes (at most its byteLength), or null when they cannot be had.
+  /// Buffer `id`'s bytes, or null when it is no buffer of the file or its file does not
+  /// open; throws InputError for a data URI that is not base64 or does not decode.
   const std::string* bytes(const nlohmann::json& id) {
     const nlohmann::json* b = element(doc_, "buffers", id);
     if (!b) return nullptr;
     const std::uint64_t key = id.get<std::uint64_t>();
     auto it = cache_.find(key);
-    if (it == cache_.end()) it = cache_.emplace(key, read(*b)).first;
+    if (it == cache_.end()) it = cache_.emplace(key, read(key, *b)).first;
     return it->second ? &*it->second : nullptr;
   }
 
  private:
-  std::optional<std::string> read(const nlohmann::json& b) const {
+  std::optional<std::string> read(std::uint64_t key, const nlohmann::json& b) const {
     const std::optional<std::uint64_t> length = whole(b, "byteLength", 0);
     if (!length) return std::nullopt;
-    if (!b.contains("uri")) {
-      if (!binary_) return std::nullopt;
-      const GlbLayout glb = read_glb_layout(path_);
+    // Assimp takes a GLB's first buffer from its BIN chunk, whatever its uri says.
+    const GlbLayout glb = binary_ ? read_glb_layout(path_) : GlbLayout{};
+    if (binary_ && (!b.contains("uri") || (key == 0 && glb.bin_length > 0))) {
       const std::string all = file_bytes(path_, static_cast<std::size_t>(glb.bin_offset + glb.bin_length));
       if (all.size() < glb.bin_offset) return std::nullopt;
       return all.substr(static_cast<std::size_t>(glb.bin_offset));
     }
-    if (!b["uri"].is_string()) return std::nullopt;
+    if (!b.contains("uri") || !b["uri"].is_string()) return std::nullopt;
     const std::string uri = b["uri"].get<std::string>();
+    const std::string what = "buffer " + std::to_string(key);
     if (uri.rfind("data:", 0) == 0) {
+      // Assimp copies the text of a data URI without ";base64" as its bytes, and decodes a
+      // character outside the alphabet as 0: neither is data a file means.
       const std::size_t comma = uri.find(',');
-      if (comma == std::string::npos || uri.rfind(";base64", comma) == std::string::npos) return std::nullopt;
-      return base64_decode(uri.substr(comma + 1));
+      if (comma == std::string::npos || uri.rfind(";base64", comma) == std::string::npos)
+        throw InputError({path_.string(), 0, what}, "a data URI that is not base64 (\"" +
+                                                        printable(uri.substr(0, std::min<std::size_t>(comma, 60))) +
+                                                        "\"): loom reads base64 data URIs");
+      std::optional<std::string> data = base64_decode(uri.substr(comma + 1));
+      if (!data)
+        throw InputError({path_.string(), 0, what}, "its data URI holds a character that is not base64");
+      return data;
     }
     std::error_code ec;
     const std::filesystem::path file = path_.parent_path() / uri;
@@ -138,60 +148,89 @@ void check_mode_vertices(const nlohmann::json& doc, const nlohmann::json& prim, 
                          (indexed ? " indices" : positioned ? " positions" : " (no POSITION attribute, no indices)"));
 }
 
-/// Checks one primitive (`where` names it): its mode's vertices, and its indices against
-/// its vertex count.
+/// Where the elements of an accessor lie in its buffer's bytes, once checked.
+struct AccessorBytes {
+  const std::string* data = nullptr;  ///< the buffer's bytes
+  std::size_t first = 0;              ///< byte of element 0
+  std::uint64_t stride = 0, size = 0, count = 0;
+};
+
+/// Checks accessor `id` of a primitive (`where`) as Assimp will read it — `role` the
+/// attribute ("POSITION") or "index" — and says where its elements lie. Why: Assimp 5.2
+/// bounds an accessor by count · stride against its bufferView, leaving out the
+/// accessor's byteOffset and an element longer than the stride, and copied vertices from
+/// past the buffer; it zero-fills an accessor without a bufferView by its declared count,
+/// and a sparse one dereferenced null or a wild offset.
+AccessorBytes accessor_bytes(const nlohmann::json& doc, const nlohmann::json& id, BufferBytes& buffers,
+                             const std::filesystem::path& path, const std::string& where, const std::string& role) {
+  const bool index = role == "index";
+  const std::string name = (index ? "index accessor " : role + " accessor ") + id.dump();
+  auto refuse = [&](const std::string& why) { throw InputError({path.string(), 0, where}, name + " " + why); };
+  const nlohmann::json* a = element(doc, "accessors", id);
+  if (!a) refuse("is not an accessor of the file");
+  if (a->contains("sparse")) refuse("is sparse: loom reads positions and indices stored whole");
+  if (!a->contains("bufferView")) refuse("has no bufferView (all zeros): loom reads positions and indices from buffers");
+  const std::optional<std::uint64_t> type = whole(*a, "componentType", 0), count = whole(*a, "count", 0),
+                                     offset = whole(*a, "byteOffset", 0);
+  const std::string shape = a->contains("type") && (*a)["type"].is_string() ? (*a)["type"].get<std::string>() : "";
+  if (index ? !type || index_bytes(*type) == 0 || shape != "SCALAR" : !type || *type != 5126 || shape != "VEC3")
+    refuse(std::string("is not ") + (index ? "SCALAR of unsigned bytes, shorts or ints (5121, 5123, 5125)"
+                                           : "VEC3 of floats (5126)"));
+  if (!count || *count == 0)
+    refuse("has no elements: its count is " + (a->contains("count") ? (*a)["count"].dump() : std::string("missing")));
+  if (!offset) refuse("has a byteOffset that is not a whole number of bytes");
+  const std::uint64_t size = index ? index_bytes(*type) : 12;
+  const nlohmann::json* view = element(doc, "bufferViews", (*a)["bufferView"]);
+  if (!view) refuse("names bufferView " + (*a)["bufferView"].dump() + ", which is not one of the file");
+  const std::optional<std::uint64_t> view_offset = whole(*view, "byteOffset", 0),
+                                     view_length = whole(*view, "byteLength", 0), stride = whole(*view, "byteStride", size);
+  if (!view_offset || !view_length || !stride || *stride < size || !view->contains("buffer"))
+    refuse("has a bufferView whose byteOffset, byteLength, byteStride (at least " + std::to_string(size) +
+           ") or buffer is not given as whole numbers");
+  if (!element(doc, "buffers", (*view)["buffer"]))
+    refuse("lies in buffer " + (*view)["buffer"].dump() + ", which is not one of the file");
+  const std::string* data = buffers.bytes((*view)["buffer"]);
+  // A buffer file that does not open: Assimp cannot read it either, and says so.
+  if (!data) return {nullptr, 0, *stride, size, *count};
+  // (count − 1)·stride + size ≤ the bytes after the offset, in a form that cannot wrap.
+  const std::uint64_t room = *offset <= *view_length ? *view_length - *offset : 0;
+  if (*offset > *view_length || size > room || *count - 1 > (room - size) / *stride)
+    refuse("(" + std::to_string(*count) + " elements of " + std::to_string(size) + " bytes, " +
+           std::to_string(*stride) + " apart, from byte " + std::to_string(*offset) + ") reaches beyond its bufferView's " +
+           std::to_string(*view_length) + " bytes");
+  if (*view_offset > data->size() || *view_length > data->size() - *view_offset)
+    refuse("lies in a bufferView (bytes " + std::to_string(*view_offset) + " + " + std::to_string(*view_length) +
+           ") reaching beyond its buffer's " + std::to_string(data->size()) + " bytes");
+  return {data, static_cast<std::size_t>(*view_offset + *offset), *stride, size, *count};
+}
+
+/// Checks one primitive (`where` names it): its mode's vertices, its POSITION and index
+/// accessors, and each index against its vertex count.
 void check_primitive(const nlohmann::json& doc, const nlohmann::json& prim, BufferBytes& buffers,
                      const std::filesystem::path& path, const std::string& where) {
   if (!prim.is_object()) return;
   check_mode_vertices(doc, prim, path, where);
+  const bool positioned = prim.contains("attributes") && prim["attributes"].is_object() &&
+                          prim["attributes"].contains("POSITION");
+  const AccessorBytes positions =
+      positioned ? accessor_bytes(doc, prim["attributes"]["POSITION"], buffers, path, where, "POSITION") : AccessorBytes{};
   if (!prim.contains("indices")) return;
   // Indices name vertices: without a POSITION accessor Assimp builds faces over no vertices
   // and dereferences null.
-  const bool positioned = prim.contains("attributes") && prim["attributes"].is_object() &&
-                          prim["attributes"].contains("POSITION");
-  const nlohmann::json* positions = positioned ? element(doc, "accessors", prim["attributes"]["POSITION"]) : nullptr;
-  if (!positions)
-    throw InputError({path.string(), 0, where},
-                     "indices (accessor " + prim["indices"].dump() + ") name vertices, but " +
-                         (positioned ? "the POSITION attribute " + prim["attributes"]["POSITION"].dump() +
-                                           " names no accessor of the file"
-                                     : std::string("the primitive has no POSITION attribute")));
-  const nlohmann::json* indices = element(doc, "accessors", prim["indices"]);
-  if (!indices || indices->contains("sparse") || !indices->contains("bufferView")) return;
-  const std::optional<std::uint64_t> vertices = whole(*positions, "count", 0), count = whole(*indices, "count", 0),
-                                     type = whole(*indices, "componentType", 0),
-                                     offset = whole(*indices, "byteOffset", 0);
-  const nlohmann::json* view = element(doc, "bufferViews", (*indices)["bufferView"]);
-  if (!vertices || !count || !type || !offset || !view || *count == 0 || index_bytes(*type) == 0) return;
-  const std::uint64_t size = index_bytes(*type);
-  const std::optional<std::uint64_t> view_offset = whole(*view, "byteOffset", 0),
-                                     view_length = whole(*view, "byteLength", 0), stride = whole(*view, "byteStride", size);
-  if (!view_offset || !view_length || !stride || *stride < size || !view->contains("buffer")) return;
-  const std::string* data = buffers.bytes((*view)["buffer"]);
-  if (!data) return;
-  const std::string accessor = "accessor " + prim["indices"].dump();
-  // (count − 1)·stride + size ≤ the bytes after the offset, in a form that cannot wrap.
-  const std::uint64_t room = *offset <= *view_length ? *view_length - *offset : 0;
-  if (*offset > *view_length || size > room || *count - 1 > (room - size) / *stride)
-    throw InputError({path.string(), 0, where},
-                     "index " + accessor + " (" + std::to_string(*count) + " indices of " + std::to_string(size) +
-                         " bytes from byte " + std::to_string(*offset) + ") reaches beyond its bufferView's " +
-                         std::to_string(*view_length) + " bytes");
-  if (*view_offset > data->size() || *view_length > data->size() - *view_offset)
-    throw InputError({path.string(), 0, where}, "the bufferView of index " + accessor + " (bytes " +
-                                                    std::to_string(*view_offset) + " + " + std::to_string(*view_length) +
-                                                    ") reaches beyond its buffer's " + std::to_string(data->size()) +
-                                                    " bytes");
-  const std::size_t first = static_cast<std::size_t>(*view_offset + *offset);
-  for (std::uint64_t k = 0; k < *count; ++k) {
-    const std::size_t at = first + static_cast<std::size_t>(k * *stride);
+  if (!positioned)
+    throw InputError({path.string(), 0, where}, "indices (accessor " + prim["indices"].dump() +
+                                                    ") name vertices, but the primitive has no POSITION attribute");
+  const AccessorBytes indices = accessor_bytes(doc, prim["indices"], buffers, path, where, "index");
+  if (!indices.data) return;
+  for (std::uint64_t k = 0; k < indices.count; ++k) {
+    const std::size_t at = indices.first + static_cast<std::size_t>(k * indices.stride);
     std::uint64_t v = 0;
-    for (std::uint64_t b = size; b-- > 0;) v = (v << 8) | static_cast<unsigned char>((*data)[at + b]);
-    if (v >= *vertices)
+    for (std::uint64_t b = indices.size; b-- > 0;) v = (v << 8) | static_cast<unsigned char>((*indices.data)[at + b]);
+    if (v >= positions.count)
       throw InputError({path.string(), 0, where},
-                       "index " + std::to_string(k) + " of " + accessor + " names vertex " + std::to_string(v) +
-                           "; the primitive has " + std::to_string(*vertices) + " (POSITION accessor " +
-                           prim["attributes"]["POSITION"].dump() + ")");
+                       "index " + std::to_string(k) + " of accessor " + prim["indices"].dump() + " names vertex " +
+                           std::to_string(v) + "; the primitive has " + std::to_string(positions.count) +
+                           " (POSITION accessor " + prim["attributes"]["POSITION"].dump() + ")");
   }
 }
 

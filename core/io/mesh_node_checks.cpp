@@ -1,6 +1,7 @@
 #include "core/io/mesh_node_checks.hpp"
 
 #include "core/error.hpp"
+#include "core/io/dae_geometry.hpp"
 #include "core/io/glb_container.hpp"
 #include "core/io/gltf_primitive_checks.hpp"
 #include "core/io/input_file.hpp"
@@ -161,12 +162,16 @@ class Dae {
       const std::string name = node.name();
       if (const char* id = node.attribute("id").value(); *id) {
         const auto [other, fresh] = ids_.emplace(id, node);
-        if (!fresh && is_data_array(name) && is_data_array(other->second.name())) {
-          // The walk is not in file order: name the later of the two.
+        if (!fresh) {
+          // The walk is not in file order: name the later of the two. Why: Assimp keeps one
+          // array, node, geometry per id (a second array under a source's id made it
+          // dereference null), and the instancing check would follow another element than
+          // Assimp does (a node instancing itself behind a camera of its id: a stack overflow).
           const bool later = node.offset_debug() > other->second.offset_debug();
-          fail(later ? node : other->second, "id '" + printable(id) + "' is given to an array again (first at line " +
-                                                 std::to_string(line(later ? other->second : node)) +
-                                                 "): each array needs an id of its own");
+          const pugi::xml_node first = later ? other->second : node;
+          fail(later ? node : other->second, "id '" + printable(id) + "' is given again (first at line " +
+                                                 std::to_string(line(first)) + ", <" + first.name() +
+                                                 ">): each element needs an id of its own");
         }
       }
       if (name == "p" || name == "vcount") check_indices(node);
@@ -199,9 +204,14 @@ class Dae {
         if (cn == "node") {
           g.children[v].push_back(node_index_.at(c));
         } else if (cn == "instance_node") {
+          // Assimp looks a URL that names no node id up among the node names, where the
+          // instancing check does not follow it (a node instancing its own name recursed
+          // without end).
           const pugi::xml_node t = target(c, "url");
-          if (t && node_index_.count(t)) g.children[v].push_back(node_index_.at(t));
-        } else if (cn == "instance_geometry" || cn == "instance_controller") {
+          if (!t || !node_index_.count(t))
+            fail(c, "url '" + printable(c.attribute("url").value()) + "' names no <node> id of the file");
+          g.children[v].push_back(node_index_.at(t));
+        } else if (cn == "instance_geometry") {
           g.own_corners[v] += geometry_corners(target(c, "url"));
         }
       }
@@ -261,6 +271,8 @@ class Dae {
       });
       if (words != values)
         fail(n, "holds " + std::to_string(words) + " values; a <" + name + "> takes " + std::to_string(values));
+      // Valid COLLADA that Assimp 5.2 cannot apply: it asserts (an abort in Debian's build).
+      if (name == "skew") fail(n, "a <skew> transform is not read (Assimp cannot apply one)");
     }
   }
 
@@ -503,14 +515,6 @@ class Dae {
 
 // --- glTF ---------------------------------------------------------------------------------
 
-/// The JSON of a glTF file, or of a GLB file's JSON chunk (its container checked first).
-std::string gltf_json(const std::filesystem::path& path, bool binary) {
-  if (!binary) return file_bytes(path);
-  const GlbLayout glb = read_glb_layout(path);
-  return file_bytes(path, static_cast<std::size_t>(glb.json_offset + glb.json_length))
-      .substr(static_cast<std::size_t>(glb.json_offset));
-}
-
 /// Every buffer's byteLength against the bytes that can back it: a GLB's body buffer (no
 /// uri) against its BIN chunk, a file buffer against that file, a data URI against its
 /// decoded size. Why: Assimp allocates a buffer by its declared byteLength before reading it.
@@ -594,9 +598,10 @@ void check_dae_file(const std::filesystem::path& path) {
   pugi::xml_document doc;
   // Not left to Assimp: it reads the part of a malformed document parsed before the error,
   // and a primitive cut off there was read over vertices that are not there.
-  if (const pugi::xml_parse_result parsed = doc.load_buffer(text.data(), text.size(), pugi::parse_minimal); !parsed)
+  if (const pugi::xml_parse_result parsed = doc.load_buffer(text.data(), text.size(), kDaeParseOptions); !parsed)
     throw InputError({path.string(), LineMap(text).line(parsed.offset), "XML"},
                      std::string("the XML does not parse: ") + parsed.description());
+  keep_dae_geometry(doc);  // what Assimp will read
   Dae dae(path, text);
   dae.scan(doc);
   dae.check_instancing(doc);

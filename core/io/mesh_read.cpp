@@ -1,9 +1,14 @@
 #include "core/io/mesh_read.hpp"
 
 #include "core/error.hpp"
+#include "core/io/dae_geometry.hpp"
+#include "core/io/glb_container.hpp"
+#include "core/io/gltf_geometry.hpp"
 #include "core/io/input_file.hpp"
 #include "core/io/mesh_file_checks.hpp"
 #include "core/io/step_file_checks.hpp"
+
+#include <nlohmann/json.hpp>
 
 #include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
@@ -126,7 +131,14 @@ Mesh read_mesh_file(const std::filesystem::path& path) {
   Assimp::Importer importer;
   auto* io = new RegularFilesOnly;
   importer.SetIOHandler(io);  // the importer owns and deletes it
-  if (lower_extension(path) == ".obj") io->serve(path.string(), obj_text_for_assimp(file_bytes(path)));
+  const std::string ext = lower_extension(path);
+  if (ext == ".obj") io->serve(path.string(), obj_text_for_assimp(file_bytes(path)));
+  if (ext == ".dae") io->serve(path.string(), dae_geometry_for_assimp(file_bytes(path)));
+  if (ext == ".gltf" || ext == ".glb") {
+    // Parsed and checked by check_mesh_file_structure; Assimp reads the geometry alone.
+    const nlohmann::json doc = nlohmann::json::parse(gltf_json(path, ext == ".glb"));
+    if (auto geometry = gltf_geometry_for_assimp(doc, path, ext == ".glb")) io->serve(path.string(), std::move(*geometry));
+  }
   // Points and lines are dropped; node transforms are baked in so one mesh results.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   // ValidateDataStructure runs before the other steps: a face index beyond the vertices (which
