@@ -243,8 +243,7 @@ class Dae {
   }
 
   /// Whether an element named `name` is a COLLADA data array (<float_array>, <int_array>,
-  /// ...). Why their ids matter: Assimp keeps one array per id, and a second array under
-  /// the id of one a source already reads made it dereference null (SIGSEGV).
+  /// ...), whose count check_array_count holds to its values.
   static bool is_data_array(const std::string& name) {
     return name == "float_array" || name == "int_array" || name == "bool_array" || name == "Name_array" ||
            name == "IDREF_array" || name == "SIDREF_array" || name == "token_array";
