@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "core/io/mesh_read.hpp"
+#include "common/gltf_seed.hpp"
 #include "common/test_files.hpp"
 
 #include <gtest/gtest.h>
@@ -23,21 +24,11 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-/// The tetrahedron seed of the fuzz corpus: 4 positions, 12 unsigned-short indices, its
-/// buffer a base64 data URI.
-json tetra() { return json::parse(testing::slurp(fs::path(LOOM_SOURCE_DIR) / "tests/fuzz/seeds/gltf/tetra.gltf")); }
+/// The tetrahedron seed of the fuzz corpus, parsed.
+json tetra() { return json::parse(testing::tetra_gltf_text()); }
 
-/// The seed's buffer bytes: 48 of positions, 24 of indices.
-std::string tetra_bytes() {
-  std::string bin;
-  for (const float c : {0.f, 0.f, 0.f, 10.f, 0.f, 0.f, 0.f, 10.f, 0.f, 0.f, 0.f, 10.f}) {
-    char b[4];
-    std::memcpy(b, &c, 4);  // little-endian, as glTF and the machines loom runs on
-    bin.append(b, 4);
-  }
-  for (const int i : {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3}) bin += std::string{static_cast<char>(i), '\0'};
-  return bin;
-}
+/// The seed's buffer bytes.
+std::string tetra_bytes() { return testing::tetra_gltf_buffer(); }
 
 /// `doc` written as `name` in `dir`, read by loom.
 Mesh read(const fs::path& dir, const std::string& name, const json& doc) {

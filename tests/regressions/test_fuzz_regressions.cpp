@@ -28,6 +28,7 @@
 #include "core/io/point_cloud_io.hpp"
 #include "core/io/toml_checks.hpp"
 #include "common/run_loom.hpp"
+#include "common/gltf_seed.hpp"
 #include "common/test_files.hpp"
 
 namespace {
@@ -97,7 +98,7 @@ void expect_read_refused(const fs::path& file, const std::string& text, const st
 }
 
 /// The tetrahedron glTF seed of the fuzz corpus (its buffer a base64 data URI).
-std::string tetra_gltf() { return slurp(fs::path(LOOM_SOURCE_DIR) / "tests/fuzz/seeds/gltf/tetra.gltf"); }
+std::string tetra_gltf() { return loom::testing::tetra_gltf_text(); }
 
 // --- DAE -------------------------------------------------------------------------------------
 
@@ -125,6 +126,9 @@ const char* kDaeSceneOfG =
 </COLLADA>
 )";
 
+/// A COLLADA document of dae_triangle_geometry's one triangle, instanced once.
+std::string dae_one_triangle() { return kDaeHead + dae_triangle_geometry("3", "0 1 2") + kDaeSceneOfG; }
+
 /// dae_triangle_geometry's primitive for p = "0 1 2", for tests that put another in its place.
 const std::string kDaeTriangle =
     R"(<triangles count="1"><input semantic="VERTEX" source="#v" offset="0"/><p>0 1 2</p></triangles>)";
@@ -141,7 +145,7 @@ TEST(FuzzRegression, DaeAccessorHugeStrideCrashed) {
             std::string::npos)
       << r.out;
   // Stride 3 (the array exactly) reads the triangle; stride 4 reaches one value beyond.
-  write(d / "ok.dae", kDaeHead + dae_triangle_geometry("3", "0 1 2") + kDaeSceneOfG);
+  write(d / "ok.dae", dae_one_triangle());
   EXPECT_EQ(loom::read_mesh_file(d / "ok.dae").triangle_count(), 1u);
   write(d / "four.dae", kDaeHead + dae_triangle_geometry("4", "0 1 2") + kDaeSceneOfG);
   const std::string e = input_error([&] { loom::read_mesh_file(d / "four.dae"); });
@@ -277,7 +281,7 @@ TEST(FuzzRegression, DaeInputOffsetBeyondItsIndicesAllocated) {
   expect_finding_refused(d, "mesh_dae/input-offset-beyond-indices-oom.dae", "offset.dae",
                          "offset.dae:16: <input>: offset '9999999999999999999999999999999990' is not an index into "
                          "the 12 values of the <p>");
-  std::string many = kDaeHead + dae_triangle_geometry("3", "0 1 2") + kDaeSceneOfG;
+  std::string many = dae_one_triangle();
   many.replace(many.find(R"(<triangles count="1">)"), 21, R"(<triangles count="1000000000">)");
   expect_part_refused(d, "many.dae", many,
                       "<triangles>: count 1000000000 triangles take 3000000000 indices at 1 per vertex, but the <p> "
@@ -292,7 +296,7 @@ TEST(FuzzRegression, DaeArrayIdGivenTwiceCrashed) {
   const fs::path d = scratch();
   expect_finding_refused(d, "mesh_dae/array-id-given-twice-segv.dae", "twice.dae",
                          "twice.dae:63: <visual_scene>: id 'scene' is given again (first at line 43, <visual_scene>)");
-  std::string two = kDaeHead + dae_triangle_geometry("3", "0 1 2") + kDaeSceneOfG;
+  std::string two = dae_one_triangle();
   const std::string array = R"(<float_array id="pa" count="9">0 0 0 1 0 0 0 1 0</float_array>)";
   two.insert(two.find("</library_geometries>"),
              R"(<geometry id="g2"><mesh><source id="p2">)" + array + "</source></mesh></geometry>\n");
@@ -337,7 +341,7 @@ TEST(FuzzRegression, DaePrimitiveBeforeVerticesOverflowed) {
   expect_finding_refused(d, "mesh_dae/primitive-before-vertices-hbo.dae", "early.dae",
                          "early.dae:1: <polylist>: comes before the mesh's <vertices> (line 1): a mesh's primitives "
                          "follow its <vertices>");
-  const std::string one = kDaeHead + dae_triangle_geometry("3", "0 1 2") + kDaeSceneOfG;
+  const std::string one = dae_one_triangle();
   write(d / "one.dae", one);
   EXPECT_EQ(loom::read_mesh_file(d / "one.dae").triangle_count(), 1u);
   std::string none = one;
@@ -356,7 +360,7 @@ TEST(FuzzRegression, DaeMalformedXmlReadInPartOverflowed) {
   const fs::path d = scratch();
   expect_finding_refused(d, "mesh_dae/malformed-xml-read-in-part-hbo.dae", "cut.dae",
                          "cut.dae:1: XML: the XML does not parse: Error parsing start element tag");
-  std::string cut = kDaeHead + dae_triangle_geometry("3", "0 1 2") + kDaeSceneOfG;
+  std::string cut = dae_one_triangle();
   cut.resize(cut.find("</mesh>") + 3);
   expect_part_refused(d, "end.dae", cut, "end.dae:8: XML: the XML does not parse: Start-end tags mismatch");
 }
@@ -368,7 +372,7 @@ TEST(FuzzRegression, DaeArrayCountBeyondItsValuesAllocated) {
   const fs::path d = scratch();
   expect_finding_refused(d, "mesh_dae/array-count-beyond-values-oom.dae", "count.dae",
                          "count.dae:8: <float_array>: attribute 'count' = '3333");
-  std::string more = kDaeHead + dae_triangle_geometry("3", "0 1 2") + kDaeSceneOfG;
+  std::string more = dae_one_triangle();
   more.replace(more.find(R"(count="9")"), 9, R"(count="10")");
   expect_part_refused(d, "more.dae", more, "<float_array>: count 10 but it holds 9 values");
 }
@@ -620,13 +624,7 @@ TEST(FuzzRegression, GlbLineLoopIndexOutOfRangeCrashed) {
   const std::size_t uri = text.find("data:application");
   text.replace(uri, text.find('"', uri) - uri, "tetra.bin");
   write(d / "file.gltf", text);
-  std::string bin;
-  for (const float c : {0.f, 0.f, 0.f, 10.f, 0.f, 0.f, 0.f, 10.f, 0.f, 0.f, 0.f, 10.f}) {
-    char b[4];
-    std::memcpy(b, &c, 4);  // little-endian, as glTF and the machines loom runs on
-    bin.append(b, 4);
-  }
-  for (const int i : {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3}) bin += std::string{static_cast<char>(i), '\0'};
+  std::string bin = loom::testing::tetra_gltf_buffer();
   write(d / "tetra.bin", bin);
   EXPECT_EQ(loom::read_mesh_file(d / "file.gltf").triangle_count(), 4u);
   bin[48 + 22] = 9;
