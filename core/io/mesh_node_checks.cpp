@@ -181,6 +181,7 @@ class Dae {
       else if (name == "visual_scene") visual_scenes_.push_back(node);
       else if (name == "geometry") geometries_.push_back(node);
       else if (name == "mesh") check_mesh_layout(node);
+      if (name == "vertices" || is_primitive_name(name)) check_in_its_mesh(node);
       if (std::string(node.parent().name()) == "node") check_transform(node, name);
       if (is_data_array(name)) check_array_count(node);
       for (pugi::xml_node c = node.first_child(); c; c = c.next_sibling())
@@ -296,14 +297,28 @@ class Dae {
     }
   }
 
+  /// Whether `name` names a COLLADA primitive (<triangles>, <polylist>, ...).
+  static bool is_primitive_name(const std::string& name) {
+    static const char* const kPrimitives[] = {"triangles", "polylist", "polygons", "lines",
+                                              "linestrips", "trifans", "tristrips"};
+    return std::any_of(std::begin(kPrimitives), std::end(kPrimitives), [&](const char* k) { return name == k; });
+  }
+
   /// Whether `n` is a primitive of a <mesh>: Assimp reads those (and nothing of a
   /// <convex_mesh> or other holder).
   static bool is_primitive(const pugi::xml_node& n) {
-    static const char* const kPrimitives[] = {"triangles", "polylist", "polygons", "lines",
-                                              "linestrips", "trifans", "tristrips"};
-    const std::string name = n.name();
-    return std::string(n.parent().name()) == "mesh" &&
-           std::any_of(std::begin(kPrimitives), std::end(kPrimitives), [&](const char* k) { return name == k; });
+    return std::string(n.parent().name()) == "mesh" && is_primitive_name(n.name());
+  }
+
+  /// A <vertices> or primitive within a <mesh> is a child of it. Why: Assimp 5.2 walks all
+  /// of a mesh's descendants for them, so a <triangles> a mutation had put inside an
+  /// <accessor> was read as the mesh's — unchecked, with a count of 4.7·10⁵⁵ (103 GB).
+  void check_in_its_mesh(const pugi::xml_node& n) const {
+    if (std::string(n.parent().name()) == "mesh") return;
+    for (pugi::xml_node a = n.parent(); a; a = a.parent())
+      if (std::string(a.name()) == "mesh")
+        fail(n, "inside <" + std::string(n.parent().name()) + ">, not a child of the <mesh> on line " +
+                    std::to_string(line(a)) + " (Assimp would read it as one of that mesh's)");
   }
 
   /// A primitive with a count above 0 holds a <p>; a <polylist> holds its <vcount> before

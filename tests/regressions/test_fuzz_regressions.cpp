@@ -352,6 +352,20 @@ TEST(FuzzRegression, DaePrimitiveBeforeVerticesOverflowed) {
   expect_part_refused(d, "two.dae", two, "two.dae:7: <vertices>: a second <vertices> in the mesh (the first at line 6)");
 }
 
+// A `<triangles count="4777…777">` a mutation had put inside an `<accessor>` (libFuzzer,
+// seed 32, 397,729 executions after the geometry-only reduction): Assimp walks all of a
+// mesh's descendants for its primitives, read this one as the mesh's and allocated by its
+// count (103 GB); the pre-check took only the mesh's children for primitives. A
+// <vertices> or primitive within a mesh is now a child of it.
+TEST(FuzzRegression, DaePrimitiveInsideAnAccessorAllocated) {
+  const fs::path d = scratch();
+  expect_finding_refused(d, "mesh_dae/primitive-inside-accessor-oom.dae", "deep.dae",
+                         "deep.dae:12: <polylist>: inside <accessor>, not a child of the <mesh> on line 6");
+  std::string deep = dae_one_triangle();
+  deep.insert(deep.find("</technique_common>"), R"(<vertices id="v2"><input semantic="POSITION" source="#p"/></vertices>)");
+  expect_part_refused(d, "vertices.dae", deep, "<vertices>: inside <technique_common>, not a child of the <mesh> on line 3");
+}
+
 // The same input cut by a mutation inside a start tag (`<node  <instance_geometry`): the
 // XML does not parse, yet Assimp read the part before the error and overflowed the same
 // way, while the pre-check had left malformed XML to Assimp. Malformed XML is refused,
