@@ -503,10 +503,14 @@ class Dae {
     if (!array || count == 0) return;
     std::uint64_t params = 0;
     for (pugi::xml_node p = a.child("param"); p; p = p.next_sibling("param")) ++params;
+    // A stride of 0 read every element at the offset, past an empty array (SIGSEGV).
+    if (stride == 0 || stride < params)
+      fail(a, "stride " + std::to_string(stride) + " for " + std::to_string(params) +
+                  " params: an element takes at least one value and its params' values");
     const std::uint64_t size = count_attribute(array, "count", 0);
     // offset + (count − 1)·stride + params ≤ size, without overflow.
     const bool fits = offset <= size && params <= size - offset &&
-                      (stride == 0 || count - 1 <= (size - offset - params) / stride);
+                      count - 1 <= (size - offset - params) / stride;
     if (!fits)
       fail(a, "count " + std::to_string(count) + " x stride " + std::to_string(stride) + " from offset " +
                   std::to_string(offset) + " reaches beyond the " + std::to_string(size) + " values of <" +

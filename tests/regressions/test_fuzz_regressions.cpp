@@ -366,6 +366,18 @@ TEST(FuzzRegression, DaePrimitiveInsideAnAccessorAllocated) {
   expect_part_refused(d, "vertices.dae", deep, "<vertices>: inside <technique_common>, not a child of the <mesh> on line 3");
 }
 
+// An `<accessor stride="0">` over a float_array whose count a mutation had spoilt
+// (libFuzzer, seed 33, 776,170 executions after the mesh-children fix; minimised by
+// libFuzzer to 551 bytes): the bound check let a stride of 0 through, and Assimp read
+// every position at the offset of an empty array (SIGSEGV).
+TEST(FuzzRegression, DaeAccessorStrideZeroCrashed) {
+  const fs::path d = scratch();
+  expect_finding_refused(d, "mesh_dae/accessor-stride-zero-segv.dae", "zero.dae",
+                         "zero.dae:6: <accessor>: stride 0 for 0 params");
+  expect_part_refused(d, "two.dae", kDaeHead + dae_triangle_geometry("2", "0 1 2") + kDaeSceneOfG,
+                      "<accessor>: stride 2 for 3 params");
+}
+
 // The same input cut by a mutation inside a start tag (`<node  <instance_geometry`): the
 // XML does not parse, yet Assimp read the part before the error and overflowed the same
 // way, while the pre-check had left malformed XML to Assimp. Malformed XML is refused,
