@@ -129,6 +129,11 @@ std::uint64_t accessor_count(const nlohmann::json& doc, const nlohmann::json& id
   return n ? *n : 0;
 }
 
+/// Whether primitive `prim` (an object) names a POSITION attribute.
+bool has_position(const nlohmann::json& prim) {
+  return prim.contains("attributes") && prim["attributes"].is_object() && prim["attributes"].contains("POSITION");
+}
+
 /// A strip, fan or loop has the vertices its mode needs for one face (`where` names it).
 void check_mode_vertices(const nlohmann::json& doc, const nlohmann::json& prim, const std::filesystem::path& path,
                          const std::string& where) {
@@ -136,8 +141,7 @@ void check_mode_vertices(const nlohmann::json& doc, const nlohmann::json& prim, 
   const std::uint64_t least = mode ? least_vertices(*mode) : 0;
   if (least == 0) return;
   const bool indexed = prim.contains("indices");
-  const bool positioned = prim.contains("attributes") && prim["attributes"].is_object() &&
-                          prim["attributes"].contains("POSITION");
+  const bool positioned = has_position(prim);
   const std::uint64_t n = indexed      ? accessor_count(doc, prim["indices"])
                           : positioned ? accessor_count(doc, prim["attributes"]["POSITION"])
                                        : 0;
@@ -210,8 +214,7 @@ void check_primitive(const nlohmann::json& doc, const nlohmann::json& prim, Buff
                      const std::filesystem::path& path, const std::string& where) {
   if (!prim.is_object()) return;
   check_mode_vertices(doc, prim, path, where);
-  const bool positioned = prim.contains("attributes") && prim["attributes"].is_object() &&
-                          prim["attributes"].contains("POSITION");
+  const bool positioned = has_position(prim);
   const AccessorBytes positions =
       positioned ? accessor_bytes(doc, prim["attributes"]["POSITION"], buffers, path, where, "POSITION") : AccessorBytes{};
   if (!prim.contains("indices")) return;
